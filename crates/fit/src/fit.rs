@@ -1,0 +1,178 @@
+//! The whole fit of one source: extraction, G1, Fresnel, parameter fits and errors.
+
+use crate::brdf::Brdf;
+use crate::error::FitError;
+use crate::extract::{ExtractConfig, extract_anisotropic, extract_isotropic};
+use crate::fresnel::{Fresnel, FresnelTable};
+use crate::grid::{GridSamples, fresnel_average, microfacet_error};
+use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
+use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use crate::params::{fit_least_squares, fit_moments, model_with_fresnel};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// Which models to fit and report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Models {
+    pub tabulated: bool,
+    pub ggx: bool,
+    pub beckmann: bool,
+}
+
+impl Models {
+    pub const ALL: Models = Models {
+        tabulated: true,
+        ggx: true,
+        beckmann: true,
+    };
+}
+
+/// Fit settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitConfig {
+    pub extract: ExtractConfig,
+    /// Extract on a (θ, φ) grid and fit αx, αy and rotation.
+    pub anisotropic: bool,
+    pub models: Models,
+    /// The least-squares searches run on every `search_stride`-th grid sample; the reported
+    /// errors use every sample.
+    pub search_stride: usize,
+}
+
+impl FitConfig {
+    pub const fn isotropic() -> Self {
+        FitConfig {
+            extract: ExtractConfig::isotropic(),
+            anisotropic: false,
+            models: Models::ALL,
+            search_stride: 32,
+        }
+    }
+
+    pub const fn anisotropic() -> Self {
+        FitConfig {
+            extract: ExtractConfig::anisotropic(),
+            anisotropic: true,
+            models: Models::ALL,
+            search_stride: 64,
+        }
+    }
+}
+
+impl Default for FitConfig {
+    fn default() -> Self {
+        Self::isotropic()
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Fits one source. `source` describes where it came from (recorded in the JSON).
+pub fn fit_material(
+    src: &dyn Brdf,
+    source: &str,
+    cfg: &FitConfig,
+) -> Result<FittedMaterial, FitError> {
+    let start = Instant::now();
+    let t = Instant::now();
+    let ex = if cfg.anisotropic {
+        extract_anisotropic(src, &cfg.extract)?
+    } else {
+        extract_isotropic(src, &cfg.extract)?
+    };
+    let extract_ms = ms(t);
+
+    let t = Instant::now();
+    let set = GridSamples::new(src);
+    if set.is_empty() {
+        return Err(FitError::Extraction {
+            name: src.name().into(),
+            problem: "no valid sample on the MERL grid".into(),
+        });
+    }
+    let mut tabulated = MicrofacetBrdf {
+        name: format!("{}-tabulated", src.name()),
+        ndf: Ndf::Tabulated(Arc::new(ex.ndf.clone())),
+        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
+        diffuse: [0.0; 3],
+    };
+    let fresnel = FresnelTable::on_merl_bins(fresnel_average(&tabulated, &set));
+    tabulated.fresnel = Fresnel::Table(fresnel.clone());
+    let fresnel_ms = ms(t);
+
+    let t = Instant::now();
+    let tab_error = cfg
+        .models
+        .tabulated
+        .then(|| microfacet_error(&tabulated, &set));
+    let search = set.subsample(cfg.search_stride);
+    let fit_kind = |kind: NdfKind| -> ParamRecord {
+        let moments = fit_moments(kind, &ex.ndf);
+        let lsq = fit_least_squares(moments, cfg.anisotropic, &search);
+        let moment_model = model_with_fresnel("moments", moments, &set);
+        let lsq_model = model_with_fresnel("lsq", lsq, &set);
+        let Fresnel::Table(fresnel) = lsq_model.fresnel.clone() else {
+            unreachable!()
+        };
+        let params = |n: &AnalyticNdf, e| Params {
+            alpha_x: n.alpha_x,
+            alpha_y: n.alpha_y,
+            rotation: n.rotation,
+            error: e,
+        };
+        let moments = params(&moments, microfacet_error(&moment_model, &set));
+        ParamRecord {
+            alpha_x: lsq.alpha_x,
+            alpha_y: lsq.alpha_y,
+            rotation: lsq.rotation,
+            error: microfacet_error(&lsq_model, &set),
+            method: "least_squares".into(),
+            moments,
+            fresnel,
+        }
+    };
+    let ggx = cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx));
+    let beckmann = cfg.models.beckmann.then(|| fit_kind(NdfKind::Beckmann));
+    let fit_ms = ms(t);
+
+    let record = FitRecord {
+        name: src.name().to_owned(),
+        source: source.to_owned(),
+        backend: "cpu".into(),
+        resolution: cfg.extract.resolution,
+        phi_resolution: if cfg.anisotropic {
+            cfg.extract.phi_resolution
+        } else {
+            1
+        },
+        anisotropic: cfg.anisotropic,
+        quadrature: cfg.extract.quadrature,
+        iterations: ex.iterations,
+        residual: ex.residual,
+        eigenvalue: ex.eigenvalue,
+        tabulated: TabulatedRecord {
+            error: tab_error,
+            stretch: ex.ndf.stretch,
+            tables: ex.ndf.tables().clone(),
+        },
+        ggx,
+        beckmann,
+        fresnel,
+        timings_ms: Timings {
+            load: 0.0,
+            extract: extract_ms,
+            fresnel: fresnel_ms,
+            fit: fit_ms,
+            total: ms(start),
+        },
+    };
+    let mut material =
+        FittedMaterial::from_record(record).map_err(|problem| FitError::Extraction {
+            name: src.name().into(),
+            problem,
+        })?;
+    material.tabulated = tabulated; // the same model, without rebuilding the sampler
+    Ok(material)
+}

@@ -1,0 +1,201 @@
+//! A fitted material: the tabulated NDF with its Fresnel table, the GGX and Beckmann fits, and
+//! the record written as `<name>.json`. Each model is itself a [`Brdf`].
+
+use crate::brdf::{Brdf, Rgb};
+use crate::error::FitError;
+use crate::fresnel::{Fresnel, FresnelTable};
+use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use crate::tabulated::{NdfTables, Stretch, TabulatedNdf};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::sync::Arc;
+
+/// α and rotation of a parametric fit, with its error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Params {
+    pub alpha_x: f64,
+    pub alpha_y: f64,
+    /// Radians.
+    pub rotation: f64,
+    pub error: f64,
+}
+
+/// A GGX or Beckmann fit: by least squares in the metric's space (the model used), with the
+/// moment estimate beside it and the Fresnel table averaged for the least-squares model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParamRecord {
+    pub alpha_x: f64,
+    pub alpha_y: f64,
+    pub rotation: f64,
+    pub error: f64,
+    pub method: String,
+    pub moments: Params,
+    pub fresnel: FresnelTable,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TabulatedRecord {
+    /// Error metric of the tabulated model; absent when it was not asked for.
+    pub error: Option<f64>,
+    pub stretch: Stretch,
+    pub tables: NdfTables,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    pub load: f64,
+    pub extract: f64,
+    pub fresnel: f64,
+    pub fit: f64,
+    pub total: f64,
+}
+
+/// The fit JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitRecord {
+    pub name: String,
+    pub source: String,
+    pub backend: String,
+    pub resolution: usize,
+    pub phi_resolution: usize,
+    pub anisotropic: bool,
+    pub quadrature: crate::quadrature::Quadrature,
+    pub iterations: usize,
+    pub residual: f64,
+    /// λ of the power iteration: F(0) of the backscattering slice, mean of RGB.
+    pub eigenvalue: f64,
+    pub tabulated: TabulatedRecord,
+    pub ggx: Option<ParamRecord>,
+    pub beckmann: Option<ParamRecord>,
+    /// F(θd) of the tabulated model.
+    pub fresnel: FresnelTable,
+    pub timings_ms: Timings,
+}
+
+/// Which model of a fit to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelChoice {
+    Tabulated,
+    Ggx,
+    Beckmann,
+}
+
+impl ModelChoice {
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "tabulated" => Some(ModelChoice::Tabulated),
+            "ggx" => Some(ModelChoice::Ggx),
+            "beckmann" => Some(ModelChoice::Beckmann),
+            _ => None,
+        }
+    }
+}
+
+/// A fit record with its models built.
+#[derive(Clone, Debug)]
+pub struct FittedMaterial {
+    pub record: FitRecord,
+    pub tabulated: MicrofacetBrdf,
+    pub ggx: Option<MicrofacetBrdf>,
+    pub beckmann: Option<MicrofacetBrdf>,
+}
+
+impl FittedMaterial {
+    pub fn from_record(record: FitRecord) -> Result<Self, String> {
+        record.fresnel.validate()?;
+        let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)?;
+        let tabulated = MicrofacetBrdf {
+            name: format!("{}-tabulated", record.name),
+            ndf: Ndf::Tabulated(Arc::new(ndf)),
+            fresnel: Fresnel::Table(record.fresnel.clone()),
+            diffuse: [0.0; 3],
+        };
+        let param =
+            |kind: NdfKind, p: &Option<ParamRecord>| -> Result<Option<MicrofacetBrdf>, String> {
+                let Some(p) = p else { return Ok(None) };
+                p.fresnel.validate()?;
+                if !(p.alpha_x > 0.0 && p.alpha_y > 0.0 && p.rotation.is_finite()) {
+                    return Err(format!("{} α must be positive", kind.name()));
+                }
+                Ok(Some(MicrofacetBrdf {
+                    name: format!("{}-{}", record.name, kind.name()),
+                    ndf: Ndf::Analytic(AnalyticNdf {
+                        kind,
+                        alpha_x: p.alpha_x,
+                        alpha_y: p.alpha_y,
+                        rotation: p.rotation,
+                    }),
+                    fresnel: Fresnel::Table(p.fresnel.clone()),
+                    diffuse: [0.0; 3],
+                }))
+            };
+        let ggx = param(NdfKind::Ggx, &record.ggx)?;
+        let beckmann = param(NdfKind::Beckmann, &record.beckmann)?;
+        Ok(FittedMaterial {
+            record,
+            tabulated,
+            ggx,
+            beckmann,
+        })
+    }
+
+    pub fn load(path: &Path) -> Result<Self, FitError> {
+        let bad = |problem: String| FitError::Material {
+            path: path.to_owned(),
+            problem,
+        };
+        let text = std::fs::read_to_string(path).map_err(|e| FitError::io(path, e))?;
+        let record: FitRecord = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        Self::from_record(record).map_err(bad)
+    }
+
+    /// Writes the record as pretty JSON, through a temporary file renamed into place.
+    pub fn save(&self, path: &Path) -> Result<(), FitError> {
+        let text =
+            serde_json::to_string_pretty(&self.record).expect("a fit record always serialises");
+        let tmp = path.with_extension("json.partial");
+        std::fs::write(&tmp, text)
+            .and_then(|_| std::fs::rename(&tmp, path))
+            .map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                FitError::io(path, e)
+            })
+    }
+
+    /// One of the fitted models, if it was fitted.
+    pub fn model(&self, choice: ModelChoice) -> Option<&MicrofacetBrdf> {
+        match choice {
+            ModelChoice::Tabulated => Some(&self.tabulated),
+            ModelChoice::Ggx => self.ggx.as_ref(),
+            ModelChoice::Beckmann => self.beckmann.as_ref(),
+        }
+    }
+
+    /// The tabulated model with its NDF stretched: `P(x~/αx, y~/αy) sec⁴θ / (αx αy)`.
+    pub fn stretched(&self, stretch: Stretch) -> MicrofacetBrdf {
+        let Ndf::Tabulated(t) = &self.tabulated.ndf else {
+            unreachable!("the tabulated model has a tabulated NDF")
+        };
+        MicrofacetBrdf {
+            ndf: Ndf::Tabulated(Arc::new(t.with_stretch(stretch))),
+            ..self.tabulated.clone()
+        }
+    }
+}
+
+/// A fitted material is a BRDF source: its tabulated model.
+impl Brdf for FittedMaterial {
+    fn name(&self) -> &str {
+        &self.record.name
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        self.tabulated.eval(wi, wo)
+    }
+
+    fn is_isotropic(&self) -> bool {
+        self.tabulated.is_isotropic()
+    }
+}

@@ -1,0 +1,392 @@
+//! MERL isotropic BRDF files (Matusik et al. 2003): reader, writer, nearest and interpolated
+//! lookups.
+//!
+//! File layout: three little-endian `i32` dimensions (90, 90, 180) followed by 3·n `f64`
+//! values, all red then all green then all blue, sample index
+//! `φd_bin + 180 (θd_bin + 90 θh_bin)`. A stored value times the channel scale
+//! (1, 1.15, 1.66) / 1500 is f_r; a negative value marks a missing sample.
+//! Sample (i, j, k) sits at the bin's lower edge: θh = (i/90)² π/2, θd = j/90 · π/2, φd = k/180 · π.
+
+use crate::brdf::{Brdf, Rgb};
+use crate::error::FitError;
+use crate::geometry::{HalfDiff, from_half_diff, to_half_diff};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::f64::consts::{FRAC_PI_2, PI};
+use std::io::{Read, Write};
+use std::path::Path;
+
+pub const THETA_H_RES: usize = 90;
+pub const THETA_D_RES: usize = 90;
+pub const PHI_D_RES: usize = 180;
+/// Samples per channel.
+pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
+/// f_r = stored value × SCALE[channel].
+pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
+const HEADER_BYTES: u64 = 12;
+
+/// Flat index of bin (θh, θd, φd).
+pub const fn index(i: usize, j: usize, k: usize) -> usize {
+    k + PHI_D_RES * (j + THETA_D_RES * i)
+}
+
+/// Angles of the sample in bin (i, j, k): its lower edge.
+pub fn bin_angles(i: usize, j: usize, k: usize) -> HalfDiff {
+    let u = i as f64 / THETA_H_RES as f64;
+    HalfDiff {
+        theta_h: u * u * FRAC_PI_2,
+        phi_h: 0.0,
+        theta_d: j as f64 / THETA_D_RES as f64 * FRAC_PI_2,
+        phi_d: k as f64 / PHI_D_RES as f64 * PI,
+    }
+}
+
+/// Continuous bin coordinates (sample centres at integers) of a Rusinkiewicz pair.
+fn bin_coords(c: HalfDiff) -> [f64; 3] {
+    [
+        (c.theta_h.max(0.0) / FRAC_PI_2).sqrt() * THETA_H_RES as f64,
+        c.theta_d.max(0.0) / FRAC_PI_2 * THETA_D_RES as f64,
+        c.phi_d.rem_euclid(PI) / PI * PHI_D_RES as f64, // reciprocity: φd and φd + π are one bin
+    ]
+}
+
+/// The raw samples of a MERL file, exactly as stored.
+#[derive(Clone, PartialEq)]
+pub struct MerlTable {
+    /// 3 · SAMPLES stored values, channel-major, as in the file.
+    raw: Vec<f64>,
+}
+
+impl std::fmt::Debug for MerlTable {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "MerlTable({} samples, {} missing)",
+            SAMPLES,
+            self.missing_count()
+        )
+    }
+}
+
+impl MerlTable {
+    /// Reads and validates a MERL `.binary` file.
+    pub fn read(path: &Path) -> Result<Self, FitError> {
+        let bad = |problem: String| FitError::Merl {
+            path: path.to_owned(),
+            problem,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| FitError::io(path, e))?;
+        if meta.is_dir() {
+            return Err(bad("is a directory".into()));
+        }
+        let len = meta.len();
+        if len == 0 {
+            return Err(bad("the file is empty".into()));
+        }
+        if len < HEADER_BYTES {
+            return Err(bad(format!(
+                "truncated header: {len} bytes, a header needs 12"
+            )));
+        }
+        let mut file = std::fs::File::open(path).map_err(|e| FitError::io(path, e))?;
+        let mut header = [0u8; 12];
+        file.read_exact(&mut header)
+            .map_err(|e| FitError::io(path, e))?;
+        let dims: [i32; 3] = std::array::from_fn(|d| {
+            i32::from_le_bytes(header[4 * d..4 * d + 4].try_into().unwrap())
+        });
+        if dims.iter().any(|&d| d <= 0) {
+            return Err(bad(format!(
+                "dimensions {dims:?} in the header are not positive"
+            )));
+        }
+        let n = dims.iter().map(|&d| d as u64).product::<u64>();
+        let expected = HEADER_BYTES + 3 * 8 * n;
+        if len < expected {
+            return Err(bad(format!(
+                "truncated: header {}×{}×{} needs {expected} bytes, the file has {len}",
+                dims[0], dims[1], dims[2]
+            )));
+        }
+        if len > expected {
+            return Err(bad(format!(
+                "oversized: header {}×{}×{} needs {expected} bytes, the file has {} more",
+                dims[0],
+                dims[1],
+                dims[2],
+                len - expected
+            )));
+        }
+        if dims != [THETA_H_RES as i32, THETA_D_RES as i32, PHI_D_RES as i32] {
+            return Err(bad(format!(
+                "dimensions {}×{}×{} are not the standard 90×90×180 layout",
+                dims[0], dims[1], dims[2]
+            )));
+        }
+        let mut raw = vec![0f64; 3 * SAMPLES];
+        file.read_exact(bytemuck::cast_slice_mut(&mut raw))
+            .map_err(|e| FitError::io(path, e))?;
+        if cfg!(target_endian = "big") {
+            raw.iter_mut()
+                .for_each(|v| *v = f64::from_bits(u64::from_le(v.to_bits())));
+        }
+        if let Some(at) = raw.iter().position(|v| !v.is_finite()) {
+            let (c, s) = (at / SAMPLES, at % SAMPLES);
+            let (i, j, k) = (
+                s / (PHI_D_RES * THETA_D_RES),
+                s / PHI_D_RES % THETA_D_RES,
+                s % PHI_D_RES,
+            );
+            return Err(bad(format!(
+                "sample {s} of channel {} (θh bin {i}, θd bin {j}, φd bin {k}) is {}",
+                ["red", "green", "blue"][c],
+                raw[at]
+            )));
+        }
+        Ok(MerlTable { raw })
+    }
+
+    /// Writes the table as a MERL file. The file is written beside its destination and renamed
+    /// into place, so a failed write never leaves a half-written file.
+    pub fn write(&self, path: &Path) -> Result<(), FitError> {
+        let tmp = path.with_extension("binary.partial");
+        let result = (|| {
+            let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+            for d in [THETA_H_RES, THETA_D_RES, PHI_D_RES] {
+                file.write_all(&(d as i32).to_le_bytes())?;
+            }
+            if cfg!(target_endian = "big") {
+                for v in &self.raw {
+                    file.write_all(&v.to_le_bytes())?;
+                }
+            } else {
+                file.write_all(bytemuck::cast_slice(&self.raw))?;
+            }
+            file.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+            std::fs::rename(&tmp, path)
+        })();
+        result.map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            FitError::io(path, e)
+        })
+    }
+
+    /// Samples any BRDF at the bin lower edges; below the horizon and where the source has no
+    /// value the sample is marked missing (−1).
+    pub fn sample<B: Brdf + ?Sized>(brdf: &B) -> Self {
+        let mut raw = vec![-1.0; 3 * SAMPLES];
+        let values: Vec<Option<Rgb>> = (0..SAMPLES)
+            .into_par_iter()
+            .map(|s| {
+                let (i, j, k) = (
+                    s / (PHI_D_RES * THETA_D_RES),
+                    s / PHI_D_RES % THETA_D_RES,
+                    s % PHI_D_RES,
+                );
+                let (wi, wo) = from_half_diff(bin_angles(i, j, k));
+                if wi.z <= 0.0 || wo.z <= 0.0 {
+                    return None;
+                }
+                brdf.eval(wi, wo)
+            })
+            .collect();
+        for (s, v) in values.into_iter().enumerate() {
+            if let Some(v) = v {
+                for c in 0..3 {
+                    raw[c * SAMPLES + s] = v[c] / SCALE[c];
+                }
+            }
+        }
+        MerlTable { raw }
+    }
+
+    /// f_r of bin (i, j, k), or `None` if the sample is missing.
+    #[inline]
+    pub fn value(&self, i: usize, j: usize, k: usize) -> Option<Rgb> {
+        self.value_at(index(i, j, k))
+    }
+
+    /// f_r of flat sample `s`, or `None` if the sample is missing.
+    #[inline]
+    pub fn value_at(&self, s: usize) -> Option<Rgb> {
+        let r = [
+            self.raw[s],
+            self.raw[SAMPLES + s],
+            self.raw[2 * SAMPLES + s],
+        ];
+        if r.iter().any(|&v| v < 0.0) {
+            return None;
+        }
+        Some([r[0] * SCALE[0], r[1] * SCALE[1], r[2] * SCALE[2]])
+    }
+
+    /// Marks flat sample `s` as missing.
+    pub fn mark_missing(&mut self, s: usize) {
+        for c in 0..3 {
+            self.raw[c * SAMPLES + s] = -1.0;
+        }
+    }
+
+    /// Scales sample `s` by a per-channel factor (for noise experiments).
+    pub fn scale_sample(&mut self, s: usize, factor: Rgb) {
+        for c in 0..3 {
+            if self.raw[c * SAMPLES + s] >= 0.0 {
+                self.raw[c * SAMPLES + s] *= factor[c];
+            }
+        }
+    }
+
+    pub fn missing_count(&self) -> usize {
+        (0..SAMPLES).filter(|&s| self.value_at(s).is_none()).count()
+    }
+
+    /// MERL's own lookup: the bin containing the angles (sqrt mapping on θh, φd folded by
+    /// reciprocity), indices clamped to the table.
+    pub fn lookup_nearest(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        let x = bin_coords(to_half_diff(wi, wo));
+        let clamp = |v: f64, n: usize| (v as usize).min(n - 1);
+        self.value(
+            clamp(x[0], THETA_H_RES),
+            clamp(x[1], THETA_D_RES),
+            clamp(x[2], PHI_D_RES),
+        )
+    }
+
+    /// Trilinear interpolation between the samples around (wi, wo), in the sqrt-θh, θd, φd
+    /// bin coordinates; φd wraps with period π; missing corners are left out and the weights of
+    /// the others renormalised.
+    pub fn lookup_interpolated(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        let x = bin_coords(to_half_diff(wi, wo));
+        let axis = |v: f64, n: usize| {
+            let v = v.clamp(0.0, (n - 1) as f64);
+            let i0 = (v as usize).min(n - 2);
+            (i0, i0 + 1, v - i0 as f64)
+        };
+        let (h0, h1, th) = axis(x[0], THETA_H_RES);
+        let (d0, d1, td) = axis(x[1], THETA_D_RES);
+        let p0 = (x[2] as usize).min(PHI_D_RES - 1);
+        let (p1, tp) = ((p0 + 1) % PHI_D_RES, x[2] - p0 as f64);
+        let mut sum = [0.0; 3];
+        let mut wsum = 0.0;
+        for (i, wi) in [(h0, 1.0 - th), (h1, th)] {
+            for (j, wj) in [(d0, 1.0 - td), (d1, td)] {
+                for (k, wk) in [(p0, 1.0 - tp), (p1, tp)] {
+                    let w = wi * wj * wk;
+                    if w <= 0.0 {
+                        continue;
+                    }
+                    if let Some(v) = self.value(i, j, k) {
+                        (0..3).for_each(|c| sum[c] += w * v[c]);
+                        wsum += w;
+                    }
+                }
+            }
+        }
+        (wsum > 0.0).then(|| sum.map(|s| s / wsum))
+    }
+}
+
+/// A MERL measurement as a BRDF source.
+pub struct MerlBrdf {
+    name: String,
+    table: MerlTable,
+    /// f(o, o) per θh bin: the θd = 0 samples averaged over φd, missing bins filled by linear
+    /// interpolation between their valid neighbours.
+    backscatter: Vec<Rgb>,
+}
+
+impl MerlBrdf {
+    pub fn open(path: &Path) -> Result<Self, FitError> {
+        let table = MerlTable::read(path)?;
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        Self::from_table(name, table).map_err(|problem| FitError::Merl {
+            path: path.to_owned(),
+            problem,
+        })
+    }
+
+    /// Wraps a table; fails if the table has no backscattering sample at all.
+    pub fn from_table(name: impl Into<String>, table: MerlTable) -> Result<Self, String> {
+        let slice: Vec<Option<Rgb>> = (0..THETA_H_RES)
+            .map(|i| {
+                let valid: Vec<Rgb> = (0..PHI_D_RES)
+                    .filter_map(|k| table.value(i, 0, k))
+                    .collect();
+                (!valid.is_empty()).then(|| {
+                    let n = valid.len() as f64;
+                    std::array::from_fn(|c| valid.iter().map(|v| v[c]).sum::<f64>() / n)
+                })
+            })
+            .collect();
+        let backscatter = fill_missing(&slice).ok_or("no valid backscattering sample (θd = 0)")?;
+        Ok(MerlBrdf {
+            name: name.into(),
+            table,
+            backscatter,
+        })
+    }
+
+    pub fn table(&self) -> &MerlTable {
+        &self.table
+    }
+}
+
+/// Fills `None` entries by linear interpolation between the nearest valid neighbours (constant
+/// beyond the ends). `None` if nothing is valid.
+pub(crate) fn fill_missing(v: &[Option<Rgb>]) -> Option<Vec<Rgb>> {
+    let valid: Vec<usize> = (0..v.len()).filter(|&i| v[i].is_some()).collect();
+    let (&first, &last) = (valid.first()?, valid.last()?);
+    Some(
+        (0..v.len())
+            .map(|i| match v[i] {
+                Some(x) => x,
+                None if i < first => v[first].unwrap(),
+                None if i > last => v[last].unwrap(),
+                None => {
+                    let hi = valid.partition_point(|&x| x < i);
+                    let (a, b) = (valid[hi - 1], valid[hi]);
+                    let t = (i - a) as f64 / (b - a) as f64;
+                    let (va, vb) = (v[a].unwrap(), v[b].unwrap());
+                    std::array::from_fn(|c| va[c] + t * (vb[c] - va[c]))
+                }
+            })
+            .collect(),
+    )
+}
+
+impl Brdf for MerlBrdf {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return None;
+        }
+        self.table.lookup_interpolated(wi, wo)
+    }
+
+    fn backscatter(&self, theta: f64, _phi: f64) -> Option<Rgb> {
+        // θd = 0 samples sit at integer sqrt-θh coordinates; interpolate linearly between them.
+        let last = THETA_H_RES - 1;
+        let x = (theta.max(0.0) / FRAC_PI_2).sqrt() * THETA_H_RES as f64;
+        if x > last as f64 {
+            // Past the last sample (88°) hold f cos θ constant: f(o,o) grows like 1/cos θ at
+            // grazing angles (G1 ∝ cos θ there), while f cos θ tends to a finite limit.
+            let theta_last = bin_angles(last, 0, 0).theta_h;
+            let scale = theta_last.cos() / theta.cos().max(1e-6);
+            return Some(self.backscatter[last].map(|v| v * scale));
+        }
+        let i0 = (x as usize).min(THETA_H_RES - 2);
+        let t = x - i0 as f64;
+        let (a, b) = (self.backscatter[i0], self.backscatter[i0 + 1]);
+        Some(std::array::from_fn(|c| a[c] + t * (b[c] - a[c])))
+    }
+
+    fn merl_table(&self) -> std::borrow::Cow<'_, MerlTable> {
+        std::borrow::Cow::Borrowed(&self.table)
+    }
+}

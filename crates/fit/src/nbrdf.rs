@@ -1,0 +1,184 @@
+//! Neural BRDF proxies of the MERL materials (Sztrajman, Rainer, Ritschel, Weyrich 2021):
+//! a 6-21-21-3 MLP per material, `f_r = exp(relu(relu(x W1 + b1) W2 + b2) W3 + b3) − 1`,
+//! x = (h, d) of the Rusinkiewicz parameterisation with φh = 0.
+
+use crate::brdf::{Brdf, Rgb};
+use crate::error::FitError;
+use crate::geometry::{spherical, to_half_diff};
+use glam::DVec3;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+#[derive(Deserialize)]
+struct RawWeights {
+    #[serde(rename = "W1")]
+    w1: Vec<Vec<f64>>,
+    b1: Vec<f64>,
+    #[serde(rename = "W2")]
+    w2: Vec<Vec<f64>>,
+    b2: Vec<f64>,
+    #[serde(rename = "W3")]
+    w3: Vec<Vec<f64>>,
+    b3: Vec<f64>,
+}
+
+/// A dense layer `y = x W + b`, W stored row-major (inputs × outputs).
+#[derive(Clone, Debug)]
+struct Layer {
+    inputs: usize,
+    outputs: usize,
+    w: Vec<f64>,
+    b: Vec<f64>,
+}
+
+impl Layer {
+    fn new(w: &[Vec<f64>], b: &[f64], inputs: usize, which: &str) -> Result<Self, String> {
+        let outputs = b.len();
+        if w.len() != inputs || w.iter().any(|r| r.len() != outputs) || outputs == 0 {
+            return Err(format!(
+                "{which} must be {inputs}×{outputs} to match its bias"
+            ));
+        }
+        let w: Vec<f64> = w.iter().flatten().copied().collect();
+        if w.iter().chain(b).any(|v| !v.is_finite()) {
+            return Err(format!("{which} holds a non-finite weight"));
+        }
+        Ok(Layer {
+            inputs,
+            outputs,
+            w,
+            b: b.to_vec(),
+        })
+    }
+
+    fn apply(&self, x: &[f64], out: &mut [f64]) {
+        out[..self.outputs].copy_from_slice(&self.b);
+        for (i, &xi) in x[..self.inputs].iter().enumerate() {
+            let row = &self.w[i * self.outputs..(i + 1) * self.outputs];
+            out[..self.outputs]
+                .iter_mut()
+                .zip(row)
+                .for_each(|(o, w)| *o += xi * w);
+        }
+    }
+}
+
+/// One material's network.
+#[derive(Clone, Debug)]
+pub struct NeuralBrdf {
+    name: String,
+    layers: [Layer; 3],
+}
+
+impl NeuralBrdf {
+    /// f_r from the network inputs x = (h, d).
+    fn forward(&self, x: [f64; 6]) -> Rgb {
+        let mut a = [0.0; 64];
+        let mut b = [0.0; 64];
+        self.layers[0].apply(&x, &mut a);
+        a.iter_mut().for_each(|v| *v = v.max(0.0));
+        self.layers[1].apply(&a, &mut b);
+        b.iter_mut().for_each(|v| *v = v.max(0.0));
+        self.layers[2].apply(&b, &mut a);
+        // exp(y) − 1 can dip below 0 by a hair where the fit undershoots; f_r ≥ 0.
+        [
+            a[0].exp_m1().max(0.0),
+            a[1].exp_m1().max(0.0),
+            a[2].exp_m1().max(0.0),
+        ]
+    }
+}
+
+impl Brdf for NeuralBrdf {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return None;
+        }
+        let c = to_half_diff(wi, wo);
+        let h = spherical(c.theta_h, 0.0);
+        let d = spherical(c.theta_d, c.phi_d.rem_euclid(PI)); // φd on MERL's [0, π)
+        Some(self.forward([h.x, h.y, h.z, d.x, d.y, d.z]))
+    }
+}
+
+/// The file of networks, `name -> weights`.
+pub struct NbrdfLibrary {
+    path: PathBuf,
+    entries: BTreeMap<String, serde_json::Value>,
+}
+
+impl NbrdfLibrary {
+    /// `../shared/data/nbrdf/merl100.json` as seen from the workspace root.
+    pub fn default_path() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/nbrdf/merl100.json")
+    }
+
+    pub fn open(path: &Path) -> Result<Self, FitError> {
+        let bad = |problem: String| FitError::Nbrdf {
+            path: path.to_owned(),
+            problem,
+        };
+        if path.is_dir() {
+            return Err(bad("is a directory".into()));
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| FitError::io(path, e))?;
+        let entries: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text)
+            .map_err(|e| bad(format!("not a JSON object of networks: {e}")))?;
+        if entries.is_empty() {
+            return Err(bad("holds no material".into()));
+        }
+        Ok(NbrdfLibrary {
+            path: path.to_owned(),
+            entries,
+        })
+    }
+
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.entries.keys().map(String::as_str)
+    }
+
+    pub fn get(&self, name: &str) -> Result<NeuralBrdf, FitError> {
+        let bad = |problem: String| FitError::Nbrdf {
+            path: self.path.clone(),
+            problem,
+        };
+        let value = self.entries.get(name).ok_or_else(|| {
+            let near: Vec<&str> = self
+                .names()
+                .filter(|n| n.contains(name) || name.contains(*n))
+                .take(5)
+                .collect();
+            bad(format!(
+                "no material named `{name}`{}",
+                if near.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (did you mean {}?)", near.join(", "))
+                }
+            ))
+        })?;
+        let raw: RawWeights = serde_json::from_value(value.clone())
+            .map_err(|e| bad(format!("material `{name}`: {e}")))?;
+        let l1 = Layer::new(&raw.w1, &raw.b1, 6, "W1")
+            .map_err(|p| bad(format!("material `{name}`: {p}")))?;
+        let l2 = Layer::new(&raw.w2, &raw.b2, l1.outputs, "W2")
+            .map_err(|p| bad(format!("material `{name}`: {p}")))?;
+        let l3 = Layer::new(&raw.w3, &raw.b3, l2.outputs, "W3")
+            .map_err(|p| bad(format!("material `{name}`: {p}")))?;
+        if l3.outputs != 3 || l1.outputs > 64 || l2.outputs > 64 {
+            return Err(bad(format!(
+                "material `{name}`: layer sizes must be 6-H-H-3 with H ≤ 64"
+            )));
+        }
+        Ok(NeuralBrdf {
+            name: name.to_owned(),
+            layers: [l1, l2, l3],
+        })
+    }
+}

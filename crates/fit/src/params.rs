@@ -1,0 +1,295 @@
+//! GGX and Beckmann parameters from an extracted NDF: by first absolute slope moments (the
+//! paper) and by least squares in the space of the error metric.
+
+use crate::fresnel::{Fresnel, FresnelTable};
+use crate::grid::{GridSamples, IsoTables, fresnel_average, microfacet_error, tables_error};
+use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use crate::tabulated::TabulatedNdf;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Bounds of any fitted α.
+pub const ALPHA_MIN: f64 = 1e-3;
+pub const ALPHA_MAX: f64 = 4.0;
+
+/// E|x~ cos ψ + y~ sin ψ| of the tabulated slope distribution for ψ = 0, 45°, 90°, 135°.
+fn abs_slope_moments(ndf: &TabulatedNdf) -> [f64; 4] {
+    // E|·| = ∫∫ D(θ,φ) sin²θ |cos(φ − ψ)| dθ dφ  (tan θ · D cos θ · sin θ), midpoint in u = sqrt(θ/(π/2)).
+    let nu = 2048;
+    let nphi = if ndf.tables().nphi == 1 { 1 } else { 512 };
+    let mut m = [0.0; 4];
+    for a in 0..nu {
+        let u = (a as f64 + 0.5) / nu as f64;
+        let theta = u * u * FRAC_PI_2;
+        let dtheta = PI * u / nu as f64;
+        let radial = theta.sin().powi(2) * dtheta;
+        if nphi == 1 {
+            // ∫₀^{2π} |cos(φ − ψ)| dφ = 4
+            let v = 4.0 * ndf.base_d(theta, 0.0) * radial;
+            m.iter_mut().for_each(|x| *x += v);
+            continue;
+        }
+        for b in 0..nphi {
+            let phi = (b as f64 + 0.5) / nphi as f64 * 2.0 * PI;
+            let v = ndf.base_d(theta, phi) * radial * 2.0 * PI / nphi as f64;
+            for (k, x) in m.iter_mut().enumerate() {
+                *x += v * (phi - k as f64 * PI / 4.0).cos().abs();
+            }
+        }
+    }
+    m
+}
+
+/// α by the first absolute slope moment along the principal axes.
+///
+/// For an elliptical slope distribution the moment along direction ψ is c · s(ψ) with
+/// s(ψ)² = αx² cos²(ψ − ρ) + αy² sin²(ψ − ρ) = A + B cos 2(ψ − ρ); four directions give A, B and ρ.
+pub fn fit_moments(kind: NdfKind, ndf: &TabulatedNdf) -> AnalyticNdf {
+    let m = abs_slope_moments(ndf).map(|x| x * x);
+    let a = m.iter().sum::<f64>() / 4.0;
+    let (bc, bs) = ((m[0] - m[2]) / 2.0, (m[1] - m[3]) / 2.0);
+    let b = bc.hypot(bs);
+    let rotation = if b > 1e-9 * a {
+        0.5 * bs.atan2(bc)
+    } else {
+        0.0
+    };
+    let alpha = |s2: f64| {
+        kind.alpha_from_abs_slope_moment(s2.max(0.0).sqrt())
+            .clamp(ALPHA_MIN, ALPHA_MAX)
+    };
+    let (alpha_x, alpha_y) = (alpha(a + b), alpha(a - b));
+    if ndf.tables().nphi == 1 {
+        return AnalyticNdf::isotropic(kind, alpha_x);
+    }
+    AnalyticNdf {
+        kind,
+        alpha_x,
+        alpha_y,
+        rotation,
+    }
+}
+
+/// A parametric model together with the Fresnel table averaged for it.
+pub fn model_with_fresnel(name: &str, ndf: AnalyticNdf, set: &GridSamples) -> MicrofacetBrdf {
+    let mut model = MicrofacetBrdf {
+        name: name.to_owned(),
+        ndf: Ndf::Analytic(ndf),
+        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
+        diffuse: [0.0; 3],
+    };
+    model.fresnel = Fresnel::Table(FresnelTable::on_merl_bins(fresnel_average(&model, set)));
+    model
+}
+
+/// The error of a parametric model whose Fresnel is re-averaged for it.
+fn error_of(name: &str, ndf: AnalyticNdf, set: &GridSamples) -> f64 {
+    let model = MicrofacetBrdf {
+        name: name.to_owned(),
+        ndf: Ndf::Analytic(ndf),
+        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
+        diffuse: [0.0; 3],
+    };
+    match IsoTables::new(&model).filter(|_| set.rotations.len() == 1) {
+        Some(mut tables) => {
+            let f = tables.fresnel_average(set);
+            tables.set_fresnel(&f);
+            tables_error(&tables, set)
+        }
+        None => microfacet_error(&model_with_fresnel(name, ndf, set), set),
+    }
+}
+
+/// α (and rotation when anisotropic) minimising the error metric on `set`, from `start`.
+/// Isotropic: Brent's method on ln α. Anisotropic: Nelder–Mead on (ln αx, ln αy, ρ).
+pub fn fit_least_squares(start: AnalyticNdf, anisotropic: bool, set: &GridSamples) -> AnalyticNdf {
+    let kind = start.kind;
+    if !anisotropic {
+        let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), set);
+        let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
+        let x0 = start.alpha_x.clamp(ALPHA_MIN, ALPHA_MAX).ln();
+        let t = brent(f, (x0 - 3.0).max(lo), x0, (x0 + 1.5).min(hi), 1e-4);
+        return AnalyticNdf::isotropic(kind, t.exp());
+    }
+    let make = |p: &[f64; 3]| AnalyticNdf {
+        kind,
+        alpha_x: p[0].exp().clamp(ALPHA_MIN, ALPHA_MAX),
+        alpha_y: p[1].exp().clamp(ALPHA_MIN, ALPHA_MAX),
+        rotation: p[2],
+    };
+    let p0 = [start.alpha_x.ln(), start.alpha_y.ln(), start.rotation];
+    let p = nelder_mead(
+        |p| error_of("lsq", make(p), set),
+        p0,
+        [0.3, 0.3, 0.3],
+        1e-5,
+        200,
+    );
+    normalise_rotation(make(&p))
+}
+
+/// Keeps ρ in (−π/2, π/2]: ρ and ρ + π describe the same NDF.
+fn normalise_rotation(mut n: AnalyticNdf) -> AnalyticNdf {
+    let mut r = n.rotation.rem_euclid(PI);
+    if r > FRAC_PI_2 {
+        r -= PI;
+    }
+    n.rotation = r;
+    n
+}
+
+/// Brent's minimisation on [lo, hi] starting from `start` (Numerical Recipes `brent`, golden sections
+/// with parabolic steps), to a relative tolerance `tol` in x.
+fn brent(f: impl Fn(f64) -> f64, lo: f64, start: f64, hi: f64, tol: f64) -> f64 {
+    const CGOLD: f64 = 0.381_966_011_250_105;
+    let (mut a, mut b) = (lo.min(hi), lo.max(hi));
+    let mut x = start.clamp(a, b);
+    let mut fx = f(x);
+    let (mut w, mut v) = (x, x);
+    let (mut fw, mut fv) = (fx, fx);
+    let (mut d, mut e): (f64, f64) = (0.0, 0.0);
+    for _ in 0..100 {
+        let xm = 0.5 * (a + b);
+        let tol1 = tol * x.abs().max(1e-3);
+        let tol2 = 2.0 * tol1;
+        if (x - xm).abs() <= tol2 - 0.5 * (b - a) {
+            break;
+        }
+        if e.abs() > tol1 {
+            let r = (x - w) * (fx - fv);
+            let mut q = (x - v) * (fx - fw);
+            let mut p = (x - v) * q - (x - w) * r;
+            q = 2.0 * (q - r);
+            if q > 0.0 {
+                p = -p;
+            }
+            q = q.abs();
+            let etemp = e;
+            e = d;
+            if p.abs() >= (0.5 * q * etemp).abs() || p <= q * (a - x) || p >= q * (b - x) {
+                e = if x >= xm { a - x } else { b - x };
+                d = CGOLD * e;
+            } else {
+                d = p / q;
+                let u = x + d;
+                if u - a < tol2 || b - u < tol2 {
+                    d = tol1.copysign(xm - x);
+                }
+            }
+        } else {
+            e = if x >= xm { a - x } else { b - x };
+            d = CGOLD * e;
+        }
+        let u = if d.abs() >= tol1 {
+            x + d
+        } else {
+            x + tol1.copysign(d)
+        };
+        let fu = f(u);
+        if fu <= fx {
+            if u >= x {
+                a = x
+            } else {
+                b = x
+            }
+            (v, w, x) = (w, x, u);
+            (fv, fw, fx) = (fw, fx, fu);
+        } else {
+            if u < x {
+                a = u
+            } else {
+                b = u
+            }
+            if fu <= fw || w == x {
+                (v, w) = (w, u);
+                (fv, fw) = (fw, fu);
+            } else if fu <= fv || v == x || v == w {
+                v = u;
+                fv = fu;
+            }
+        }
+    }
+    x
+}
+
+/// Nelder–Mead simplex minimisation in 3-D.
+fn nelder_mead(
+    f: impl Fn(&[f64; 3]) -> f64,
+    x0: [f64; 3],
+    step: [f64; 3],
+    tol: f64,
+    max_evals: usize,
+) -> [f64; 3] {
+    let mut pts: Vec<([f64; 3], f64)> = (0..4)
+        .map(|k| {
+            let mut p = x0;
+            if k > 0 {
+                p[k - 1] += step[k - 1];
+            }
+            (p, f(&p))
+        })
+        .collect();
+    let mut evals = 4;
+    let lerp = |a: &[f64; 3], b: &[f64; 3], t: f64| -> [f64; 3] {
+        std::array::from_fn(|i| a[i] + t * (b[i] - a[i]))
+    };
+    while evals < max_evals {
+        pts.sort_by(|a, b| a.1.total_cmp(&b.1));
+        if (pts[3].1 - pts[0].1).abs() <= tol * pts[0].1.abs().max(1e-12) {
+            break;
+        }
+        let centroid: [f64; 3] =
+            std::array::from_fn(|i| (pts[0].0[i] + pts[1].0[i] + pts[2].0[i]) / 3.0);
+        let worst = pts[3];
+        let reflect = lerp(&centroid, &worst.0, -1.0);
+        let fr = f(&reflect);
+        evals += 1;
+        if fr < pts[0].1 {
+            let expand = lerp(&centroid, &worst.0, -2.0);
+            let fe = f(&expand);
+            evals += 1;
+            pts[3] = if fe < fr { (expand, fe) } else { (reflect, fr) };
+        } else if fr < pts[2].1 {
+            pts[3] = (reflect, fr);
+        } else {
+            let contract = lerp(&centroid, &worst.0, 0.5);
+            let fc = f(&contract);
+            evals += 1;
+            if fc < worst.1 {
+                pts[3] = (contract, fc);
+            } else {
+                let best = pts[0].0;
+                for p in pts.iter_mut().skip(1) {
+                    p.0 = lerp(&best, &p.0, 0.5);
+                    p.1 = f(&p.0);
+                    evals += 1;
+                }
+            }
+        }
+    }
+    pts.sort_by(|a, b| a.1.total_cmp(&b.1));
+    pts[0].0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn brent_and_nelder_mead_find_minima() {
+        let x = brent(|x| (x - 0.7).powi(2) + 1.0, -3.0, 0.0, 2.0, 1e-8);
+        assert!((x - 0.7).abs() < 1e-6, "{x}");
+        let p = nelder_mead(
+            |p| (p[0] - 1.0).powi(2) + 2.0 * (p[1] + 0.5).powi(2) + (p[2] - 0.2).powi(2) + 1.0,
+            [0.0; 3],
+            [0.5; 3],
+            1e-14,
+            2000,
+        );
+        assert!(
+            p.iter()
+                .zip([1.0, -0.5, 0.2])
+                .all(|(a, b)| (a - b).abs() < 1e-4),
+            "{p:?}"
+        );
+    }
+}

@@ -1,0 +1,32 @@
+//! Resolving an input of `facet fit` to a BRDF source.
+
+use crate::analytic::parse_analytic;
+use crate::brdf::Brdf;
+use crate::error::FitError;
+use crate::material::FittedMaterial;
+use crate::merl::MerlBrdf;
+use crate::nbrdf::NbrdfLibrary;
+use std::path::Path;
+
+/// An input: `nbrdf:NAME`, `analytic:SPEC`, a fit `.json` (its tabulated model) or a MERL file.
+/// `nbrdf` is the network file used for `nbrdf:` inputs, opened on first use.
+pub fn open_source(
+    input: &str,
+    nbrdf: &Path,
+    library: &mut Option<NbrdfLibrary>,
+) -> Result<Box<dyn Brdf>, FitError> {
+    if let Some(name) = input.strip_prefix("nbrdf:") {
+        if library.is_none() {
+            *library = Some(NbrdfLibrary::open(nbrdf)?);
+        }
+        return Ok(Box::new(library.as_ref().unwrap().get(name)?));
+    }
+    if let Some(spec) = input.strip_prefix("analytic:") {
+        return Ok(Box::new(parse_analytic(spec)?));
+    }
+    let path = Path::new(input);
+    if path.extension().is_some_and(|e| e == "json") {
+        return Ok(Box::new(FittedMaterial::load(path)?));
+    }
+    Ok(Box::new(MerlBrdf::open(path)?))
+}
