@@ -45,7 +45,7 @@ impl FitConfig {
             extract: ExtractConfig::isotropic(),
             anisotropic: false,
             models: Models::ALL,
-            search_stride: 32,
+            search_stride: 48,
         }
     }
 

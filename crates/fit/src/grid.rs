@@ -54,7 +54,7 @@ fn geometry() -> &'static [BinGeometry] {
 }
 
 /// One valid sample: a MERL bin seen at azimuth rotation `rot`, with the source's value.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, Default)]
 pub struct GridSample {
     /// Flat MERL bin index.
     pub bin: u32,
@@ -91,17 +91,38 @@ impl GridSamples {
         if src.is_isotropic() {
             let table = src.merl_table();
             let geo = geometry();
-            let samples = (0..SAMPLES)
+            // Count the valid samples of each θh bin, then fill one allocation in place, a θh bin
+            // per task (no intermediate vectors: the set is ~60 MB and page faults dominate).
+            let per_i = THETA_D_RES * PHI_D_RES;
+            let valid = |s: usize| {
+                let g = &geo[s];
+                g.cos_i > 0.0 && g.cos_o > 0.0 && table.value_at(s).is_some()
+            };
+            let counts: Vec<usize> = (0..THETA_H_RES)
                 .into_par_iter()
-                .filter_map(|s| {
-                    let g = geo[s];
+                .map(|i| (i * per_i..(i + 1) * per_i).filter(|&s| valid(s)).count())
+                .collect();
+            let mut samples = vec![GridSample::default(); counts.iter().sum()];
+            let mut chunks = Vec::with_capacity(THETA_H_RES);
+            let mut rest = samples.as_mut_slice();
+            for &n in &counts {
+                let (head, tail) = rest.split_at_mut(n);
+                chunks.push(head);
+                rest = tail;
+            }
+            chunks.into_par_iter().enumerate().for_each(|(i, chunk)| {
+                let valid_bins = (i * per_i..(i + 1) * per_i).filter_map(|s| {
+                    let g = &geo[s];
                     if g.cos_i <= 0.0 || g.cos_o <= 0.0 {
                         return None;
                     }
-                    let v = table.value_at(s)?;
-                    Some(make_sample(s, 0, v, &g))
-                })
-                .collect();
+                    table.value_at(s).map(|v| make_sample(s, 0, v, g))
+                });
+                chunk
+                    .iter_mut()
+                    .zip(valid_bins)
+                    .for_each(|(out, s)| *out = s);
+            });
             return GridSamples {
                 rotations: vec![0.0],
                 samples,
@@ -205,7 +226,8 @@ fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
 pub struct IsoTables {
     /// D at each θh bin.
     d: [f64; THETA_H_RES],
-    /// G1 on [0, π/2], uniform in θ.
+    /// G1 on [0, π/2], uniform in θ (interpolated as G1, which stays bounded at grazing
+    /// angles where Λ diverges).
     g1: Vec<f64>,
     /// F at each θd bin.
     fresnel: [Rgb; THETA_D_RES],

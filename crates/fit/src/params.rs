@@ -107,7 +107,7 @@ pub fn fit_least_squares(start: AnalyticNdf, anisotropic: bool, set: &GridSample
         let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), set);
         let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
         let x0 = start.alpha_x.clamp(ALPHA_MIN, ALPHA_MAX).ln();
-        let t = brent(f, (x0 - 3.0).max(lo), x0, (x0 + 1.5).min(hi), 1e-4);
+        let t = brent(f, (x0 - 3.0).max(lo), x0, (x0 + 1.5).min(hi), 2e-4);
         return AnalyticNdf::isotropic(kind, t.exp());
     }
     let make = |p: &[f64; 3]| AnalyticNdf {
