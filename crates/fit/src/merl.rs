@@ -100,8 +100,10 @@ impl MerlTable {
                 "dimensions {dims:?} in the header are not positive"
             )));
         }
-        let n = dims.iter().map(|&d| d as u64).product::<u64>();
-        let expected = HEADER_BYTES + 3 * 8 * n;
+        // i32 dimensions: the product and the byte count fit in u128 whatever the header says.
+        let n = dims.iter().map(|&d| d as u128).product::<u128>();
+        let expected = HEADER_BYTES as u128 + 3 * 8 * n;
+        let len = len as u128;
         if len < expected {
             return Err(bad(format!(
                 "truncated: header {}×{}×{} needs {expected} bytes, the file has {len}",
