@@ -1,4 +1,32 @@
-//! Placeholder; filled below.
+//! # facet-fit: measured BRDFs to microfacet models
+//!
+//! Extracts the normal distribution function of a measured material by power iterations on the
+//! backscattering slice (Dupuy et al., EGSR 2015), tabulates G1 and the Fresnel curve, and fits
+//! GGX and Beckmann parameters, on the CPU in f64.
+//!
+//! ```
+//! use facet_fit::analytic::parse_analytic;
+//! use facet_fit::fit::{fit_material, FitConfig};
+//! use facet_fit::merl::{MerlBrdf, MerlTable};
+//!
+//! // A GGX conductor written as a MERL table, then fitted as if it were a measurement.
+//! let model = parse_analytic("ggx?alpha=0.3&conductor=gold").unwrap();
+//! let source = MerlBrdf::from_table("gold", MerlTable::sample(&model)).unwrap();
+//! let fit = fit_material(&source, "example", &FitConfig::isotropic()).unwrap();
+//! let ggx = fit.record.ggx.as_ref().unwrap();
+//! assert!((ggx.alpha_x - 0.3).abs() < 0.003);
+//! println!("GGX α = {:.4}, error {:.5}", ggx.alpha_x, ggx.error);
+//! ```
+//!
+//! Sources implement [`brdf::Brdf`]: MERL files ([`merl::MerlBrdf`]), the neural proxies
+//! ([`nbrdf::NbrdfLibrary`]), analytic models ([`analytic::parse_analytic`]) and fits themselves
+//! ([`material::FittedMaterial`]). [`fit::fit_material`] runs the whole pipeline;
+//! [`extract`] holds the power iteration, [`tabulated`] the stretched tabulated NDF with its
+//! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid.
+
+// `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod analytic;
 pub mod brdf;
 pub mod error;
@@ -15,3 +43,13 @@ pub mod params;
 pub mod quadrature;
 pub mod source;
 pub mod tabulated;
+
+pub use brdf::{Brdf, Rgb};
+pub use error::FitError;
+pub use fit::{FitConfig, fit_material};
+pub use material::FittedMaterial;
+
+/// The README's Rust examples, compiled and run as doc-tests.
+#[doc = include_str!("../../../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;

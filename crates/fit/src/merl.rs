@@ -231,9 +231,9 @@ impl MerlTable {
 
     /// Scales sample `s` by a per-channel factor (for noise experiments).
     pub fn scale_sample(&mut self, s: usize, factor: Rgb) {
-        for c in 0..3 {
+        for (c, f) in factor.iter().enumerate() {
             if self.raw[c * SAMPLES + s] >= 0.0 {
-                self.raw[c * SAMPLES + s] *= factor[c];
+                self.raw[c * SAMPLES + s] *= f;
             }
         }
     }

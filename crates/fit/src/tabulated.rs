@@ -215,7 +215,7 @@ impl TabulatedNdf {
         }
         let s = self.stretch;
         let hl = DVec3::new(h0.x * s.alpha_x, h0.y * s.alpha_y, h0.z).normalize();
-        self.from_local(hl)
+        self.to_world(hl)
     }
 
     /// Density of [`Self::sample`] over solid angle:
@@ -246,7 +246,7 @@ impl TabulatedNdf {
         DVec3::new(c * w.x + s * w.y, -s * w.x + c * w.y, w.z)
     }
 
-    fn from_local(&self, w: DVec3) -> DVec3 {
+    fn to_world(&self, w: DVec3) -> DVec3 {
         let (s, c) = self.stretch.rotation.sin_cos();
         DVec3::new(c * w.x - s * w.y, s * w.x + c * w.y, w.z)
     }
