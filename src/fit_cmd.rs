@@ -171,9 +171,11 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
             Ok(fit) => rows.push(fit),
             Err(e) => {
                 failures += 1;
+                // Printed around the bar (a hidden bar, as when stderr is not a terminal,
+                // would swallow `bar.println`).
                 let msg = format!("error: {e:#}");
                 match &bar {
-                    Some(bar) => bar.println(msg),
+                    Some(bar) => bar.suspend(|| eprintln!("{msg}")),
                     None => eprintln!("{msg}"),
                 }
             }
