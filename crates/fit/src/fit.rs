@@ -20,6 +20,12 @@ pub struct Models {
 }
 
 impl Models {
+    /// Extraction, G1 and Fresnel only: the scope of the paper's code.
+    pub const NONE: Models = Models {
+        tabulated: false,
+        ggx: false,
+        beckmann: false,
+    };
     pub const ALL: Models = Models {
         tabulated: true,
         ggx: true,
@@ -111,10 +117,17 @@ pub fn fit_material(
     let fit_kind = |kind: NdfKind| -> ParamRecord {
         let moments = fit_moments(kind, &ex.ndf);
         let lsq = fit_least_squares(moments, cfg.anisotropic, &search);
-        let moment_model = model_with_fresnel("moments", moments, &set);
+        // The paper's estimate: α by moments with the Fresnel of the extraction.
+        let moment_model = MicrofacetBrdf {
+            name: "moments".into(),
+            ndf: Ndf::Analytic(moments),
+            fresnel: Fresnel::Table(fresnel.clone()),
+            diffuse: [0.0; 3],
+        };
+        // The least-squares model with a Fresnel table averaged for its own D and G.
         let lsq_model = model_with_fresnel("lsq", lsq, &set);
-        let Fresnel::Table(fresnel) = lsq_model.fresnel.clone() else {
-            unreachable!()
+        let Fresnel::Table(lsq_fresnel) = lsq_model.fresnel.clone() else {
+            unreachable!("model_with_fresnel sets a table")
         };
         let params = |n: &AnalyticNdf, e| Params {
             alpha_x: n.alpha_x,
@@ -130,7 +143,7 @@ pub fn fit_material(
             error: microfacet_error(&lsq_model, &set),
             method: "least_squares".into(),
             moments,
-            fresnel,
+            fresnel: lsq_fresnel,
         }
     };
     let ggx = cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx));

@@ -15,16 +15,18 @@ use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::OnceLock;
 
-/// Entries of the G1 tables of the fast path, uniform in θ over [0, π/2].
-const G1_TABLE: usize = 4096;
+/// Entries of the Λ cos θ tables of the fast path, uniform in θ over [0, π/2].
+const LAMBDA_TABLE: usize = 4096;
 
-/// Geometry of one grid bin (rotation-independent).
+/// Geometry of one grid bin (rotation-independent), in the form the inner loops use.
 #[derive(Clone, Copy, Debug)]
 struct BinGeometry {
     cos_i: f32,
-    cos_o: f32,
-    theta_i: f32,
-    theta_o: f32,
+    inv_cos_i: f32,
+    inv_cos_o: f32,
+    /// θi and θo in units of the Λ cos θ table's step.
+    gi: f32,
+    go: f32,
     /// λ(φ) of the correlated G2, φ the azimuth between wi and wo.
     corr: f32,
 }
@@ -33,6 +35,7 @@ struct BinGeometry {
 fn geometry() -> &'static [BinGeometry] {
     static GEOMETRY: OnceLock<Vec<BinGeometry>> = OnceLock::new();
     GEOMETRY.get_or_init(|| {
+        let step = (LAMBDA_TABLE - 1) as f64 / FRAC_PI_2;
         (0..SAMPLES)
             .into_par_iter()
             .map(|s| {
@@ -43,14 +46,19 @@ fn geometry() -> &'static [BinGeometry] {
                 ));
                 BinGeometry {
                     cos_i: wi.z as f32,
-                    cos_o: wo.z as f32,
-                    theta_i: wi.z.clamp(-1.0, 1.0).acos() as f32,
-                    theta_o: wo.z.clamp(-1.0, 1.0).acos() as f32,
+                    inv_cos_i: (1.0 / wi.z) as f32,
+                    inv_cos_o: (1.0 / wo.z) as f32,
+                    gi: (wi.z.clamp(-1.0, 1.0).acos() * step) as f32,
+                    go: (wo.z.clamp(-1.0, 1.0).acos() * step) as f32,
                     corr: correlation(azimuth_between(wi, wo)) as f32,
                 }
             })
             .collect()
     })
+}
+
+fn above_horizon(g: &BinGeometry) -> bool {
+    g.inv_cos_i > 0.0 && g.inv_cos_o > 0.0
 }
 
 /// One valid sample: a MERL bin seen at azimuth rotation `rot`, with the source's value.
@@ -63,13 +71,6 @@ pub struct GridSample {
     /// θh bin and θd bin.
     pub i: u8,
     pub j: u8,
-    pub cos_i: f32,
-    pub cos_o: f32,
-    /// θi and θo in units of the G1 table's step.
-    pub gi: f32,
-    pub go: f32,
-    /// λ(φ) of the correlated G2.
-    pub corr: f32,
     /// x = f_r cos θi per channel.
     pub x: [f32; 3],
     /// ln(1 + x) per channel.
@@ -92,37 +93,48 @@ impl GridSamples {
             let table = src.merl_table();
             let geo = geometry();
             // Count the valid samples of each θh bin, then fill one allocation in place, a θh bin
-            // per task (no intermediate vectors: the set is ~60 MB and page faults dominate).
+            // per task (no intermediate vectors, no zeroing: page faults dominate this step).
             let per_i = THETA_D_RES * PHI_D_RES;
-            let valid = |s: usize| {
-                let g = &geo[s];
-                g.cos_i > 0.0 && g.cos_o > 0.0 && table.value_at(s).is_some()
+            let valid_in = |i: usize| {
+                (i * per_i..(i + 1) * per_i).filter_map(|s| {
+                    let g = &geo[s];
+                    if !above_horizon(g) {
+                        return None;
+                    }
+                    table.value_at(s).map(|v| make_sample(s, 0, v, g))
+                })
             };
             let counts: Vec<usize> = (0..THETA_H_RES)
                 .into_par_iter()
-                .map(|i| (i * per_i..(i + 1) * per_i).filter(|&s| valid(s)).count())
+                .map(|i| {
+                    (i * per_i..(i + 1) * per_i)
+                        .filter(|&s| above_horizon(&geo[s]) && table.value_at(s).is_some())
+                        .count()
+                })
                 .collect();
-            let mut samples = vec![GridSample::default(); counts.iter().sum()];
+            let total = counts.iter().sum();
+            let mut samples: Vec<GridSample> = Vec::with_capacity(total);
             let mut chunks = Vec::with_capacity(THETA_H_RES);
-            let mut rest = samples.as_mut_slice();
+            let mut rest = &mut samples.spare_capacity_mut()[..total];
             for &n in &counts {
                 let (head, tail) = rest.split_at_mut(n);
                 chunks.push(head);
                 rest = tail;
             }
             chunks.into_par_iter().enumerate().for_each(|(i, chunk)| {
-                let valid_bins = (i * per_i..(i + 1) * per_i).filter_map(|s| {
-                    let g = &geo[s];
-                    if g.cos_i <= 0.0 || g.cos_o <= 0.0 {
-                        return None;
-                    }
-                    table.value_at(s).map(|v| make_sample(s, 0, v, g))
-                });
-                chunk
-                    .iter_mut()
-                    .zip(valid_bins)
-                    .for_each(|(out, s)| *out = s);
+                let mut written = 0;
+                for (out, s) in chunk.iter_mut().zip(valid_in(i)) {
+                    out.write(s);
+                    written += 1;
+                }
+                assert_eq!(
+                    written,
+                    chunk.len(),
+                    "the count and fill passes use one predicate"
+                );
             });
+            // SAFETY: every one of the `total` slots was written above (asserted per chunk).
+            unsafe { samples.set_len(total) };
             return GridSamples {
                 rotations: vec![0.0],
                 samples,
@@ -137,10 +149,10 @@ impl GridSamples {
                 if j % 2 == 1 || k % 2 == 1 {
                     return None;
                 }
-                let (wi, wo) = sample_directions(s, rotations[r]);
-                if wi.z <= 0.0 || wo.z <= 0.0 {
+                if !above_horizon(&geometry()[s]) {
                     return None;
                 }
+                let (wi, wo) = sample_directions(s, rotations[r]);
                 let v = src.eval(wi, wo)?;
                 Some(make_sample(s, r as u8, v, &geometry()[s]))
             })
@@ -177,40 +189,49 @@ impl GridSamples {
 
 fn make_sample(s: usize, rot: u8, v: Rgb, g: &BinGeometry) -> GridSample {
     let x = v.map(|f| (f * g.cos_i as f64) as f32);
-    let step = (G1_TABLE - 1) as f32 / FRAC_PI_2 as f32;
     GridSample {
         bin: s as u32,
         rot,
         i: (s / (PHI_D_RES * THETA_D_RES)) as u8,
         j: (s / PHI_D_RES % THETA_D_RES) as u8,
-        cos_i: g.cos_i,
-        cos_o: g.cos_o,
-        gi: g.theta_i * step,
-        go: g.theta_o * step,
-        corr: g.corr,
         x,
         log_x: x.map(ln_1p),
     }
 }
 
-/// ln(1 + x) in f32 for x ≥ 0, to ~1e-7 relative: exponent and mantissa split, the mantissa
-/// m ∈ [√½, √2) through ln m = 2 atanh(t), t = (m − 1)/(m + 1), |t| ≤ 0.172, series to t⁹.
-/// The metric spends most of its time here; libm's log1pf is several times slower.
+/// ln(1 + x) in f32 for x ≥ 0, to ~2e-7: exponent and mantissa split, the mantissa brought
+/// into m ∈ [√½, √2) and ln m = t·P(t), t = m − 1, P a degree-7 Chebyshev fit (max error
+/// 6e-8). No division and no branch: the metric spends most of its time here, and libm's
+/// log1pf is several times slower.
 #[inline]
 pub fn ln_1p(x: f32) -> f32 {
+    const P: [f32; 8] = [
+        0.999_999_94,
+        -0.500_003_64,
+        0.333_351_14,
+        -0.249_700_68,
+        0.198_985_44,
+        -0.172_470_51,
+        0.162_343_81,
+        -0.101_341_79,
+    ];
     let y = 1.0 + x.max(0.0);
     let bits = y.to_bits();
-    let mut e = ((bits >> 23) & 0xff) as i32 - 127;
-    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
-    if m > std::f32::consts::SQRT_2 {
-        m *= 0.5;
-        e += 1;
-    }
-    let t = (m - 1.0) / (m + 1.0);
+    let m1 = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+    // Branch-free: mantissas are random, a branch would mispredict half the time.
+    let up = (m1 > std::f32::consts::SQRT_2) as u32;
+    let m = f32::from_bits(m1.to_bits() - (up << 23));
+    let e = ((bits >> 23) & 0xff) as i32 - 127 + up as i32;
+    let t = m - 1.0;
+    // Estrin's scheme: shorter dependency chains than Horner.
     let t2 = t * t;
-    let series =
-        t * (2.0 + t2 * (2.0 / 3.0 + t2 * (2.0 / 5.0 + t2 * (2.0 / 7.0 + t2 * (2.0 / 9.0)))));
-    e as f32 * std::f32::consts::LN_2 + series
+    let t4 = t2 * t2;
+    let p01 = P[0] + P[1] * t;
+    let p23 = P[2] + P[3] * t;
+    let p45 = P[4] + P[5] * t;
+    let p67 = P[6] + P[7] * t;
+    let p = (p01 + p23 * t2) + (p45 + p67 * t2) * t4;
+    e as f32 * std::f32::consts::LN_2 + t * p
 }
 
 fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
@@ -226,9 +247,9 @@ fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
 pub struct IsoTables {
     /// D at each θh bin.
     d: [f64; THETA_H_RES],
-    /// G1 on [0, π/2], uniform in θ (interpolated as G1, which stays bounded at grazing
-    /// angles where Λ diverges).
-    g1: Vec<f64>,
+    /// Λ(θ) cos θ on [0, π/2], uniform in θ: finite at 90° where Λ diverges (GGX: α/2), so it
+    /// interpolates well, and Λ = table · (1/cos θ) needs no division in the inner loop.
+    lambda_cos: Vec<f64>,
     /// F at each θd bin.
     fresnel: [Rgb; THETA_D_RES],
     /// ρd/π.
@@ -248,17 +269,20 @@ impl IsoTables {
                 .ndf
                 .d(crate::geometry::spherical(bin_angles(i, 0, 0).theta_h, 0.0))
         });
-        let g1 = (0..G1_TABLE)
+        let mut lambda_cos: Vec<f64> = (0..LAMBDA_TABLE - 1)
             .map(|k| {
-                let t = k as f64 / (G1_TABLE - 1) as f64 * FRAC_PI_2;
-                1.0 / (1.0 + model.ndf.lambda(crate::geometry::spherical(t, 0.0)))
+                let t = k as f64 / (LAMBDA_TABLE - 1) as f64 * FRAC_PI_2;
+                model.ndf.lambda(crate::geometry::spherical(t, 0.0)) * t.cos()
             })
             .collect();
+        // At 90° Λ cos θ is ∞ · 0: extrapolate linearly from the two entries before it.
+        let n = lambda_cos.len();
+        lambda_cos.push((2.0 * lambda_cos[n - 1] - lambda_cos[n - 2]).max(0.0));
         let fresnel =
             std::array::from_fn(|j| model.fresnel.eval(bin_angles(0, j, 0).theta_d.cos()));
         Some(IsoTables {
             d,
-            g1,
+            lambda_cos,
             fresnel,
             diffuse: model.diffuse.map(|k| k / PI),
         })
@@ -269,45 +293,44 @@ impl IsoTables {
         self.fresnel.copy_from_slice(&f[..THETA_D_RES]);
     }
 
-    /// Λ at θ given in table steps.
+    /// Λ cos θ at θ given in table steps.
     #[inline]
-    fn lambda(&self, x: f32) -> f64 {
-        let k = (x as usize).min(G1_TABLE - 2);
+    fn lambda_cos(&self, x: f32) -> f64 {
+        let k = (x as usize).min(LAMBDA_TABLE - 2);
         let t = x as f64 - k as f64;
-        let g = self.g1[k] + t * (self.g1[k + 1] - self.g1[k]);
-        if g <= 0.0 {
-            f64::INFINITY
-        } else {
-            1.0 / g - 1.0
-        }
+        self.lambda_cos[k] + t * (self.lambda_cos[k + 1] - self.lambda_cos[k])
     }
 
-    /// D G2 / (4 cos θo): x = f cos θi of the model with F = 1 and no diffuse term.
-    #[inline]
-    fn x_ideal(&self, s: &GridSample) -> f64 {
-        self.d[s.i as usize] * g2(self.lambda(s.gi), self.lambda(s.go), s.corr as f64)
-            / (4.0 * s.cos_o as f64)
+    /// D G2 / (4 cos θo): x = f cos θi of the model with F = 1 and no diffuse term; one
+    /// division (G2's).
+    #[inline(always)]
+    fn x_ideal(&self, g: &BinGeometry, s: &GridSample) -> f64 {
+        let li = self.lambda_cos(g.gi) * g.inv_cos_i as f64;
+        let lo = self.lambda_cos(g.go) * g.inv_cos_o as f64;
+        self.d[s.i as usize] * 0.25 * g.inv_cos_o as f64 * g2(li, lo, g.corr as f64)
     }
 
     #[inline]
-    fn x(&self, s: &GridSample) -> Rgb {
-        let ideal = self.x_ideal(s);
+    fn x(&self, g: &BinGeometry, s: &GridSample) -> Rgb {
+        let ideal = self.x_ideal(g, s);
         let f = self.fresnel[s.j as usize];
-        std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * s.cos_i as f64)
+        std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * g.cos_i as f64)
     }
 
     /// Σ over samples of Σ_c |ln(1 + x_model) − ln(1 + x_data)|.
     fn log_error_sum(&self, set: &GridSamples) -> f64 {
+        let geo = geometry();
         set.samples
             .par_iter()
             .with_min_len(4096)
-            .map(|s| log_diff(self.x(s), s))
+            .map(|s| log_diff(self.x(&geo[s.bin as usize], s), s))
             .sum()
     }
 
     /// F per θd bin for this model's D and G (see [`fresnel_average`]).
     pub fn fresnel_average(&self, set: &GridSamples) -> Vec<Rgb> {
-        average_per_theta_d(set, |s| self.x_ideal(s))
+        let geo = geometry();
+        average_per_theta_d(set, |s| self.x_ideal(&geo[s.bin as usize], s))
     }
 }
 

@@ -21,8 +21,9 @@ pub struct Params {
     pub error: f64,
 }
 
-/// A GGX or Beckmann fit: by least squares in the metric's space (the model used), with the
-/// moment estimate beside it and the Fresnel table averaged for the least-squares model.
+/// A GGX or Beckmann fit: by least squares in the metric's space (the model used, with a
+/// Fresnel table averaged for its own D and G), and beside it the paper's estimate (α by first
+/// absolute slope moments, with the extraction's Fresnel) and its error.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParamRecord {
     pub alpha_x: f64,

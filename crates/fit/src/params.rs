@@ -5,7 +5,7 @@ use crate::fresnel::{Fresnel, FresnelTable};
 use crate::grid::{GridSamples, IsoTables, fresnel_average, microfacet_error, tables_error};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::tabulated::TabulatedNdf;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 /// Bounds of any fitted α.
 pub const ALPHA_MIN: f64 = 1e-3;
@@ -61,12 +61,12 @@ pub fn fit_moments(kind: NdfKind, ndf: &TabulatedNdf) -> AnalyticNdf {
     if ndf.tables().nphi == 1 {
         return AnalyticNdf::isotropic(kind, alpha_x);
     }
-    AnalyticNdf {
+    canonical(AnalyticNdf {
         kind,
         alpha_x,
         alpha_y,
         rotation,
-    }
+    })
 }
 
 /// A parametric model together with the Fresnel table averaged for it.
@@ -124,14 +124,19 @@ pub fn fit_least_squares(start: AnalyticNdf, anisotropic: bool, set: &GridSample
         1e-5,
         200,
     );
-    normalise_rotation(make(&p))
+    canonical(make(&p))
 }
 
-/// Keeps ρ in (−π/2, π/2]: ρ and ρ + π describe the same NDF.
-fn normalise_rotation(mut n: AnalyticNdf) -> AnalyticNdf {
-    let mut r = n.rotation.rem_euclid(PI);
+/// The canonical form of an anisotropic NDF: ρ ∈ (−π/4, π/4]. ρ and ρ + π are one NDF, and so
+/// are (αx, αy, ρ) and (αy, αx, ρ + π/2): the axis nearer the tangent is called x.
+fn canonical(mut n: AnalyticNdf) -> AnalyticNdf {
+    let mut r = n.rotation.rem_euclid(PI); // [0, π)
     if r > FRAC_PI_2 {
-        r -= PI;
+        r -= PI; // (−π/2, π/2]
+    }
+    if r > FRAC_PI_4 || r <= -FRAC_PI_4 {
+        std::mem::swap(&mut n.alpha_x, &mut n.alpha_y);
+        r -= FRAC_PI_2.copysign(r);
     }
     n.rotation = r;
     n
