@@ -136,14 +136,138 @@ fn backscatter_slice(src: &dyn Brdf, dirs: &[(f64, f64)]) -> Result<Vec<f64>, Fi
     Ok(out)
 }
 
+/// The discretised eigenproblem: nodes (directions), row scales 4 f(o,o) cos θo, column
+/// weights, normalisation weights, and the kernel shape.
+pub struct Problem {
+    /// Isotropic: the azimuth of `<o,h>+` integrated in closed form, nodes at φ = 0.
+    pub isotropic: bool,
+    pub dirs: Vec<[f64; 3]>,
+    /// 4 f(o,o) cos θo of each node (the mean of RGB).
+    pub row: Vec<f64>,
+    /// Quadrature weight of each node: w sin θ (isotropic), w sin θ Δφ (anisotropic).
+    pub col: Vec<f64>,
+    /// c with Σ c_j D_j = ∫ D cos θ dω.
+    pub norm: Vec<f64>,
+}
+
+impl Problem {
+    /// k(q, h): ∫ <q,h>+ dφ over the azimuth of h (isotropic) or <q,h>+.
+    #[inline]
+    pub fn kernel(&self, q: &[f64; 3], h: &[f64; 3]) -> f64 {
+        if self.isotropic {
+            azimuthal(q, h)
+        } else {
+            (q[0] * h[0] + q[1] * h[1] + q[2] * h[2]).max(0.0)
+        }
+    }
+}
+
+/// [`azimuthal_integral`] from directions at φ = 0 (θ from their z and length in xy).
+#[inline]
+fn azimuthal(q: &[f64; 3], h: &[f64; 3]) -> f64 {
+    let a = q[2] * h[2];
+    let b = q[0].hypot(q[1]) * h[0].hypot(h[1]);
+    if a >= b {
+        2.0 * PI * a
+    } else if a <= -b {
+        0.0
+    } else {
+        let c = -a / b;
+        2.0 * (a * c.acos() + b * (1.0 - c * c).sqrt())
+    }
+}
+
+/// Result of the power iteration.
+pub struct Eigen {
+    /// The normalised eigenvector (D at the nodes).
+    pub v: Vec<f64>,
+    pub lambda: f64,
+    pub iterations: usize,
+    pub residual: f64,
+}
+
+/// What runs the iteration and the table integrals: the CPU here, the GPU in `crate::gpu`.
+pub trait Solver {
+    /// Power iterations `v ← K v / λ` from ones, λ making Σ c v = 1.
+    fn iterate(&self, p: &Problem, stopping: Stopping) -> Result<Eigen, FitError>;
+    /// I(q) = Σ_j col_j k(q, h_j) v_j for each query direction.
+    fn integrals(&self, p: &Problem, v: &[f64], queries: &[[f64; 3]])
+    -> Result<Vec<f64>, FitError>;
+    /// Name recorded as the fit's backend.
+    fn name(&self) -> String;
+}
+
+/// The f64 reference, parallel with rayon. Isotropic: the N×N kernel is small and stored;
+/// anisotropic: matrix-free, each row's kernel computed on the fly.
+pub struct CpuSolver;
+
+impl Solver for CpuSolver {
+    fn iterate(&self, p: &Problem, stopping: Stopping) -> Result<Eigen, FitError> {
+        let n = p.dirs.len();
+        let dense: Option<Vec<f64>> = p.isotropic.then(|| {
+            (0..n * n)
+                .into_par_iter()
+                .map(|ij| {
+                    p.row[ij / n] * p.col[ij % n] * p.kernel(&p.dirs[ij / n], &p.dirs[ij % n])
+                })
+                .collect()
+        });
+        Ok(power_iterate(n, &p.norm, stopping, |v, out| match &dense {
+            Some(k) => out.par_iter_mut().enumerate().for_each(|(i, o)| {
+                *o = k[i * n..(i + 1) * n]
+                    .iter()
+                    .zip(v)
+                    .map(|(k, v)| k * v)
+                    .sum()
+            }),
+            None => {
+                let wv: Vec<f64> = v.iter().zip(&p.col).map(|(v, w)| v * w).collect();
+                out.par_iter_mut()
+                    .enumerate()
+                    .for_each(|(a, o)| *o = p.row[a] * project(p, &p.dirs[a], &wv));
+            }
+        }))
+    }
+
+    fn integrals(
+        &self,
+        p: &Problem,
+        v: &[f64],
+        queries: &[[f64; 3]],
+    ) -> Result<Vec<f64>, FitError> {
+        let wv: Vec<f64> = v.iter().zip(&p.col).map(|(v, w)| v * w).collect();
+        Ok(queries.par_iter().map(|q| project(p, q, &wv)).collect())
+    }
+
+    fn name(&self) -> String {
+        "cpu".into()
+    }
+}
+
+/// Σ_h wv_h k(q, h).
+fn project(p: &Problem, q: &[f64; 3], wv: &[f64]) -> f64 {
+    if p.isotropic {
+        p.dirs
+            .iter()
+            .zip(wv)
+            .map(|(h, wv)| azimuthal(q, h) * wv)
+            .sum()
+    } else {
+        p.dirs
+            .iter()
+            .zip(wv)
+            .map(|(h, wv)| (q[0] * h[0] + q[1] * h[1] + q[2] * h[2]).max(0.0) * wv)
+            .sum()
+    }
+}
+
 /// Power iteration `v ← normalise(K v)` with `normalise` making Σ c_j v_j = 1.
-/// Returns (v, λ, iterations, residual).
 fn power_iterate(
     n: usize,
     c: &[f64],
     stopping: Stopping,
     matvec: impl Fn(&[f64], &mut [f64]),
-) -> (Vec<f64>, f64, usize, f64) {
+) -> Eigen {
     let norm = |v: &[f64]| v.iter().zip(c).map(|(v, c)| v * c).sum::<f64>();
     let mut v = vec![1.0; n];
     let s = norm(&v);
@@ -173,137 +297,118 @@ fn power_iterate(
             break;
         }
     }
-    (v, lambda, it, residual)
-}
-
-/// Isotropic extraction: N polar nodes, the azimuth integrated in closed form.
-pub fn extract_isotropic(src: &dyn Brdf, cfg: &ExtractConfig) -> Result<Extraction, FitError> {
-    let nodes = cfg.quadrature.nodes(cfg.resolution.max(2));
-    let n = nodes.len();
-    let b = backscatter_slice(
-        src,
-        &nodes.iter().map(|&(t, _)| (t, 0.0)).collect::<Vec<_>>(),
-    )?;
-    // Column weights w_j sin θj; normalisation weights 2π w_j sin θj cos θj.
-    let wj: Vec<f64> = nodes.iter().map(|&(t, w)| w * t.sin()).collect();
-    let c: Vec<f64> = nodes
-        .iter()
-        .zip(&wj)
-        .map(|(&(t, _), w)| 2.0 * PI * w * t.cos())
-        .collect();
-    // K_ij = 4 f(θi) cos θi · w_j sin θj · A(θi, θj), stored: N×N is small for a 1-D problem.
-    let k: Vec<f64> = (0..n * n)
-        .into_par_iter()
-        .map(|ij| {
-            let (i, j) = (ij / n, ij % n);
-            4.0 * b[i] * nodes[i].0.cos() * wj[j] * azimuthal_integral(nodes[i].0, nodes[j].0)
-        })
-        .collect();
-    let (v, lambda, iterations, residual) = power_iterate(n, &c, cfg.stopping, |v, out| {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = k[i * n..(i + 1) * n]
-                .iter()
-                .zip(v)
-                .map(|(k, v)| k * v)
-                .sum();
-        }
-    });
-    // Nyström: I(θ) = Σ_j w_j sin θj A(θ, θj) v_j; D(θ) = 4 f(θ) cos θ I(θ) / λ; G1 = cos θ / I(θ).
-    let integral = |theta: f64| -> f64 {
-        (0..n)
-            .map(|j| wj[j] * azimuthal_integral(theta, nodes[j].0) * v[j])
-            .sum()
-    };
-    let d_thetas: Vec<(f64, f64)> = (0..ISO_TABLE_U)
-        .map(|k| (u_node_theta(k, ISO_TABLE_U), 0.0))
-        .collect();
-    let bd = backscatter_slice(src, &d_thetas)?;
-    let d: Vec<f64> = d_thetas
-        .par_iter()
-        .zip(&bd)
-        .map(|(&(t, _), &f)| 4.0 * f * t.cos().max(0.0) * integral(t) / lambda)
-        .collect();
-    let g1: Vec<f64> = (0..ISO_TABLE_G)
-        .into_par_iter()
-        .map(|k| {
-            let t = theta_node(k, ISO_TABLE_G);
-            let i = integral(t);
-            if i > 0.0 {
-                (t.cos().max(0.0) / i).min(1.0)
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    finish(
-        src,
-        NdfTables {
-            nu: ISO_TABLE_U,
-            nphi: 1,
-            d,
-            ng: ISO_TABLE_G,
-            g1,
-        },
+    Eigen {
+        v,
         lambda,
-        iterations,
+        iterations: it,
         residual,
-    )
+    }
 }
 
-/// Anisotropic extraction on a (θ, φ) grid of directions, matrix-free: each iteration computes
-/// the kernel `4 f(o,o) cos θo <o,h>+ W_h` on the fly, rows in parallel.
+/// Isotropic extraction on the CPU.
+pub fn extract_isotropic(src: &dyn Brdf, cfg: &ExtractConfig) -> Result<Extraction, FitError> {
+    extract_with(src, cfg, false, &CpuSolver)
+}
+
+/// Anisotropic extraction on the CPU.
 pub fn extract_anisotropic(src: &dyn Brdf, cfg: &ExtractConfig) -> Result<Extraction, FitError> {
+    extract_with(src, cfg, true, &CpuSolver)
+}
+
+/// Extraction with any solver: isotropic (N polar nodes, the azimuth integrated in closed form)
+/// or anisotropic (a (θ, φ) grid of directions).
+pub fn extract_with(
+    src: &dyn Brdf,
+    cfg: &ExtractConfig,
+    anisotropic: bool,
+    solver: &dyn Solver,
+) -> Result<Extraction, FitError> {
     let polar = cfg.quadrature.nodes(cfg.resolution.max(2));
-    let nphi = cfg.phi_resolution.max(1);
+    let nphi = if anisotropic {
+        cfg.phi_resolution.max(1)
+    } else {
+        1
+    };
     let dphi = 2.0 * PI / nphi as f64;
-    // Node (i, l): θ_i, φ_l = (l + ½) Δφ, weight W = w_i sin θ_i Δφ.
-    let dirs: Vec<(f64, f64)> = polar
+    // Node (i, l): θ_i, φ_l = (l + ½) Δφ (isotropic: φ = 0 and the azimuth integrated).
+    let angles: Vec<(f64, f64)> = polar
         .iter()
-        .flat_map(|&(t, _)| (0..nphi).map(move |l| (t, (l as f64 + 0.5) * dphi)))
+        .flat_map(|&(t, _)| {
+            (0..nphi).map(move |l| {
+                (
+                    t,
+                    if anisotropic {
+                        (l as f64 + 0.5) * dphi
+                    } else {
+                        0.0
+                    },
+                )
+            })
+        })
         .collect();
-    let n = dirs.len();
-    let weight: Vec<f64> = polar
-        .iter()
-        .flat_map(|&(t, w)| std::iter::repeat_n(w * t.sin() * dphi, nphi))
-        .collect();
-    let xyz: Vec<[f64; 3]> = dirs
+    let b = backscatter_slice(src, &angles)?;
+    let dirs: Vec<[f64; 3]> = angles
         .iter()
         .map(|&(t, p)| spherical(t, p).to_array())
         .collect();
-    let b = backscatter_slice(src, &dirs)?;
-    let c: Vec<f64> = weight.iter().zip(&xyz).map(|(w, d)| w * d[2]).collect();
-    // Σ_h W_h <o,h>+ v_h for one direction o, the inner loop of the kernel–vector product.
-    let project = |o: [f64; 3], wv: &[f64]| -> f64 {
-        xyz.iter()
-            .zip(wv)
-            .map(|(h, wv)| (o[0] * h[0] + o[1] * h[1] + o[2] * h[2]).max(0.0) * wv)
-            .sum::<f64>()
-    };
-    let (v, lambda, iterations, residual) = power_iterate(n, &c, cfg.stopping, |v, out| {
-        let wv: Vec<f64> = v.iter().zip(&weight).map(|(v, w)| v * w).collect();
-        out.par_iter_mut()
-            .enumerate()
-            .for_each(|(a, o)| *o = 4.0 * b[a] * xyz[a][2] * project(xyz[a], &wv));
-    });
-    let wv: Vec<f64> = v.iter().zip(&weight).map(|(v, w)| v * w).collect();
-    let nu = 2 * cfg.resolution.max(2) + 1;
-    let d_dirs: Vec<(f64, f64)> = (0..nu)
-        .flat_map(|k| (0..nphi).map(move |l| (u_node_theta(k, nu), phi_node(l, nphi))))
-        .collect();
-    let bd = backscatter_slice(src, &d_dirs)?;
-    let d: Vec<f64> = d_dirs
-        .par_iter()
-        .zip(&bd)
-        .map(|(&(t, p), &f)| {
-            4.0 * f * t.cos().max(0.0) * project(spherical(t, p).to_array(), &wv) / lambda
+    // Column weights w sin θ (Δφ when anisotropic); c = w sin θ cos θ (· 2π when isotropic).
+    let col: Vec<f64> = polar
+        .iter()
+        .flat_map(|&(t, w)| {
+            std::iter::repeat_n(w * t.sin() * if anisotropic { dphi } else { 1.0 }, nphi)
         })
         .collect();
-    let ng = nu;
-    let g1: Vec<f64> = (0..ng * nphi)
-        .into_par_iter()
-        .map(|kl| {
-            let (t, p) = (theta_node(kl / nphi, ng), phi_node(kl % nphi, nphi));
-            let i = project(spherical(t, p).to_array(), &wv);
+    let norm: Vec<f64> = col
+        .iter()
+        .zip(&dirs)
+        .map(|(w, d)| w * d[2] * if anisotropic { 1.0 } else { 2.0 * PI })
+        .collect();
+    let row: Vec<f64> = b.iter().zip(&dirs).map(|(b, d)| 4.0 * b * d[2]).collect();
+    let problem = Problem {
+        isotropic: !anisotropic,
+        dirs,
+        row,
+        col,
+        norm,
+    };
+    let eigen = solver.iterate(&problem, cfg.stopping)?;
+    if !(eigen.lambda > 0.0 && eigen.lambda.is_finite()) || eigen.v.iter().any(|x| !x.is_finite()) {
+        return Err(FitError::Extraction {
+            name: src.name().to_owned(),
+            problem: format!("the power iteration diverged (λ = {})", eigen.lambda),
+        });
+    }
+    // Nyström: I(q) = Σ_j col_j k(q, h_j) v_j; D(q) = 4 f(q) cos θ I(q) / λ; G1 = cos θ / I(q).
+    let (nu, ng) = if anisotropic {
+        let n = 2 * cfg.resolution.max(2) + 1;
+        (n, n)
+    } else {
+        (ISO_TABLE_U, ISO_TABLE_G)
+    };
+    let d_angles: Vec<(f64, f64)> = (0..nu)
+        .flat_map(|k| (0..nphi).map(move |l| (u_node_theta(k, nu), phi_node(l, nphi))))
+        .collect();
+    let g_angles: Vec<(f64, f64)> = (0..ng)
+        .flat_map(|k| (0..nphi).map(move |l| (theta_node(k, ng), phi_node(l, nphi))))
+        .collect();
+    let queries: Vec<[f64; 3]> = d_angles
+        .iter()
+        .chain(&g_angles)
+        .map(|&(t, p)| spherical(t, p).to_array())
+        .collect();
+    let integrals = solver.integrals(&problem, &eigen.v, &queries)?;
+    let (i_d, i_g) = integrals.split_at(d_angles.len());
+    let bd = backscatter_slice(src, &d_angles)?;
+    let d: Vec<f64> = d_angles
+        .iter()
+        .zip(&bd)
+        .zip(i_d)
+        .map(|((&(t, _), &f), &i)| (4.0 * f * t.cos().max(0.0) * i / eigen.lambda).max(0.0))
+        .collect();
+    let g1: Vec<f64> = g_angles
+        .iter()
+        .zip(i_g)
+        .map(|(&(t, _), &i)| {
             if i > 0.0 {
                 (t.cos().max(0.0) / i).min(1.0)
             } else {
@@ -320,9 +425,9 @@ pub fn extract_anisotropic(src: &dyn Brdf, cfg: &ExtractConfig) -> Result<Extrac
             ng,
             g1,
         },
-        lambda,
-        iterations,
-        residual,
+        eigen.lambda,
+        eigen.iterations,
+        eigen.residual,
     )
 }
 
