@@ -3,12 +3,14 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::extract::Stopping;
-use facet_fit::fit::{FitConfig, Models, fit_material};
+use facet_fit::fit::{Backend, FitConfig, Models, fit_material_on};
+use facet_fit::gpu::GpuFitter;
 use facet_fit::material::FittedMaterial;
 use facet_fit::merl::{MerlBrdf, MerlTable};
 use facet_fit::nbrdf::NbrdfLibrary;
 use facet_fit::quadrature::Quadrature;
 use facet_fit::source::open_source;
+use facet_gpu::Gpu;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
 use std::io::Write;
@@ -26,8 +28,48 @@ pub enum ModelArg {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {
+    /// The GPU when a hardware adapter exists, else the CPU (with a notice).
+    Auto,
+    /// WGSL compute passes (f32); fails when there is no adapter.
+    Gpu,
     /// f64 reference on the CPU, parallel over all cores.
     Cpu,
+}
+
+/// The GPU for `--backend`, or `None` for the CPU. `FACET_BACKEND` / `FACET_ADAPTER` choose it.
+fn open_gpu(arg: BackendArg) -> Result<Option<Gpu>> {
+    match arg {
+        BackendArg::Cpu => Ok(None),
+        BackendArg::Gpu => Ok(Some(Gpu::new().context("--backend gpu")?)),
+        BackendArg::Auto => match Gpu::new() {
+            // A software rasteriser (lavapipe, llvmpipe) is slower than the f64 CPU path.
+            Ok(g) if g.info.device_type == wgpu::DeviceType::Cpu => {
+                eprintln!(
+                    "notice: only a software adapter ({}); fitting on the CPU (--backend gpu uses it)",
+                    g.info.name
+                );
+                Ok(None)
+            }
+            Ok(g) => Ok(Some(g)),
+            Err(e) => {
+                eprintln!("notice: {e}; fitting on the CPU");
+                Ok(None)
+            }
+        },
+    }
+}
+
+/// Pipelines on the GPU, or the CPU when `--backend auto` cannot build them.
+fn fitter<'g>(gpu: &'g Option<Gpu>, arg: BackendArg) -> Result<Option<GpuFitter<'g>>> {
+    let Some(g) = gpu else { return Ok(None) };
+    match GpuFitter::new(g) {
+        Ok(f) => Ok(Some(f)),
+        Err(e) if arg == BackendArg::Auto => {
+            eprintln!("notice: GPU pipelines failed ({e}); fitting on the CPU");
+            Ok(None)
+        }
+        Err(e) => Err(e).context("building the GPU pipelines"),
+    }
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -62,7 +104,7 @@ pub struct FitArgs {
     tolerance: f64,
     #[arg(long, value_enum, default_value = "gauss-legendre-sqrt")]
     quadrature: QuadratureArg,
-    #[arg(long, value_enum, default_value = "cpu")]
+    #[arg(long, value_enum, default_value = "auto")]
     backend: BackendArg,
     /// Output folder for <name>.json and the tables.
     #[arg(long, default_value = "out")]
@@ -147,6 +189,9 @@ fn nbrdf_path(arg: &Option<PathBuf>) -> PathBuf {
 
 pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let cfg = args.config()?;
+    let gpu = open_gpu(args.backend)?;
+    let fitter = fitter(&gpu, args.backend)?;
+    let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating the output folder {}", args.out.display()))?;
     let nbrdf = nbrdf_path(&args.nbrdf);
@@ -167,7 +212,15 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
         if let Some(bar) = &bar {
             bar.set_message(input.clone());
         }
-        match fit_one(input, &cfg, &args.out, &nbrdf, &mut library, &mut names) {
+        match fit_one(
+            input,
+            &cfg,
+            backend,
+            &args.out,
+            &nbrdf,
+            &mut library,
+            &mut names,
+        ) {
             Ok(fit) => rows.push(fit),
             Err(e) => {
                 failures += 1;
@@ -204,6 +257,7 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
 fn fit_one(
     input: &str,
     cfg: &FitConfig,
+    backend: Backend,
     out: &Path,
     nbrdf: &Path,
     library: &mut Option<NbrdfLibrary>,
@@ -212,7 +266,10 @@ fn fit_one(
     let t = Instant::now();
     let src = open_source(input, nbrdf, library)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
-    let mut fit = fit_material(src.as_ref(), input, cfg)?;
+    let mut fit = fit_material_on(src.as_ref(), input, cfg, backend)?;
+    if fit.record.backend.starts_with("cpu (fallback") {
+        eprintln!("notice: {input}: {}", fit.record.backend);
+    }
     fit.record.timings_ms.load = load_ms;
     fit.record.timings_ms.total += load_ms;
     // Two inputs with one name get -2, -3, ... rather than overwriting each other.
@@ -344,10 +401,14 @@ pub fn run_default() -> Result<ExitCode> {
     let src = MerlBrdf::from_table("default-gold-ggx", MerlTable::sample(&model))
         .map_err(anyhow::Error::msg)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
-    let mut fit = fit_material(
+    let gpu = open_gpu(BackendArg::Auto)?;
+    let fitter = fitter(&gpu, BackendArg::Auto)?;
+    let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
+    let mut fit = fit_material_on(
         &src,
         &format!("embedded:analytic:{DEFAULT_MATERIAL}"),
         &FitConfig::isotropic(),
+        backend,
     )?;
     fit.record.timings_ms.load = load_ms;
     let out = Path::new("out");

@@ -17,6 +17,11 @@ pub enum FitError {
     Material { path: PathBuf, problem: String },
     #[error("input `{spec}`: {problem}")]
     Spec { spec: String, problem: String },
+    #[error("{name}: on the GPU: {source}")]
+    Gpu {
+        name: String,
+        source: facet_gpu::GpuError,
+    },
     #[error("{name}: cannot extract an NDF: {problem}")]
     Extraction { name: String, problem: String },
 }

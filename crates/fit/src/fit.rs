@@ -2,12 +2,14 @@
 
 use crate::brdf::Brdf;
 use crate::error::FitError;
-use crate::extract::{ExtractConfig, extract_anisotropic, extract_isotropic};
+use crate::extract::{CpuSolver, ExtractConfig, Solver, extract_with};
 use crate::fresnel::{Fresnel, FresnelTable};
+use crate::gpu::{GpuFitter, gpu_error};
+use crate::grid::IsoTables;
 use crate::grid::{GridSamples, fresnel_average, microfacet_error};
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
-use crate::params::{fit_least_squares, fit_moments, model_with_fresnel};
+use crate::params::{fit_least_squares, fit_moments};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -75,19 +77,57 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-/// Fits one source. `source` describes where it came from (recorded in the JSON).
+/// Where the extraction and the Fresnel averages run. The parameter searches and the error
+/// metric always run on the CPU.
+#[derive(Clone, Copy)]
+pub enum Backend<'a, 'g> {
+    Cpu,
+    Gpu(&'a GpuFitter<'g>),
+}
+
+/// Fits one source on the CPU. `source` describes where it came from (recorded in the JSON).
 pub fn fit_material(
     src: &dyn Brdf,
     source: &str,
     cfg: &FitConfig,
 ) -> Result<FittedMaterial, FitError> {
+    fit_material_on(src, source, cfg, Backend::Cpu)
+}
+
+/// Fits one source on a backend. A GPU failure falls back to the CPU, and the record's
+/// `backend` says so: the answer is never silently different.
+pub fn fit_material_on(
+    src: &dyn Brdf,
+    source: &str,
+    cfg: &FitConfig,
+    backend: Backend,
+) -> Result<FittedMaterial, FitError> {
+    match backend {
+        Backend::Cpu => fit_with(src, source, cfg, None),
+        Backend::Gpu(g) => match fit_with(src, source, cfg, Some(g)) {
+            Err(e @ FitError::Gpu { .. }) => {
+                let mut m = fit_with(src, source, cfg, None)?;
+                m.record.backend = format!("cpu (fallback after a GPU failure: {e})");
+                Ok(m)
+            }
+            other => other,
+        },
+    }
+}
+
+fn fit_with(
+    src: &dyn Brdf,
+    source: &str,
+    cfg: &FitConfig,
+    gpu: Option<&GpuFitter>,
+) -> Result<FittedMaterial, FitError> {
     let start = Instant::now();
     let t = Instant::now();
-    let ex = if cfg.anisotropic {
-        extract_anisotropic(src, &cfg.extract)?
-    } else {
-        extract_isotropic(src, &cfg.extract)?
+    let solver: &dyn Solver = match gpu {
+        Some(g) => g,
+        None => &CpuSolver,
     };
+    let ex = extract_with(src, &cfg.extract, cfg.anisotropic, solver)?;
     let extract_ms = ms(t);
 
     let t = Instant::now();
@@ -98,13 +138,32 @@ pub fn fit_material(
             problem: "no valid sample on the MERL grid".into(),
         });
     }
+    // The GPU averages Fresnel over isotropic sample sets, uploaded once for all models.
+    let uploaded = match gpu {
+        Some(g) if set.rotations.len() == 1 => Some((
+            g,
+            g.fresnel
+                .upload(g.gpu, &set)
+                .map_err(|e| gpu_error(src.name(), e))?,
+        )),
+        _ => None,
+    };
+    let average = |model: &MicrofacetBrdf| -> Result<Vec<crate::brdf::Rgb>, FitError> {
+        match (&uploaded, IsoTables::new(model)) {
+            (Some((g, samples)), Some(tables)) => g
+                .fresnel
+                .average(g.gpu, samples, &tables)
+                .map_err(|e| gpu_error(src.name(), e)),
+            _ => Ok(fresnel_average(model, &set)),
+        }
+    };
     let mut tabulated = MicrofacetBrdf {
         name: format!("{}-tabulated", src.name()),
         ndf: Ndf::Tabulated(Arc::new(ex.ndf.clone())),
         fresnel: Fresnel::Schlick { f0: [1.0; 3] },
         diffuse: [0.0; 3],
     };
-    let fresnel = FresnelTable::on_merl_bins(fresnel_average(&tabulated, &set));
+    let fresnel = FresnelTable::on_merl_bins(average(&tabulated)?);
     tabulated.fresnel = Fresnel::Table(fresnel.clone());
     let fresnel_ms = ms(t);
 
@@ -114,7 +173,7 @@ pub fn fit_material(
         .tabulated
         .then(|| microfacet_error(&tabulated, &set));
     let search = set.subsample(cfg.search_stride);
-    let fit_kind = |kind: NdfKind| -> ParamRecord {
+    let fit_kind = |kind: NdfKind| -> Result<ParamRecord, FitError> {
         let moments = fit_moments(kind, &ex.ndf);
         let lsq = fit_least_squares(moments, cfg.anisotropic, &search);
         // The paper's estimate: α by moments with the Fresnel of the extraction.
@@ -125,10 +184,14 @@ pub fn fit_material(
             diffuse: [0.0; 3],
         };
         // The least-squares model with a Fresnel table averaged for its own D and G.
-        let lsq_model = model_with_fresnel("lsq", lsq, &set);
-        let Fresnel::Table(lsq_fresnel) = lsq_model.fresnel.clone() else {
-            unreachable!("model_with_fresnel sets a table")
+        let mut lsq_model = MicrofacetBrdf {
+            name: "lsq".into(),
+            ndf: Ndf::Analytic(lsq),
+            fresnel: Fresnel::Schlick { f0: [1.0; 3] },
+            diffuse: [0.0; 3],
         };
+        let lsq_fresnel = FresnelTable::on_merl_bins(average(&lsq_model)?);
+        lsq_model.fresnel = Fresnel::Table(lsq_fresnel.clone());
         let params = |n: &AnalyticNdf, e| Params {
             alpha_x: n.alpha_x,
             alpha_y: n.alpha_y,
@@ -136,7 +199,7 @@ pub fn fit_material(
             error: e,
         };
         let moments = params(&moments, microfacet_error(&moment_model, &set));
-        ParamRecord {
+        Ok(ParamRecord {
             alpha_x: lsq.alpha_x,
             alpha_y: lsq.alpha_y,
             rotation: lsq.rotation,
@@ -144,16 +207,20 @@ pub fn fit_material(
             method: "least_squares".into(),
             moments,
             fresnel: lsq_fresnel,
-        }
+        })
     };
-    let ggx = cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx));
-    let beckmann = cfg.models.beckmann.then(|| fit_kind(NdfKind::Beckmann));
+    let ggx = cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx)).transpose()?;
+    let beckmann = cfg
+        .models
+        .beckmann
+        .then(|| fit_kind(NdfKind::Beckmann))
+        .transpose()?;
     let fit_ms = ms(t);
 
     let record = FitRecord {
         name: src.name().to_owned(),
         source: source.to_owned(),
-        backend: "cpu".into(),
+        backend: solver.name(),
         resolution: cfg.extract.resolution,
         phi_resolution: if cfg.anisotropic {
             cfg.extract.phi_resolution

@@ -288,6 +288,16 @@ impl IsoTables {
         })
     }
 
+    /// D per θh bin.
+    pub(crate) fn d_table(&self) -> &[f64] {
+        &self.d
+    }
+
+    /// Λ cos θ, uniform in θ over [0, π/2].
+    pub(crate) fn lambda_cos_table(&self) -> &[f64] {
+        &self.lambda_cos
+    }
+
     /// The same model with another Fresnel table.
     pub fn set_fresnel(&mut self, f: &[Rgb]) {
         self.fresnel.copy_from_slice(&f[..THETA_D_RES]);
@@ -387,6 +397,21 @@ pub fn fresnel_average(model: &MicrofacetBrdf, set: &GridSamples) -> Vec<Rgb> {
     }
 }
 
+/// For the GPU upload: (θi, θo in Λ-table steps, 1/cos θi, 1/cos θo, λ(φ)) of a sample.
+pub(crate) fn sample_geometry(s: &GridSample) -> [f32; 5] {
+    let g = &geometry()[s.bin as usize];
+    [g.gi, g.go, g.inv_cos_i, g.inv_cos_o, g.corr]
+}
+
+/// F per θd bin from the sums (Σ x_data per channel, Σ x_ideal); empty bins interpolated.
+pub(crate) fn fresnel_from_sums(acc: &[([f64; 3], f64)]) -> Vec<Rgb> {
+    let per_bin: Vec<Option<Rgb>> = acc
+        .iter()
+        .map(|(x, w)| (*w > 0.0).then(|| x.map(|v| v / w)))
+        .collect();
+    merl::fill_missing(&per_bin).unwrap_or_else(|| vec![[1.0; 3]; THETA_D_RES])
+}
+
 /// Σ x_data / Σ x_ideal per θd bin, empty bins filled by interpolation.
 fn average_per_theta_d(set: &GridSamples, ideal: impl Fn(&GridSample) -> f64 + Sync) -> Vec<Rgb> {
     type Acc = Vec<([f64; 3], f64)>;
@@ -416,11 +441,7 @@ fn average_per_theta_d(set: &GridSamples, ideal: impl Fn(&GridSample) -> f64 + S
                 a
             },
         );
-    let per_bin: Vec<Option<Rgb>> = acc
-        .iter()
-        .map(|(x, w)| (*w > 0.0).then(|| x.map(|v| v / w)))
-        .collect();
-    merl::fill_missing(&per_bin).unwrap_or_else(|| vec![[1.0; 3]; THETA_D_RES])
+    fresnel_from_sums(&acc)
 }
 
 #[cfg(test)]

@@ -34,6 +34,7 @@ pub mod extract;
 pub mod fit;
 pub mod fresnel;
 pub mod geometry;
+pub mod gpu;
 pub mod grid;
 pub mod material;
 pub mod merl;

@@ -1,0 +1,21 @@
+//! # facet-gpu: the wgpu layer of Facet
+//!
+//! Adapter and device selection ([`Gpu`]), WGSL loading from `shaders/` with includes and naga
+//! validation ([`shader`]), buffer upload and read-back ([`buffer`]), GPU timestamps
+//! ([`timer::GpuTimer`]) and errors a caller can act on ([`GpuError`]). Nothing domain-specific.
+//!
+//! ```no_run
+//! let gpu = facet_gpu::Gpu::new()?; // honours FACET_BACKEND and FACET_ADAPTER
+//! println!("{}", gpu.describe());
+//! let pipeline = facet_gpu::shader::compute_pipeline(&gpu.device, "fit/power_iso.wgsl", "matvec", &[])?;
+//! # Ok::<(), facet_gpu::GpuError>(())
+//! ```
+
+pub mod buffer;
+pub mod context;
+pub mod error;
+pub mod shader;
+pub mod timer;
+
+pub use context::{Gpu, GpuOptions, gpu_for_tests};
+pub use error::GpuError;

@@ -1,0 +1,154 @@
+//! The fitter on the GPU against the f64 CPU reference (lavapipe here and in CI). Without an
+//! adapter these tests skip with a message, unless FACET_REQUIRE_GPU=1.
+
+mod common;
+
+use common::merl_from_spec;
+use facet_fit::analytic::parse_analytic;
+use facet_fit::brdf::Brdf;
+use facet_fit::extract::{CpuSolver, ExtractConfig, extract_with};
+use facet_fit::fit::{Backend, FitConfig, fit_material_on};
+use facet_fit::gpu::GpuFitter;
+use facet_gpu::gpu_for_tests;
+
+/// Largest relative difference over entries above `floor` × the largest entry (f32 relative
+/// precision is meaningless for entries 10⁶ times smaller than the peak).
+fn rel_diff(a: &[f64], b: &[f64], floor: f64) -> f64 {
+    let peak = b.iter().cloned().fold(0.0, f64::max);
+    a.iter()
+        .zip(b)
+        .filter(|(_, y)| **y > floor * peak)
+        .map(|(x, y)| (x / y - 1.0).abs())
+        .fold(0.0, f64::max)
+}
+
+fn compare(name: &str, src: &dyn Brdf, cfg: &FitConfig, fitter: &GpuFitter) {
+    let cpu = fit_material_on(src, "cpu", cfg, Backend::Cpu)
+        .unwrap()
+        .record;
+    let gpu = fit_material_on(src, "gpu", cfg, Backend::Gpu(fitter))
+        .unwrap()
+        .record;
+    assert!(
+        gpu.backend.contains("llvmpipe") || !gpu.backend.starts_with("cpu"),
+        "{name}: ran on {}",
+        gpu.backend
+    );
+    let d = rel_diff(&gpu.tabulated.tables.d, &cpu.tabulated.tables.d, 1e-4);
+    let g1 = rel_diff(&gpu.tabulated.tables.g1, &cpu.tabulated.tables.g1, 1e-3);
+    let f = gpu
+        .fresnel
+        .rgb
+        .iter()
+        .zip(&cpu.fresnel.rgb)
+        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] / b[c] - 1.0).abs()))
+        .fold(0.0, f64::max);
+    let alpha = |r: &facet_fit::material::FitRecord| {
+        let g = r.ggx.as_ref().unwrap();
+        [g.alpha_x, g.alpha_y, g.moments.alpha_x, g.moments.alpha_y]
+    };
+    let da = alpha(&gpu)
+        .iter()
+        .zip(alpha(&cpu))
+        .map(|(a, b)| (a / b - 1.0).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "{name}: D {d:.1e}, G1 {g1:.1e}, F {f:.1e}, α {da:.1e}; iterations cpu {} gpu {}; λ {:.6} / {:.6}",
+        cpu.iterations, gpu.iterations, cpu.eigenvalue, gpu.eigenvalue
+    );
+    // f32 tolerances: sums of N ≤ 4096 products in f32 carry ~1e-6 relative error; the
+    // eigenvector's iteration stops at a residual of ~1e-7 in f32; 1e-4 leaves a wide margin.
+    assert!(
+        d < 1e-4 && g1 < 1e-4 && f < 1e-4,
+        "{name}: D {d}, G1 {g1}, F {f}"
+    );
+    assert!(da < 1e-3, "{name}: α differs by {da}");
+}
+
+#[test]
+fn gpu_and_cpu_fits_agree() {
+    let Some(gpu) = gpu_for_tests("gpu_and_cpu_fits_agree") else {
+        return;
+    };
+    let fitter = GpuFitter::new(&gpu).unwrap();
+    println!("adapter: {}", gpu.describe());
+    let mut iso = FitConfig::isotropic();
+    iso.models.beckmann = false;
+    for spec in [
+        "ggx?alpha=0.05&f0=0.04",
+        "ggx?alpha=0.3&conductor=gold",
+        "beckmann?alpha=0.2&f0=0.5",
+    ] {
+        compare(spec, &merl_from_spec(spec), &iso, &fitter);
+    }
+    let lib = common::nbrdf();
+    for name in [
+        "blue-acrylic",
+        "gold-metallic-paint",
+        "alum-bronze",
+        "chrome",
+        "red-fabric",
+    ] {
+        compare(name, &lib.get(name).unwrap(), &iso, &fitter);
+    }
+    // Anisotropic, sized for lavapipe.
+    let mut aniso = FitConfig::anisotropic();
+    aniso.models.beckmann = false;
+    aniso.extract.resolution = 24;
+    aniso.extract.phi_resolution = 32;
+    let src = parse_analytic("ggx?alpha_x=0.15&alpha_y=0.35&rotation=20&f0=0.04").unwrap();
+    compare("anisotropic GGX (0.15, 0.35, 20°)", &src, &aniso, &fitter);
+}
+
+#[test]
+fn gpu_extraction_matches_cpu_at_large_n() {
+    let Some(gpu) = gpu_for_tests("gpu_extraction_matches_cpu_at_large_n") else {
+        return;
+    };
+    let fitter = GpuFitter::new(&gpu).unwrap();
+    let src = merl_from_spec("ggx?alpha=0.1&f0=0.04");
+    let cfg = ExtractConfig {
+        resolution: 1024,
+        ..ExtractConfig::isotropic()
+    };
+    let cpu = extract_with(&src, &cfg, false, &CpuSolver).unwrap();
+    let g = extract_with(&src, &cfg, false, &fitter).unwrap();
+    let d = rel_diff(&g.ndf.tables().d, &cpu.ndf.tables().d, 1e-4);
+    println!(
+        "N = 1024: D {d:.1e}, λ {} vs {}",
+        g.eigenvalue, cpu.eigenvalue
+    );
+    assert!(d < 1e-4 && (g.eigenvalue / cpu.eigenvalue - 1.0).abs() < 1e-5);
+}
+
+#[test]
+fn without_an_adapter_gpu_tests_skip_or_fail_as_asked() {
+    // Re-runs one GPU test of this binary with the GPU switched off (FACET_BACKEND=cpu).
+    let run = |require: bool| {
+        let mut cmd = std::process::Command::new(std::env::current_exe().unwrap());
+        cmd.args([
+            "gpu_extraction_matches_cpu_at_large_n",
+            "--exact",
+            "--nocapture",
+        ])
+        .env("FACET_BACKEND", "cpu");
+        if require {
+            cmd.env("FACET_REQUIRE_GPU", "1");
+        } else {
+            cmd.env_remove("FACET_REQUIRE_GPU");
+        }
+        let out = cmd.output().unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).to_string()
+                + &String::from_utf8_lossy(&out.stderr),
+        )
+    };
+    let (ok, text) = run(false);
+    assert!(
+        ok && text.contains("SKIPPED gpu_extraction_matches_cpu_at_large_n"),
+        "{text}"
+    );
+    let (ok, text) = run(true);
+    assert!(!ok && text.contains("FACET_REQUIRE_GPU=1"), "{text}");
+}

@@ -1,0 +1,82 @@
+//! Every WGSL file parses and validates with naga; every struct shared with Rust has the same
+//! size and offsets on both sides. No GPU needed.
+
+use facet_fit::gpu::{GpuNode, GpuSample, GpuState};
+use facet_gpu::shader;
+use std::mem::{offset_of, size_of};
+
+#[test]
+fn every_wgsl_file_validates() {
+    let files: Vec<&str> = shader::pipeline_files().collect();
+    assert!(files.len() >= 3, "found {files:?}");
+    for name in files {
+        let src = shader::expand(name).unwrap();
+        shader::validate(name, &src).unwrap_or_else(|e| panic!("{e}"));
+        println!("{name}: valid");
+    }
+    // Include-only files are valid WGSL on their own too.
+    for (name, src) in shader::SHADERS
+        .iter()
+        .filter(|(n, _)| n.ends_with(".inc.wgsl"))
+    {
+        shader::validate(name, src).unwrap_or_else(|e| panic!("{e}"));
+    }
+}
+
+#[test]
+fn include_errors_name_the_file() {
+    let err = shader::expand("fit/no-such-file.wgsl")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("fit/no-such-file.wgsl"), "{err}");
+    let bad = shader::validate("broken.wgsl", "fn f() -> f32 { return x; }")
+        .unwrap_err()
+        .to_string();
+    assert!(bad.contains("broken.wgsl") && bad.contains("x"), "{bad}");
+}
+
+fn layout(file: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let module = shader::validate(file, &shader::expand(file).unwrap()).unwrap();
+    shader::struct_layout(&module, name).unwrap_or_else(|| panic!("{file} has no struct {name}"))
+}
+
+#[test]
+fn shared_structs_match_naga_layouts() {
+    let (size, members) = layout("fit/kernel.wgsl", "Node");
+    assert_eq!(size as usize, size_of::<GpuNode>());
+    let rust = [
+        ("x", offset_of!(GpuNode, x)),
+        ("y", offset_of!(GpuNode, y)),
+        ("z", offset_of!(GpuNode, z)),
+        ("row_scale", offset_of!(GpuNode, row_scale)),
+        ("col_weight", offset_of!(GpuNode, col_weight)),
+        ("norm_weight", offset_of!(GpuNode, norm_weight)),
+    ];
+    for (name, off) in rust {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Node.{name}: {members:?}"
+        );
+    }
+    let (size, members) = layout("fit/normalise.wgsl", "State");
+    assert_eq!(size as usize, size_of::<GpuState>());
+    assert!(members.contains(&("iteration".into(), offset_of!(GpuState, iteration) as u32)));
+    assert!(members.contains(&("lambda".into(), offset_of!(GpuState, lambda) as u32)));
+    let (size, members) = layout("fit/fresnel.wgsl", "Sample");
+    assert_eq!(size as usize, size_of::<GpuSample>());
+    let rust = [
+        ("x", offset_of!(GpuSample, x)),
+        ("i", offset_of!(GpuSample, i)),
+        ("gi", offset_of!(GpuSample, gi)),
+        ("go", offset_of!(GpuSample, go)),
+        ("inv_cos_i", offset_of!(GpuSample, inv_cos_i)),
+        ("inv_cos_o", offset_of!(GpuSample, inv_cos_o)),
+        ("corr", offset_of!(GpuSample, corr)),
+    ];
+    for (name, off) in rust {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Sample.{name}: {members:?}"
+        );
+    }
+}
