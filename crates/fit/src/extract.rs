@@ -315,14 +315,13 @@ pub fn extract_anisotropic(src: &dyn Brdf, cfg: &ExtractConfig) -> Result<Extrac
     extract_with(src, cfg, true, &CpuSolver)
 }
 
-/// Extraction with any solver: isotropic (N polar nodes, the azimuth integrated in closed form)
-/// or anisotropic (a (θ, φ) grid of directions).
-pub fn extract_with(
+/// The discretised problem of a source: isotropic (N polar nodes, the azimuth integrated in
+/// closed form) or anisotropic (a (θ, φ) grid of directions); rows 4 f(o,o) cos θo, weights.
+pub fn build_problem(
     src: &dyn Brdf,
     cfg: &ExtractConfig,
     anisotropic: bool,
-    solver: &dyn Solver,
-) -> Result<Extraction, FitError> {
+) -> Result<Problem, FitError> {
     let polar = cfg.quadrature.nodes(cfg.resolution.max(2));
     let nphi = if anisotropic {
         cfg.phi_resolution.max(1)
@@ -364,13 +363,28 @@ pub fn extract_with(
         .map(|(w, d)| w * d[2] * if anisotropic { 1.0 } else { 2.0 * PI })
         .collect();
     let row: Vec<f64> = b.iter().zip(&dirs).map(|(b, d)| 4.0 * b * d[2]).collect();
-    let problem = Problem {
+    Ok(Problem {
         isotropic: !anisotropic,
         dirs,
         row,
         col,
         norm,
+    })
+}
+
+/// Extraction with any solver: the power iteration, then the D and G1 tables by Nyström.
+pub fn extract_with(
+    src: &dyn Brdf,
+    cfg: &ExtractConfig,
+    anisotropic: bool,
+    solver: &dyn Solver,
+) -> Result<Extraction, FitError> {
+    let nphi = if anisotropic {
+        cfg.phi_resolution.max(1)
+    } else {
+        1
     };
+    let problem = build_problem(src, cfg, anisotropic)?;
     let eigen = solver.iterate(&problem, cfg.stopping)?;
     if !(eigen.lambda > 0.0 && eigen.lambda.is_finite()) || eigen.v.iter().any(|x| !x.is_finite()) {
         return Err(FitError::Extraction {

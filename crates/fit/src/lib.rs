@@ -22,7 +22,9 @@
 //! ([`nbrdf::NbrdfLibrary`]), analytic models ([`analytic::parse_analytic`]) and fits themselves
 //! ([`material::FittedMaterial`]). [`fit::fit_material`] runs the whole pipeline;
 //! [`extract`] holds the power iteration, [`tabulated`] the stretched tabulated NDF with its
-//! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid.
+//! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid, [`gpu`] the
+//! same extraction and Fresnel average as WGSL compute passes
+//! ([`fit::fit_material_on`] with [`fit::Backend::Gpu`]).
 
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

@@ -263,6 +263,54 @@ impl PowerIteration {
     }
 }
 
+impl PowerIteration {
+    /// Milliseconds of one kernel–vector product (GPU timestamps, median of `reps` passes);
+    /// `None` when the adapter has no timestamp queries.
+    pub fn time_kernel(&self, gpu: &Gpu, p: &Problem, reps: u32) -> Result<Option<f64>, GpuError> {
+        let d = &gpu.device;
+        let Some(mut timer) = facet_gpu::timer::GpuTimer::new(d, &gpu.queue, reps) else {
+            return Ok(None);
+        };
+        let n = p.dirs.len();
+        let nodes: Vec<GpuNode> = (0..n)
+            .map(|j| GpuNode {
+                x: p.dirs[j][0] as f32,
+                y: p.dirs[j][1] as f32,
+                z: p.dirs[j][2] as f32,
+                row_scale: p.row[j] as f32,
+                col_weight: p.col[j] as f32,
+                norm_weight: p.norm[j] as f32,
+                ..Default::default()
+            })
+            .collect();
+        let (nb, vb, yb) = gpu.scoped(|| {
+            (
+                buffer::storage(d, "nodes", &nodes),
+                buffer::storage(d, "v", &vec![1.0f32; n]),
+                buffer::storage_zeroed(d, "y", (n * 4) as u64),
+            )
+        })?;
+        let bg = self.kernel_bind_group(gpu, p.isotropic, &nb, &nb, &vb, &yb);
+        let (x, y) = dispatch_size(n, self.kernel_wg);
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("time kernel"),
+        });
+        for _ in 0..reps {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("kernel"),
+                timestamp_writes: timer.pass(),
+            });
+            pass.set_pipeline(self.kernel(p.isotropic));
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let mut ms = timer.read_ms(d, &gpu.queue)?;
+        ms.sort_by(f64::total_cmp);
+        Ok(ms.get(ms.len() / 2).copied())
+    }
+}
+
 impl Solver for GpuFitter<'_> {
     fn iterate(&self, p: &Problem, stopping: Stopping) -> Result<Eigen, FitError> {
         self.power
