@@ -58,25 +58,16 @@ fn product(q: Node, count: u32, lid: u32, isotropic: bool) -> f32 {
     return q.row_scale * acc;
 }
 
-@compute @workgroup_size(WG)
-fn kernel_isotropic(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>,
-                    @builtin(num_workgroups) nwg: vec3<u32>) {
-    let q = gid.x + gid.y * nwg.x * WG;
-    let nq = arrayLength(&queries);
-    let node = queries[min(q, nq - 1u)];
-    let r = product(node, arrayLength(&nodes), lid.x, true);
-    if (q < nq) {
-        y[q] = r;
-    }
-}
+// Isotropic (closed-form azimuth) or anisotropic kernel: one pipeline per value.
+override ISOTROPIC: bool = true;
 
 @compute @workgroup_size(WG)
-fn kernel_anisotropic(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>,
-                      @builtin(num_workgroups) nwg: vec3<u32>) {
+fn kernel(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>,
+          @builtin(num_workgroups) nwg: vec3<u32>) {
     let q = gid.x + gid.y * nwg.x * WG;
     let nq = arrayLength(&queries);
     let node = queries[min(q, nq - 1u)];
-    let r = product(node, arrayLength(&nodes), lid.x, false);
+    let r = product(node, arrayLength(&nodes), lid.x, ISOTROPIC);
     if (q < nq) {
         y[q] = r;
     }

@@ -101,8 +101,12 @@ const ISO_TABLE_G: usize = 512;
 /// ∫₀^{2π} max(0, cos θo cos θh + sin θo sin θh cos φ) dφ, in closed form:
 /// 2πa if a ≥ b, 0 if a ≤ −b, else 2(a φ₀ + b sin φ₀) with φ₀ = acos(−a/b).
 pub fn azimuthal_integral(theta_o: f64, theta_h: f64) -> f64 {
-    let a = theta_o.cos() * theta_h.cos();
-    let b = theta_o.sin() * theta_h.sin();
+    azimuthal_ab(theta_o.cos() * theta_h.cos(), theta_o.sin() * theta_h.sin())
+}
+
+/// ∫₀^{2π} max(0, a + b cos φ) dφ for b ≥ 0.
+#[inline]
+fn azimuthal_ab(a: f64, b: f64) -> f64 {
     if a >= b {
         2.0 * PI * a
     } else if a <= -b {
@@ -165,16 +169,7 @@ impl Problem {
 /// [`azimuthal_integral`] from directions at φ = 0 (θ from their z and length in xy).
 #[inline]
 fn azimuthal(q: &[f64; 3], h: &[f64; 3]) -> f64 {
-    let a = q[2] * h[2];
-    let b = q[0].hypot(q[1]) * h[0].hypot(h[1]);
-    if a >= b {
-        2.0 * PI * a
-    } else if a <= -b {
-        0.0
-    } else {
-        let c = -a / b;
-        2.0 * (a * c.acos() + b * (1.0 - c * c).sqrt())
-    }
+    azimuthal_ab(q[2] * h[2], q[0].hypot(q[1]) * h[0].hypot(h[1]))
 }
 
 /// Result of the power iteration.

@@ -7,7 +7,7 @@
 //! ```no_run
 //! let gpu = facet_gpu::Gpu::new()?; // honours FACET_BACKEND and FACET_ADAPTER
 //! println!("{}", gpu.describe());
-//! let pipeline = facet_gpu::shader::compute_pipeline(&gpu.device, "fit/kernel.wgsl", "kernel_isotropic", &[])?;
+//! let pipeline = facet_gpu::shader::compute_pipeline(&gpu.device, "fit/kernel.wgsl", "kernel", &[("ISOTROPIC", 1.0)])?;
 //! # Ok::<(), facet_gpu::GpuError>(())
 //! ```
 

@@ -25,6 +25,21 @@ pub struct PowerIteration {
     rescale_wg: u32,
 }
 
+/// The problem's nodes in the GPU layout.
+fn gpu_nodes(p: &Problem) -> Vec<GpuNode> {
+    (0..p.dirs.len())
+        .map(|j| GpuNode {
+            x: p.dirs[j][0] as f32,
+            y: p.dirs[j][1] as f32,
+            z: p.dirs[j][2] as f32,
+            row_scale: p.row[j] as f32,
+            col_weight: p.col[j] as f32,
+            norm_weight: p.norm[j] as f32,
+            ..Default::default()
+        })
+        .collect()
+}
+
 /// `@workgroup_size` x of an entry point, as naga reads it.
 fn workgroup_size(file: &str, entry: &str) -> Result<u32, GpuError> {
     let module = shader::validate(file, &shader::expand(file)?)?;
@@ -51,11 +66,11 @@ impl PowerIteration {
         let k = "fit/kernel.wgsl";
         let n = "fit/normalise.wgsl";
         Ok(PowerIteration {
-            kernel_iso: shader::compute_pipeline(device, k, "kernel_isotropic", &[])?,
-            kernel_aniso: shader::compute_pipeline(device, k, "kernel_anisotropic", &[])?,
+            kernel_iso: shader::compute_pipeline(device, k, "kernel", &[("ISOTROPIC", 1.0)])?,
+            kernel_aniso: shader::compute_pipeline(device, k, "kernel", &[("ISOTROPIC", 0.0)])?,
             reduce: shader::compute_pipeline(device, n, "reduce", &[])?,
             rescale: shader::compute_pipeline(device, n, "rescale", &[])?,
-            kernel_wg: workgroup_size(k, "kernel_isotropic")?,
+            kernel_wg: workgroup_size(k, "kernel")?,
             rescale_wg: workgroup_size(n, "rescale")?,
         })
     }
@@ -104,17 +119,7 @@ impl PowerIteration {
 
     fn run(&self, gpu: &Gpu, p: &Problem, stopping: Stopping) -> Result<Eigen, GpuError> {
         let n = p.dirs.len();
-        let nodes: Vec<GpuNode> = (0..n)
-            .map(|j| GpuNode {
-                x: p.dirs[j][0] as f32,
-                y: p.dirs[j][1] as f32,
-                z: p.dirs[j][2] as f32,
-                row_scale: p.row[j] as f32,
-                col_weight: p.col[j] as f32,
-                norm_weight: p.norm[j] as f32,
-                ..Default::default()
-            })
-            .collect();
+        let nodes = gpu_nodes(p);
         buffer::check_binding(
             &gpu.device,
             "the quadrature nodes",
@@ -272,17 +277,7 @@ impl PowerIteration {
             return Ok(None);
         };
         let n = p.dirs.len();
-        let nodes: Vec<GpuNode> = (0..n)
-            .map(|j| GpuNode {
-                x: p.dirs[j][0] as f32,
-                y: p.dirs[j][1] as f32,
-                z: p.dirs[j][2] as f32,
-                row_scale: p.row[j] as f32,
-                col_weight: p.col[j] as f32,
-                norm_weight: p.norm[j] as f32,
-                ..Default::default()
-            })
-            .collect();
+        let nodes = gpu_nodes(p);
         let (nb, vb, yb) = gpu.scoped(|| {
             (
                 buffer::storage(d, "nodes", &nodes),
