@@ -152,3 +152,33 @@ fn without_an_adapter_gpu_tests_skip_or_fail_as_asked() {
     let (ok, text) = run(true);
     assert!(!ok && text.contains("FACET_REQUIRE_GPU=1"), "{text}");
 }
+
+#[test]
+fn a_gpu_failure_falls_back_to_the_cpu_and_says_so() {
+    let Some(_) = gpu_for_tests("a_gpu_failure_falls_back_to_the_cpu_and_says_so") else {
+        return;
+    };
+    // A device whose storage bindings are capped at 1 MiB cannot hold the MERL grid samples.
+    let mut opts = facet_gpu::GpuOptions::from_env().unwrap();
+    opts.max_storage_binding = Some(1 << 20);
+    let gpu = facet_gpu::Gpu::with_options(&opts).unwrap();
+    let fitter = GpuFitter::new(&gpu).unwrap();
+    let src = merl_from_spec("ggx?alpha=0.2&f0=0.04");
+    let mut cfg = FitConfig::isotropic();
+    cfg.models.beckmann = false;
+    let fell_back = fit_material_on(&src, "gpu", &cfg, Backend::Gpu(&fitter))
+        .unwrap()
+        .record;
+    let cpu = fit_material_on(&src, "cpu", &cfg, Backend::Cpu)
+        .unwrap()
+        .record;
+    println!("backend: {}", fell_back.backend);
+    assert!(
+        fell_back.backend.starts_with("cpu (fallback") && fell_back.backend.contains("bytes"),
+        "{}",
+        fell_back.backend
+    );
+    // The answer is the CPU's, exactly.
+    assert_eq!(fell_back.tabulated.tables, cpu.tabulated.tables);
+    assert_eq!(fell_back.ggx.unwrap().alpha_x, cpu.ggx.unwrap().alpha_x);
+}

@@ -16,6 +16,8 @@ pub struct GpuOptions {
     pub backends: Option<wgpu::Backends>,
     /// Only adapters whose name contains this (case-insensitive).
     pub adapter_name: Option<String>,
+    /// Cap on the storage binding size requested (default: all the adapter allows).
+    pub max_storage_binding: Option<u64>,
 }
 
 impl GpuOptions {
@@ -47,6 +49,7 @@ impl GpuOptions {
         Ok(GpuOptions {
             backends,
             adapter_name,
+            max_storage_binding: None,
         })
     }
 }
@@ -108,10 +111,15 @@ impl Gpu {
         })?;
         let info = adapter.get_info();
         let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let mut limits = adapter.limits();
+        if let Some(cap) = opts.max_storage_binding {
+            limits.max_storage_buffer_binding_size =
+                limits.max_storage_buffer_binding_size.min(cap);
+        }
         let desc = wgpu::DeviceDescriptor {
             label: Some("facet"),
             required_features: features,
-            required_limits: adapter.limits(),
+            required_limits: limits,
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
             trace: wgpu::Trace::Off,
