@@ -1,0 +1,210 @@
+//! The Directional Probability Function of the filterable glint model (Wang, Wang, Poulin,
+//! Holzschuch 2018): P(ωi, ωo, γ), the probability that one flake, its normal m drawn from
+//! p(m) = D(m) cos θm, reflects ωi into the cone of half-angle γ around ωo.
+//!
+//! Computed by integrating over the cone, not by summing 1° cells (which overestimates P(γ) by
+//! 7–24 %): with h(ω) = normalize(ωi + ω) and dω_h = dω / (4 ωi·h),
+//!   P = ∫_{ω ∈ cone(ωo, γ)} D(h) cos θh / (4 ωi·h) dω,
+//! Gauss–Legendre in the cone's polar angle ψ (weight sin ψ) × midpoint in its azimuth χ.
+
+use facet_fit::microfacet::Ndf;
+use facet_fit::quadrature::gauss_legendre;
+use glam::DVec3;
+use rayon::prelude::*;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// The nine cone half-angles of the pyramid, in degrees.
+pub const LEVELS_DEG: [f64; 9] = [1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0];
+
+/// σ(γ) = 2π(1 − cos γ): the solid angle of a cone of half-angle γ.
+pub fn cone_solid_angle(gamma: f64) -> f64 {
+    2.0 * PI * (1.0 - gamma.cos())
+}
+
+/// P(ωi, ωo, γ) by quadrature over the cone; `wi`, `wo` unit vectors, z up.
+pub fn dpf(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64) -> f64 {
+    let deg = gamma.to_degrees();
+    // Nodes grow with the cone so that a peaked NDF (α ≈ 0.05) is resolved at any γ.
+    let (n_psi, n_chi) = (12 + (deg * 0.75) as usize, 24 + (deg * 1.5) as usize);
+    let (t, b) = frame(wo);
+    let mut sum = 0.0;
+    for (x, w) in gauss_legendre(n_psi) {
+        let psi = x * gamma;
+        let (sp, cp) = psi.sin_cos();
+        let mut ring = 0.0;
+        for k in 0..n_chi {
+            let chi = (k as f64 + 0.5) / n_chi as f64 * 2.0 * PI;
+            let w_dir = cp * wo + sp * (chi.cos() * t + chi.sin() * b);
+            ring += flake_density(ndf, wi, w_dir);
+        }
+        sum += w * gamma * sp * ring * 2.0 * PI / n_chi as f64;
+    }
+    sum
+}
+
+/// p(h) / (4 ωi·h) at h = normalize(ωi + ω): the density over reflected directions ω.
+fn flake_density(ndf: &Ndf, wi: DVec3, w: DVec3) -> f64 {
+    let s = wi + w;
+    let len = s.length();
+    if len < 1e-12 {
+        return 0.0;
+    }
+    let h = s / len;
+    let cos_ih = wi.dot(h);
+    if h.z <= 0.0 || cos_ih <= 0.0 {
+        return 0.0;
+    }
+    ndf.d(h) * h.z / (4.0 * cos_ih)
+}
+
+/// An orthonormal pair perpendicular to `n`.
+fn frame(n: DVec3) -> (DVec3, DVec3) {
+    let a = if n.x.abs() < 0.9 { DVec3::X } else { DVec3::Y };
+    let t = a.cross(n).normalize();
+    (t, n.cross(t))
+}
+
+/// Table resolution: cells over θo, θi ∈ [0°, 90°] and Δφ ∈ [0°, 180°].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct DpfConfig {
+    pub n_theta: usize,
+    pub n_dphi: usize,
+}
+
+impl DpfConfig {
+    /// 2.8° × 2.8° × 2.8° cells.
+    pub const fn standard() -> Self {
+        DpfConfig {
+            n_theta: 32,
+            n_dphi: 64,
+        }
+    }
+
+    /// Small tables for tests and previews.
+    pub const fn preview() -> Self {
+        DpfConfig {
+            n_theta: 12,
+            n_dphi: 24,
+        }
+    }
+}
+
+/// P at one γ on a regular (θo, θi, Δφ) grid. Cell k covers [k, k + 1) · step and its value is
+/// taken at the cell centre (k + ½) · step; lookups interpolate trilinearly between centres
+/// (clamped at the edges). Δφ = φo − φi folded to [0°, 180°]; 180° is the mirror configuration.
+#[derive(Clone, Debug)]
+pub struct DpfTable {
+    pub gamma: f64,
+    pub config: DpfConfig,
+    /// Index (θo, θi, Δφ) → values[(o · n_theta + i) · n_dphi + p].
+    pub values: Vec<f32>,
+}
+
+/// Directions of a table query: ωi at azimuth 0, ωo at azimuth Δφ.
+pub fn query_directions(theta_o: f64, theta_i: f64, dphi: f64) -> (DVec3, DVec3) {
+    let wi = DVec3::new(theta_i.sin(), 0.0, theta_i.cos());
+    let wo = DVec3::new(
+        theta_o.sin() * dphi.cos(),
+        theta_o.sin() * dphi.sin(),
+        theta_o.cos(),
+    );
+    (wi, wo)
+}
+
+impl DpfTable {
+    /// The CPU reference build, cell centres in parallel.
+    pub fn build(ndf: &Ndf, gamma: f64, config: DpfConfig) -> Self {
+        let (nt, np) = (config.n_theta, config.n_dphi);
+        let values = (0..nt * nt * np)
+            .into_par_iter()
+            .map(|c| {
+                let (o, i, p) = (c / (nt * np), c / np % nt, c % np);
+                let (theta_o, theta_i, dphi) = Self::cell_centre(config, o, i, p);
+                let (wi, wo) = query_directions(theta_o, theta_i, dphi);
+                dpf(ndf, wi, wo, gamma) as f32
+            })
+            .collect();
+        DpfTable {
+            gamma,
+            config,
+            values,
+        }
+    }
+
+    /// (θo, θi, Δφ) of cell (o, i, p), radians.
+    pub fn cell_centre(config: DpfConfig, o: usize, i: usize, p: usize) -> (f64, f64, f64) {
+        let st = FRAC_PI_2 / config.n_theta as f64;
+        let sp = PI / config.n_dphi as f64;
+        (
+            (o as f64 + 0.5) * st,
+            (i as f64 + 0.5) * st,
+            (p as f64 + 0.5) * sp,
+        )
+    }
+
+    /// Trilinear lookup between cell centres.
+    pub fn lookup(&self, theta_o: f64, theta_i: f64, dphi: f64) -> f64 {
+        let (nt, np) = (self.config.n_theta, self.config.n_dphi);
+        let st = FRAC_PI_2 / nt as f64;
+        let sp = PI / np as f64;
+        let fold = {
+            let d = dphi.rem_euclid(2.0 * PI);
+            if d > PI { 2.0 * PI - d } else { d }
+        };
+        // Continuous index with centres at integers: x = value / step − ½.
+        let axis = |v: f64, step: f64, n: usize| {
+            let x = (v / step - 0.5).clamp(0.0, (n - 1) as f64);
+            let k = (x as usize).min(n.saturating_sub(2));
+            (k, (k + 1).min(n - 1), x - k as f64)
+        };
+        let (o0, o1, to) = axis(theta_o, st, nt);
+        let (i0, i1, ti) = axis(theta_i, st, nt);
+        let (p0, p1, tp) = axis(fold, sp, np);
+        let at = |o: usize, i: usize, p: usize| self.values[(o * nt + i) * np + p] as f64;
+        let lerp = |a: f64, b: f64, t: f64| a + t * (b - a);
+        let plane = |o: usize| {
+            lerp(
+                lerp(at(o, i0, p0), at(o, i0, p1), tp),
+                lerp(at(o, i1, p0), at(o, i1, p1), tp),
+                ti,
+            )
+        };
+        lerp(plane(o0), plane(o1), to)
+    }
+}
+
+/// The nine levels, γ ∈ [`LEVELS_DEG`]; any γ between levels interpolates P/σ(γ) (the mean
+/// density over the cone, smooth in γ) linearly and multiplies by σ(γ).
+#[derive(Clone, Debug)]
+pub struct DpfPyramid {
+    pub levels: Vec<DpfTable>,
+}
+
+impl DpfPyramid {
+    pub fn build(ndf: &Ndf, config: DpfConfig) -> Self {
+        DpfPyramid {
+            levels: LEVELS_DEG
+                .iter()
+                .map(|g| DpfTable::build(ndf, g.to_radians(), config))
+                .collect(),
+        }
+    }
+
+    /// P(θo, θi, Δφ, γ); γ below 1° scales the 1° level by σ(γ)/σ(1°), above 90° clamps.
+    pub fn lookup(&self, theta_o: f64, theta_i: f64, dphi: f64, gamma: f64) -> f64 {
+        let g = gamma.to_degrees().clamp(0.0, 90.0);
+        let density = |k: usize| {
+            self.levels[k].lookup(theta_o, theta_i, dphi) / cone_solid_angle(self.levels[k].gamma)
+        };
+        let k = LEVELS_DEG.partition_point(|&l| l <= g);
+        let mean = if k == 0 {
+            density(0)
+        } else if k == LEVELS_DEG.len() {
+            density(LEVELS_DEG.len() - 1)
+        } else {
+            let t = (g - LEVELS_DEG[k - 1]) / (LEVELS_DEG[k] - LEVELS_DEG[k - 1]);
+            density(k - 1) * (1.0 - t) + density(k) * t
+        };
+        mean * cone_solid_angle(gamma.clamp(0.0, FRAC_PI_2))
+    }
+}

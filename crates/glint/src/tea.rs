@@ -1,0 +1,77 @@
+//! The Tiny Encryption Algorithm (Wheeler and Needham 1994) as a hash: 8 rounds over the pair
+//! (v0, v1) with Facet's fixed key, the per-flake random numbers of the filterable glint model
+//! (Wang et al. 2018). The WGSL twin is `shaders/glint/tea.inc.wgsl`; tests check both against
+//! known answers.
+
+/// The key k0..k3.
+pub const KEY: [u32; 4] = [0xA341_316C, 0xC801_3EA4, 0xAD90_777D, 0x7E95_761E];
+/// TEA's round constant δ.
+pub const DELTA: u32 = 0x9e37_79b9;
+pub const ROUNDS: u32 = 8;
+
+/// The override constants of `shaders/glint/tea.inc.wgsl`.
+pub fn pipeline_constants() -> [(&'static str, f64); 6] {
+    [
+        ("TEA_K0", KEY[0] as f64),
+        ("TEA_K1", KEY[1] as f64),
+        ("TEA_K2", KEY[2] as f64),
+        ("TEA_K3", KEY[3] as f64),
+        ("TEA_DELTA", DELTA as f64),
+        ("TEA_ROUNDS", ROUNDS as f64),
+    ]
+}
+
+/// The 64-bit hash (v1 << 32) + v0 after 8 rounds.
+pub fn tea(mut v0: u32, mut v1: u32) -> u64 {
+    let mut sum = 0u32;
+    for _ in 0..ROUNDS {
+        sum = sum.wrapping_add(DELTA);
+        // v0 += ((v1 << 4) + k0) ^ (v1 + sum) ^ ((v1 >> 5) + k1), and symmetrically for v1.
+        v0 = v0.wrapping_add(
+            (v1 << 4).wrapping_add(KEY[0]) ^ v1.wrapping_add(sum) ^ (v1 >> 5).wrapping_add(KEY[1]),
+        );
+        v1 = v1.wrapping_add(
+            (v0 << 4).wrapping_add(KEY[2]) ^ v0.wrapping_add(sum) ^ (v0 >> 5).wrapping_add(KEY[3]),
+        );
+    }
+    ((v1 as u64) << 32) | v0 as u64
+}
+
+/// A uniform number in [0, 1): the top 23 bits of the hash's low word as the mantissa of a
+/// float in [1, 2), minus 1.
+pub fn tea_unit(v0: u32, v1: u32) -> f32 {
+    let low = tea(v0, v1) as u32;
+    f32::from_bits(0x3f80_0000 | (low >> 9)) - 1.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_answers() {
+        assert_eq!(tea(0, 0), 0x18e6_9c3c_fbc8_40dd);
+        assert_eq!(tea(1, 2), 0x7a45_99fc_d5fe_6546);
+        assert_eq!(tea(12345, 678), 0x6955_6b69_8924_22ac);
+        let u = tea_unit(0, 0);
+        assert_eq!(u, f32::from_bits(0x3f80_0000 | (0xfbc8_40dd >> 9)) - 1.0);
+        assert!((0.0..1.0).contains(&u));
+    }
+
+    #[test]
+    fn uniform_numbers_are_uniform() {
+        // Mean 1/2 and variance 1/12 within 5σ of their sampling error over 10⁵ keys.
+        let n = 100_000;
+        let xs: Vec<f64> = (0..n).map(|k| tea_unit(k, 7) as f64).collect();
+        let mean = xs.iter().sum::<f64>() / n as f64;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n as f64;
+        assert!(
+            (mean - 0.5).abs() < 5.0 * (1.0f64 / 12.0 / n as f64).sqrt(),
+            "mean {mean}"
+        );
+        assert!(
+            (var - 1.0 / 12.0).abs() < 5.0 * (1.0f64 / 180.0 / n as f64).sqrt(),
+            "variance {var}"
+        );
+    }
+}
