@@ -159,3 +159,60 @@ fn tea_in_wgsl_matches_rust() {
         0x6955_6b69_8924_22ac
     );
 }
+
+#[test]
+fn gpu_pyramid_matches_the_cpu_reference() {
+    let Some(gpu) = gpu_for_tests("gpu_pyramid_matches_the_cpu_reference") else {
+        return;
+    };
+    let cfg = DpfConfig::preview();
+    let fit = facet_fit::fit::fit_material(
+        &common::merl_from_spec("ggx?alpha=0.25&f0=0.04"),
+        "test",
+        &facet_fit::fit::FitConfig::isotropic(),
+    )
+    .unwrap();
+    let tabulated = fit.tabulated.ndf.clone();
+    for (name, ndf, tol) in [
+        ("beckmann 0.1", beckmann(0.1), 1e-4),
+        (
+            "GGX 0.3",
+            Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Ggx, 0.3)),
+            1e-4,
+        ),
+        ("tabulated fit", tabulated, 2e-3),
+    ] {
+        let g = facet_glint::gpu::build_pyramid(&gpu, &ndf, cfg).unwrap();
+        let c = DpfPyramid::build(&ndf, cfg);
+        // Relative difference over cells above 1 % of the level's peak whose cone stays above
+        // the horizon (θo + γ ≤ 85°), and absolute (in units of the peak) everywhere. Where the
+        // cone crosses the horizon the integrand is cut there, and a quadrature node on the cut
+        // can flip between f32 and f64: a difference of the rule's own error, not of the GPU.
+        let (mut rel, mut abs) = (0.0f64, 0.0f64);
+        for (lg, lc) in g.pyramid.levels.iter().zip(&c.levels) {
+            let peak = lc.values.iter().cloned().fold(0.0f32, f32::max) as f64;
+            for (k, (a, b)) in lg.values.iter().zip(&lc.values).enumerate() {
+                let (a, b) = (*a as f64, *b as f64);
+                abs = abs.max((a - b).abs() / peak);
+                let (to, _, _) = DpfTable::cell_centre(cfg, k / (cfg.n_theta * cfg.n_dphi), 0, 0);
+                if b > 1e-2 * peak && (to + lc.gamma).to_degrees() <= 85.0 {
+                    rel = rel.max((a / b - 1.0).abs());
+                }
+            }
+        }
+        println!(
+            "{name}: GPU vs CPU: relative {rel:.2e} (cone above the horizon, above 1 % of the peak), absolute {abs:.2e} of the peak"
+        );
+        // f32 sums of ≤ 10⁴ terms: ~1e-5; the tabulated NDF is resampled for the GPU (1024 u nodes).
+        assert!(rel < tol && abs < 1e-2, "{name}: {rel} {abs}");
+        assert_eq!(g.textures.len(), 9);
+        assert_eq!(
+            g.textures[0].size(),
+            wgpu::Extent3d {
+                width: cfg.n_dphi as u32,
+                height: cfg.n_theta as u32,
+                depth_or_array_layers: cfg.n_theta as u32
+            }
+        );
+    }
+}

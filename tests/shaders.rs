@@ -80,3 +80,22 @@ fn shared_structs_match_naga_layouts() {
         );
     }
 }
+
+#[test]
+fn dpf_params_match_naga() {
+    use facet_glint::gpu::DpfParams;
+    let (size, members) = layout("glint/dpf_build.wgsl", "Params");
+    assert_eq!(size as usize, size_of::<DpfParams>());
+    for (name, off) in [
+        ("n_theta", offset_of!(DpfParams, n_theta)),
+        ("gamma", offset_of!(DpfParams, gamma)),
+        ("ndf_kind", offset_of!(DpfParams, ndf_kind)),
+        ("rotation", offset_of!(DpfParams, rotation)),
+        ("table_nphi", offset_of!(DpfParams, table_nphi)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Params.{name}: {members:?}"
+        );
+    }
+}

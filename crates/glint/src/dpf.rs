@@ -21,11 +21,16 @@ pub fn cone_solid_angle(gamma: f64) -> f64 {
     2.0 * PI * (1.0 - gamma.cos())
 }
 
+/// Quadrature nodes (ψ, χ) of a cone of half-angle γ, shared by the CPU and the GPU: they grow
+/// with the cone so that a peaked NDF (α ≈ 0.05) is resolved at any γ.
+pub fn cone_rule(gamma: f64) -> (usize, usize) {
+    let deg = gamma.to_degrees();
+    (12 + (deg * 0.75) as usize, 24 + (deg * 1.5) as usize)
+}
+
 /// P(ωi, ωo, γ) by quadrature over the cone; `wi`, `wo` unit vectors, z up.
 pub fn dpf(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64) -> f64 {
-    let deg = gamma.to_degrees();
-    // Nodes grow with the cone so that a peaked NDF (α ≈ 0.05) is resolved at any γ.
-    let (n_psi, n_chi) = (12 + (deg * 0.75) as usize, 24 + (deg * 1.5) as usize);
+    let (n_psi, n_chi) = cone_rule(gamma);
     let (t, b) = frame(wo);
     let mut sum = 0.0;
     for (x, w) in gauss_legendre(n_psi) {

@@ -16,4 +16,5 @@
 //! ```
 
 pub mod dpf;
+pub mod gpu;
 pub mod tea;

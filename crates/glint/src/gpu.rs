@@ -1,0 +1,188 @@
+//! Host driver of `shaders/glint/dpf_build.wgsl`: the DPF levels built on the GPU and stored as
+//! one 3D texture per level (R32Float, x = Δφ, y = θi, z = θo, values at cell centres).
+
+use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG, cone_rule};
+use bytemuck::{Pod, Zeroable};
+use facet_fit::geometry::spherical;
+use facet_fit::microfacet::Ndf;
+use facet_fit::quadrature::gauss_legendre;
+use facet_gpu::{Gpu, GpuError, buffer, shader};
+
+/// Uniforms of the build (WGSL `Params`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DpfParams {
+    pub n_theta: u32,
+    pub n_dphi: u32,
+    pub n_psi: u32,
+    pub n_chi: u32,
+    pub gamma: f32,
+    /// 0 GGX, 1 Beckmann, 2 table.
+    pub ndf_kind: u32,
+    pub alpha_x: f32,
+    pub alpha_y: f32,
+    pub rotation: f32,
+    pub table_nu: u32,
+    pub table_nphi: u32,
+    pub pad0: u32,
+}
+
+/// Resolution of the NDF table for tabulated (or stretched) NDFs on the GPU.
+const NDF_TABLE_NU: usize = 1024;
+
+/// The NDF as the shader takes it: analytic parameters, or D sampled on a (u, φ) grid.
+fn ndf_upload(ndf: &Ndf) -> (DpfParams, Vec<f32>) {
+    match ndf {
+        Ndf::Analytic(a) => {
+            let kind = match a.kind {
+                facet_fit::microfacet::NdfKind::Ggx => 0,
+                facet_fit::microfacet::NdfKind::Beckmann => 1,
+            };
+            let p = DpfParams {
+                ndf_kind: kind,
+                alpha_x: a.alpha_x as f32,
+                alpha_y: a.alpha_y as f32,
+                rotation: a.rotation as f32,
+                table_nu: 2,
+                table_nphi: 1,
+                ..Default::default()
+            };
+            (p, vec![0.0])
+        }
+        Ndf::Tabulated(t) => {
+            let nphi = if t.is_isotropic() { 1 } else { 128 };
+            let table = (0..NDF_TABLE_NU * nphi)
+                .map(|kl| {
+                    let u = (kl / nphi) as f64 / (NDF_TABLE_NU - 1) as f64;
+                    let phi = (kl % nphi) as f64 / nphi as f64 * 2.0 * std::f64::consts::PI;
+                    t.d(spherical(u * u * std::f64::consts::FRAC_PI_2, phi)) as f32
+                })
+                .collect();
+            let p = DpfParams {
+                ndf_kind: 2,
+                table_nu: NDF_TABLE_NU as u32,
+                table_nphi: nphi as u32,
+                alpha_x: 1.0,
+                alpha_y: 1.0,
+                ..Default::default()
+            };
+            (p, table)
+        }
+    }
+}
+
+/// The pyramid built on the GPU: the tables (read back) and one 3D texture per level.
+pub struct GpuDpf {
+    pub pyramid: DpfPyramid,
+    pub textures: Vec<wgpu::Texture>,
+}
+
+/// Builds the nine levels on the GPU.
+pub fn build_pyramid(gpu: &Gpu, ndf: &Ndf, config: DpfConfig) -> Result<GpuDpf, GpuError> {
+    let d = &gpu.device;
+    let pipeline = shader::compute_pipeline(d, "glint/dpf_build.wgsl", "dpf_build", &[])?;
+    let (base, table) = ndf_upload(ndf);
+    let cells = config.n_theta * config.n_theta * config.n_dphi;
+    let table_buf = gpu.scoped(|| buffer::storage(d, "ndf table", &table))?;
+    let mut levels = Vec::new();
+    let mut textures = Vec::new();
+    for &deg in &LEVELS_DEG {
+        let gamma = deg.to_radians();
+        let (n_psi, n_chi) = cone_rule(gamma);
+        let nodes: Vec<[f32; 2]> = gauss_legendre(n_psi)
+            .into_iter()
+            .map(|(x, w)| [x as f32, w as f32])
+            .collect();
+        let params = DpfParams {
+            n_theta: config.n_theta as u32,
+            n_dphi: config.n_dphi as u32,
+            n_psi: n_psi as u32,
+            n_chi: n_chi as u32,
+            gamma: gamma as f32,
+            ..base
+        };
+        let (pb, gb, ob) = gpu.scoped(|| {
+            (
+                buffer::uniform(d, "dpf params", &params),
+                buffer::storage(d, "gauss-legendre", &nodes),
+                buffer::storage_zeroed(d, "dpf level", (cells * 4) as u64),
+            )
+        })?;
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dpf build"),
+            layout: &pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: pb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: gb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: table_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: ob.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("dpf build"),
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("dpf build"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            let groups = (cells as u32).div_ceil(64);
+            let x = groups.min(65_535);
+            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let values: Vec<f32> = buffer::read(d, &gpu.queue, &ob, cells)?;
+        gpu.check_lost()?;
+        let size = wgpu::Extent3d {
+            width: config.n_dphi as u32,
+            height: config.n_theta as u32,
+            depth_or_array_layers: config.n_theta as u32,
+        };
+        let texture = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("dpf level"),
+            size,
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        gpu.queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(&values),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * config.n_dphi as u32),
+                rows_per_image: Some(config.n_theta as u32),
+            },
+            size,
+        );
+        textures.push(texture);
+        levels.push(DpfTable {
+            gamma,
+            config,
+            values,
+        });
+    }
+    Ok(GpuDpf {
+        pyramid: DpfPyramid { levels },
+        textures,
+    })
+}
