@@ -172,7 +172,7 @@ impl FitArgs {
 }
 
 /// The neural proxy file: `--nbrdf`, else `FACET_NBRDF`, else the shared data beside the checkout.
-fn nbrdf_path(arg: &Option<PathBuf>) -> PathBuf {
+pub fn nbrdf_path(arg: &Option<PathBuf>) -> PathBuf {
     if let Some(p) = arg {
         return p.clone();
     }

@@ -1,5 +1,6 @@
 //! `facet`: measured materials to microfacet models.
 
+mod dpf_cmd;
 mod fit_cmd;
 
 use clap::{Parser, Subcommand};
@@ -8,7 +9,7 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "facet",
     version,
-    about = "Measured materials to microfacet models: NDF extraction and fitting"
+    about = "Measured materials to microfacet models: NDF extraction, fitting, glint DPF tables"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -19,12 +20,15 @@ struct Cli {
 enum Command {
     /// Extract the NDF of each input and fit tabulated, GGX and Beckmann models.
     Fit(fit_cmd::FitArgs),
+    /// The glint model's Directional Probability Function: one query, or the tables as EXR.
+    Dpf(dpf_cmd::DpfArgs),
 }
 
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Fit(args)) => fit_cmd::run(&args),
+        Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         None => fit_cmd::run_default(),
     };
     match result {

@@ -112,3 +112,65 @@ fn bad_inputs_fail_cleanly_and_the_rest_still_run() {
     let (ok, _, stderr) = facet(&["fit", "analytic:ggx?alpha=0.2", "--resolution", "1"]);
     assert!(!ok && stderr.contains("--resolution"), "{stderr}");
 }
+
+#[test]
+fn dpf_query_and_exr_slices() {
+    let (ok, stdout, stderr) = facet(&[
+        "dpf",
+        "--ndf",
+        "analytic:beckmann?alpha=0.1",
+        "--gamma",
+        "6",
+        "--theta-o",
+        "20",
+        "--theta-i",
+        "25",
+        "--dphi",
+        "170",
+        "--json",
+        "--resolution",
+        "preview",
+    ]);
+    assert!(ok, "{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let (p, direct) = (v["p"].as_f64().unwrap(), v["p_direct"].as_f64().unwrap());
+    // Preview cells are 7.5°: the trilinear table value stays within 25 % of the integral here.
+    assert!(
+        p > 0.0 && (p / direct - 1.0).abs() < 0.25,
+        "table {p}, direct {direct}"
+    );
+    assert_eq!(v["levels_deg"], serde_json::json!([5.0, 10.0]));
+
+    let dir = common::scratch("cli_dpf");
+    let (ok, stdout, stderr) = facet(&[
+        "dpf",
+        "--ndf",
+        "analytic:ggx?alpha=0.3",
+        "--write",
+        dir.to_str().unwrap(),
+        "--resolution",
+        "preview",
+    ]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("wrote 9 levels"), "{stdout}");
+    for g in [1, 2, 5, 10, 20, 30, 45, 60, 90] {
+        let path = dir.join(format!("dpf-gamma{g:02}.exr"));
+        let image = exr::prelude::read_first_rgba_layer_from_file(
+            &path,
+            |res, _| vec![0f32; res.width() * res.height()],
+            |px: &mut Vec<f32>, pos, (r, _, _, _): (f32, f32, f32, f32)| {
+                px[pos.y() * 12 * 24 + pos.x()] = r
+            },
+        )
+        .unwrap();
+        let px = &image.layer_data.channel_data.pixels;
+        assert_eq!(px.len(), 12 * 24 * 12);
+        assert!(
+            px.iter().all(|v| v.is_finite() && *v >= 0.0) && px.iter().any(|v| *v > 0.0),
+            "{}",
+            path.display()
+        );
+    }
+    let (ok, _, stderr) = facet(&["dpf", "--ndf", "analytic:ggx?alpha=0.3", "--gamma", "5"]);
+    assert!(!ok && stderr.contains("--theta-o"), "{stderr}");
+}

@@ -179,37 +179,60 @@ impl DpfTable {
 }
 
 /// The nine levels, γ ∈ [`LEVELS_DEG`]; any γ between levels interpolates P/σ(γ) (the mean
-/// density over the cone, smooth in γ) linearly and multiplies by σ(γ).
+/// density over the cone, smooth in γ) linearly and multiplies by σ(γ). A pyramid may hold
+/// only some levels ([`DpfPyramid::levels_for`] says which a γ needs).
 #[derive(Clone, Debug)]
 pub struct DpfPyramid {
-    pub levels: Vec<DpfTable>,
+    pub levels: Vec<Option<DpfTable>>,
 }
 
 impl DpfPyramid {
+    /// All nine levels (CPU reference).
     pub fn build(ndf: &Ndf, config: DpfConfig) -> Self {
-        DpfPyramid {
-            levels: LEVELS_DEG
-                .iter()
-                .map(|g| DpfTable::build(ndf, g.to_radians(), config))
-                .collect(),
+        Self::build_levels(ndf, config, &[0, 1, 2, 3, 4, 5, 6, 7, 8])
+    }
+
+    /// Only the levels listed (indices into [`LEVELS_DEG`]).
+    pub fn build_levels(ndf: &Ndf, config: DpfConfig, which: &[usize]) -> Self {
+        let levels = (0..LEVELS_DEG.len())
+            .map(|k| {
+                which
+                    .contains(&k)
+                    .then(|| DpfTable::build(ndf, LEVELS_DEG[k].to_radians(), config))
+            })
+            .collect();
+        DpfPyramid { levels }
+    }
+
+    /// The levels a lookup at γ reads, and the weight of the second.
+    pub fn levels_for(gamma: f64) -> ([usize; 2], f64) {
+        let g = gamma.to_degrees().clamp(0.0, 90.0);
+        let k = LEVELS_DEG.partition_point(|&l| l <= g);
+        if k == 0 {
+            ([0, 0], 0.0)
+        } else if k == LEVELS_DEG.len() {
+            ([k - 1, k - 1], 0.0)
+        } else {
+            (
+                [k - 1, k],
+                (g - LEVELS_DEG[k - 1]) / (LEVELS_DEG[k] - LEVELS_DEG[k - 1]),
+            )
         }
     }
 
     /// P(θo, θi, Δφ, γ); γ below 1° scales the 1° level by σ(γ)/σ(1°), above 90° clamps.
     pub fn lookup(&self, theta_o: f64, theta_i: f64, dphi: f64, gamma: f64) -> f64 {
-        let g = gamma.to_degrees().clamp(0.0, 90.0);
         let density = |k: usize| {
-            self.levels[k].lookup(theta_o, theta_i, dphi) / cone_solid_angle(self.levels[k].gamma)
+            let t = self.levels[k].as_ref().unwrap_or_else(|| {
+                panic!(
+                    "level {}° was not built: build it with DpfPyramid::build_levels",
+                    LEVELS_DEG[k]
+                )
+            });
+            t.lookup(theta_o, theta_i, dphi) / cone_solid_angle(t.gamma)
         };
-        let k = LEVELS_DEG.partition_point(|&l| l <= g);
-        let mean = if k == 0 {
-            density(0)
-        } else if k == LEVELS_DEG.len() {
-            density(LEVELS_DEG.len() - 1)
-        } else {
-            let t = (g - LEVELS_DEG[k - 1]) / (LEVELS_DEG[k] - LEVELS_DEG[k - 1]);
-            density(k - 1) * (1.0 - t) + density(k) * t
-        };
+        let ([k0, k1], t) = Self::levels_for(gamma);
+        let mean = density(k0) * (1.0 - t) + if t > 0.0 { density(k1) * t } else { 0.0 };
         mean * cone_solid_angle(gamma.clamp(0.0, FRAC_PI_2))
     }
 }

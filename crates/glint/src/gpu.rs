@@ -79,14 +79,28 @@ pub struct GpuDpf {
 
 /// Builds the nine levels on the GPU.
 pub fn build_pyramid(gpu: &Gpu, ndf: &Ndf, config: DpfConfig) -> Result<GpuDpf, GpuError> {
+    build_levels(gpu, ndf, config, &[0, 1, 2, 3, 4, 5, 6, 7, 8])
+}
+
+/// Builds the listed levels (indices into [`LEVELS_DEG`]); `textures` holds them in order.
+pub fn build_levels(
+    gpu: &Gpu,
+    ndf: &Ndf,
+    config: DpfConfig,
+    which: &[usize],
+) -> Result<GpuDpf, GpuError> {
     let d = &gpu.device;
     let pipeline = shader::compute_pipeline(d, "glint/dpf_build.wgsl", "dpf_build", &[])?;
     let (base, table) = ndf_upload(ndf);
     let cells = config.n_theta * config.n_theta * config.n_dphi;
     let table_buf = gpu.scoped(|| buffer::storage(d, "ndf table", &table))?;
-    let mut levels = Vec::new();
+    let mut levels = vec![None; LEVELS_DEG.len()];
     let mut textures = Vec::new();
-    for &deg in &LEVELS_DEG {
+    for (k, &deg) in LEVELS_DEG
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| which.contains(k))
+    {
         let gamma = deg.to_radians();
         let (n_psi, n_chi) = cone_rule(gamma);
         let nodes: Vec<[f32; 2]> = gauss_legendre(n_psi)
@@ -175,7 +189,7 @@ pub fn build_pyramid(gpu: &Gpu, ndf: &Ndf, config: DpfConfig) -> Result<GpuDpf, 
             size,
         );
         textures.push(texture);
-        levels.push(DpfTable {
+        levels[k] = Some(DpfTable {
             gamma,
             config,
             values,
