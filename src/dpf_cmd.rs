@@ -111,11 +111,12 @@ pub fn run(args: &DpfArgs) -> Result<ExitCode> {
             "give --gamma, --theta-o, --theta-i and --dphi (degrees) for a query, or --write DIR"
         );
     };
-    if !(0.0..=90.0).contains(&to)
-        || !(0.0..=90.0).contains(&ti)
-        || !(g > 0.0 && g <= 90.0)
-        || !dp.is_finite()
-    {
+    let in_range = (0.0..=90.0).contains(&to)
+        && (0.0..=90.0).contains(&ti)
+        && g > 0.0
+        && g <= 90.0
+        && dp.is_finite();
+    if !in_range {
         bail!("angles out of range: θo, θi in [0, 90], γ in (0, 90], Δφ finite");
     }
     let (levels, _) = DpfPyramid::levels_for(g.to_radians());
