@@ -236,3 +236,59 @@ impl DpfPyramid {
         mean * cone_solid_angle(gamma.clamp(0.0, FRAC_PI_2))
     }
 }
+
+impl DpfPyramid {
+    /// The levels the way the paper builds them: the finest (1°) level blurred over ωo with a
+    /// Gaussian of standard deviation γ/2 (the per-axis spread of a cone of half-angle γ), in
+    /// the table's (θo, Δφ) cells (an arc of Δφ is sin θo · Δφ on the sphere), normalised and
+    /// scaled by σ(γ)/σ(1°). For comparison with the exact levels; needs level 0.
+    pub fn blurred_from_finest(&self) -> DpfPyramid {
+        let fine = self.levels[0]
+            .as_ref()
+            .expect("level 1° is needed: build it with DpfPyramid::build_levels");
+        let cfg = fine.config;
+        let (nt, np) = (cfg.n_theta, cfg.n_dphi);
+        let (st, sp) = (FRAC_PI_2 / nt as f64, PI / np as f64);
+        let levels = LEVELS_DEG
+            .iter()
+            .enumerate()
+            .map(|(k, &deg)| {
+                let gamma = deg.to_radians();
+                if k == 0 {
+                    return Some(fine.clone());
+                }
+                let sigma = gamma / 2.0;
+                let scale = cone_solid_angle(gamma) / cone_solid_angle(fine.gamma);
+                let values = (0..nt * nt * np)
+                    .into_par_iter()
+                    .map(|c| {
+                        let (o, i, p) = (c / (nt * np), c / np % nt, c % np);
+                        let theta_o = (o as f64 + 0.5) * st;
+                        let (mut sum, mut wsum) = (0.0, 0.0);
+                        for o2 in 0..nt {
+                            let t2 = (o2 as f64 + 0.5) * st;
+                            let dt = (t2 - theta_o) / sigma;
+                            if dt.abs() > 3.0 {
+                                continue;
+                            }
+                            let arc = (0.5 * (theta_o + t2)).sin().max(st);
+                            for p2 in 0..np {
+                                let dp = ((p2 as f64 - p as f64) * sp * arc) / sigma;
+                                let w = (-0.5 * (dt * dt + dp * dp)).exp();
+                                sum += w * fine.values[(o2 * nt + i) * np + p2] as f64;
+                                wsum += w;
+                            }
+                        }
+                        (sum / wsum * scale) as f32
+                    })
+                    .collect();
+                Some(DpfTable {
+                    gamma,
+                    config: cfg,
+                    values,
+                })
+            })
+            .collect();
+        DpfPyramid { levels }
+    }
+}
