@@ -16,5 +16,7 @@
 //! ```
 
 pub mod dpf;
+pub mod flakes;
+pub mod glint_brdf;
 pub mod gpu;
 pub mod tea;

@@ -1,0 +1,271 @@
+//! Flakes over texture space and their counting over a footprint (Jakob et al. 2014; Wang et
+//! al. 2018).
+//!
+//! The flakes of a material are a fixed procedural set over the UV torus [0, 1)²: the root of a
+//! quadtree holds Poisson(density) flakes, and every node splits its count among its four
+//! children by binomial draws keyed on the node itself, so any node's count is one
+//! deterministic number and nested footprints give nested counts. Leaves (≤ [`LEAF_FLAKES`]
+//! flakes) place their flakes uniformly, from TEA keyed on (leaf, k). Each flake's uniform λ is
+//! keyed on the flake and on the direction cell of the query (the half vector quantised to
+//! cells of size γ), never on the traversal: the flake is lit when λ < P(ωi, ωo, γ).
+
+use crate::tea::{tea, tea_unit};
+use glam::{DMat2, DVec2, DVec3};
+
+/// Leaves hold at most this many flakes.
+pub const LEAF_FLAKES: u64 = 8;
+/// Deepest level of the quadtree (2²⁰ cells per side).
+pub const MAX_DEPTH: u32 = 20;
+
+/// A procedural flake field.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlakeField {
+    /// Expected flakes per unit UV area.
+    pub density: f64,
+    /// Selects another, independent field.
+    pub seed: u32,
+}
+
+/// An ellipse in UV: points c + s·a + t·b with s² + t² ≤ 1 (a, b conjugate semi-axes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Footprint {
+    pub center: DVec2,
+    pub a: DVec2,
+    pub b: DVec2,
+}
+
+impl Footprint {
+    pub fn area(&self) -> f64 {
+        PI * (self.a.x * self.b.y - self.a.y * self.b.x).abs()
+    }
+
+    /// The same ellipse scaled about its centre.
+    pub fn scaled(&self, k: f64) -> Footprint {
+        Footprint {
+            a: self.a * k,
+            b: self.b * k,
+            ..*self
+        }
+    }
+
+    fn half_extent(&self) -> DVec2 {
+        DVec2::new(self.a.x.hypot(self.b.x), self.a.y.hypot(self.b.y))
+    }
+
+    /// The inverse of [a b], mapping offsets to (s, t).
+    fn inverse(&self) -> DMat2 {
+        DMat2::from_cols(self.a, self.b).inverse()
+    }
+}
+
+use std::f64::consts::PI;
+
+/// The direction cell of a query: the half vector in the azimuthal equidistant projection
+/// (θh cos φh, θh sin φh), where distances are at least the angles on the sphere, quantised to
+/// squares of side γ/√2. Moving the light by more than 2γ moves the half vector by about γ or
+/// more, which always changes the cell; a move below γ/4 changes it about one time in four.
+pub fn direction_cell(wi: DVec3, wo: DVec3, gamma: f64) -> (u32, u32) {
+    let h = (wi + wo).normalize();
+    let r = h.x.hypot(h.y);
+    let theta = h.z.clamp(-1.0, 1.0).acos();
+    let k = if r > 1e-12 { theta / r } else { 1.0 };
+    let side = gamma / std::f64::consts::SQRT_2;
+    let q = |x: f64| ((x * k / side).floor() as i64 + (1 << 24)) as u32;
+    (q(h.x), q(h.y))
+}
+
+/// A flake found by a query.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Flake {
+    /// Its identity: the same flake has the same id in every query.
+    pub id: u64,
+    pub uv: DVec2,
+}
+
+impl FlakeField {
+    fn node_hash(&self, level: u32, ix: u32, iy: u32) -> u64 {
+        tea(ix | (level << 21), iy ^ self.seed.wrapping_mul(0x9e37_79b9))
+    }
+
+    /// Flakes in the root (the whole torus).
+    fn root_count(&self) -> u64 {
+        poisson(self.density, tea_unit(0xffff_ffff, self.seed) as f64)
+    }
+
+    /// Counts of the four children (x-major: (0,0), (1,0), (0,1), (1,1)) of a node with n flakes.
+    fn split(&self, level: u32, ix: u32, iy: u32, n: u64) -> [u64; 4] {
+        let h = self.node_hash(level, ix, iy);
+        let u = |k: u32| tea_unit(h as u32, k ^ (h >> 32) as u32) as f64;
+        let left = binomial(n, u(0));
+        let (l0, r0) = (binomial(left, u(1)), binomial(n - left, u(2)));
+        [l0, r0, left - l0, n - left - r0]
+    }
+
+    /// Every flake inside the footprint (UVs wrap), found through the quadtree.
+    pub fn flakes_in(&self, fp: &Footprint) -> Vec<Flake> {
+        let mut out = Vec::new();
+        let ext = fp.half_extent();
+        // The ellipse's copies that reach into [0, 1)².
+        let lo = (fp.center - ext).floor();
+        let hi = (fp.center + ext).floor();
+        for sx in lo.x as i64..=hi.x as i64 {
+            for sy in lo.y as i64..=hi.y as i64 {
+                let shifted = Footprint {
+                    center: fp.center - DVec2::new(sx as f64, sy as f64),
+                    ..*fp
+                };
+                self.visit(
+                    &shifted,
+                    &shifted.inverse(),
+                    ext,
+                    0,
+                    0,
+                    0,
+                    self.root_count(),
+                    &mut out,
+                );
+            }
+        }
+        out
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn visit(
+        &self,
+        fp: &Footprint,
+        inv: &DMat2,
+        ext: DVec2,
+        level: u32,
+        ix: u32,
+        iy: u32,
+        n: u64,
+        out: &mut Vec<Flake>,
+    ) {
+        if n == 0 {
+            return;
+        }
+        let size = 1.0 / (1u64 << level) as f64;
+        let min = DVec2::new(ix as f64, iy as f64) * size;
+        let max = min + size;
+        if max.x < fp.center.x - ext.x
+            || min.x > fp.center.x + ext.x
+            || max.y < fp.center.y - ext.y
+            || min.y > fp.center.y + ext.y
+        {
+            return;
+        }
+        if n <= LEAF_FLAKES || level == MAX_DEPTH {
+            let h = self.node_hash(level, ix, iy);
+            for k in 0..n as u32 {
+                let id = tea(h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32 ^ k);
+                let uv = min
+                    + size
+                        * DVec2::new(tea_unit(id as u32, 1) as f64, tea_unit(id as u32, 2) as f64);
+                let st = *inv * (uv - fp.center);
+                if st.length_squared() <= 1.0 {
+                    out.push(Flake { id, uv });
+                }
+            }
+            return;
+        }
+        let c = self.split(level, ix, iy, n);
+        for (k, &m) in c.iter().enumerate() {
+            let (dx, dy) = ((k & 1) as u32, (k >> 1) as u32);
+            self.visit(fp, inv, ext, level + 1, 2 * ix + dx, 2 * iy + dy, m, out);
+        }
+    }
+}
+
+/// λ of a flake for a direction cell: uniform in [0, 1), hashed from the pair.
+pub fn flake_lambda(flake: &Flake, cell: (u32, u32)) -> f64 {
+    let c = tea(cell.0, cell.1);
+    tea_unit(
+        flake.id as u32 ^ c as u32,
+        (flake.id >> 32) as u32 ^ (c >> 32) as u32,
+    ) as f64
+}
+
+/// Inverse CDF of Poisson(mean) at u; a normal approximation above mean 500.
+pub fn poisson(mean: f64, u: f64) -> u64 {
+    if mean <= 0.0 {
+        return 0;
+    }
+    if mean > 500.0 {
+        return (mean + mean.sqrt() * normal_quantile(u) + 0.5).max(0.0) as u64;
+    }
+    let (mut k, mut p) = (0u64, (-mean).exp());
+    let mut cdf = p;
+    while cdf < u && k < 10_000 {
+        k += 1;
+        p *= mean / k as f64;
+        cdf += p;
+    }
+    k
+}
+
+/// Inverse CDF of Binomial(n, ½) at u; a normal approximation above n = 500.
+pub fn binomial(n: u64, u: f64) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    if n > 500 {
+        let x = n as f64 / 2.0 + (n as f64).sqrt() / 2.0 * normal_quantile(u) + 0.5;
+        return (x.max(0.0) as u64).min(n);
+    }
+    let (mut k, mut p) = (0u64, 0.5f64.powi(n as i32));
+    let mut cdf = p;
+    while cdf < u && k < n {
+        p *= (n - k) as f64 / (k + 1) as f64;
+        k += 1;
+        cdf += p;
+    }
+    k
+}
+
+/// The standard normal quantile (Acklam's rational approximation, |error| < 1.2e-9).
+fn normal_quantile(u: f64) -> f64 {
+    let p = u.clamp(1e-12, 1.0 - 1e-12);
+    const A: [f64; 6] = [
+        -3.969683028665376e1,
+        2.209460984245205e2,
+        -2.759285104469687e2,
+        1.383_577_518_672_69e2,
+        -3.066479806614716e1,
+        2.506628277459239,
+    ];
+    const B: [f64; 5] = [
+        -5.447609879822406e1,
+        1.615858368580409e2,
+        -1.556989798598866e2,
+        6.680131188771972e1,
+        -1.328068155288572e1,
+    ];
+    const C: [f64; 6] = [
+        -7.784894002430293e-3,
+        -3.223964580411365e-1,
+        -2.400758277161838,
+        -2.549732539343734,
+        4.374664141464968,
+        2.938163982698783,
+    ];
+    const D: [f64; 4] = [
+        7.784695709041462e-3,
+        3.224671290700398e-1,
+        2.445134137142996,
+        3.754408661907416,
+    ];
+    let tail = |q: f64| {
+        (((((C[0] * q + C[1]) * q + C[2]) * q + C[3]) * q + C[4]) * q + C[5])
+            / ((((D[0] * q + D[1]) * q + D[2]) * q + D[3]) * q + 1.0)
+    };
+    if p < 0.02425 {
+        tail((-2.0 * p.ln()).sqrt())
+    } else if p > 1.0 - 0.02425 {
+        -tail((-2.0 * (1.0 - p).ln()).sqrt())
+    } else {
+        let q = p - 0.5;
+        let r = q * q;
+        (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
+            / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    }
+}

@@ -1,0 +1,237 @@
+//! Statistics of flake counting against theory and against an explicit-flake reference.
+
+use facet_fit::fresnel::Fresnel;
+use facet_fit::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use facet_glint::dpf::dpf;
+use facet_glint::flakes::{Flake, FlakeField, Footprint, direction_cell, flake_lambda};
+use facet_glint::glint_brdf::{GlintConfig, glint_count, glint_eval};
+use facet_glint::tea::tea_unit;
+use glam::{DVec2, DVec3};
+use std::f64::consts::PI;
+
+const ALPHA: f64 = 0.2;
+
+fn ndf() -> Ndf {
+    Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Beckmann, ALPHA))
+}
+
+fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
+    facet_fit::geometry::spherical(theta_deg.to_radians(), phi_deg.to_radians())
+}
+
+/// Deterministic footprints: random centre, random orientation, semi-axes in [r/2, 3r/2].
+fn footprint(k: u32, r: f64) -> Footprint {
+    let u = |j: u32| tea_unit(k, 1000 + j) as f64;
+    let t = 2.0 * PI * u(0);
+    let (c, s) = (t.cos(), t.sin());
+    Footprint {
+        center: DVec2::new(u(1), u(2)),
+        a: DVec2::new(c, s) * r * (0.5 + u(3)),
+        b: DVec2::new(-s, c) * r * (0.5 + u(4)),
+    }
+}
+
+/// The reference: each flake gets an explicit normal m from p(m) = D(m) cos θm (Beckmann:
+/// tan²θ = −α² ln(1 − u), φ = 2πv), keyed on the flake, and is lit when ωi reflected about m
+/// falls within γ of ωo.
+fn explicit_lit(f: &Flake, wi: DVec3, wo: DVec3, gamma: f64) -> bool {
+    let (u, v) = (
+        tea_unit(f.id as u32, 77) as f64,
+        tea_unit((f.id >> 32) as u32, 78) as f64,
+    );
+    let tan2 = -ALPHA * ALPHA * (1.0 - u).ln();
+    let theta = tan2.sqrt().atan();
+    let m = facet_fit::geometry::spherical(theta, 2.0 * PI * v);
+    let r = 2.0 * wi.dot(m) * m - wi;
+    wi.dot(m) > 0.0 && r.dot(wo) >= gamma.cos()
+}
+
+#[test]
+fn counts_are_poisson_with_mean_n_a_p_like_explicit_flakes() {
+    let field = FlakeField {
+        density: 2.0e6,
+        seed: 3,
+    };
+    let cfg = GlintConfig {
+        gamma: 5f64.to_radians(),
+        threshold: 16.0,
+        filtered: false,
+    };
+    let (wi, wo) = (dir(20.0, 0.0), dir(25.0, 170.0));
+    let p = dpf(&ndf(), wi, wo, cfg.gamma);
+    let cell = direction_cell(wi, wo, cfg.gamma);
+    let (mut mean_sum, mut dev_model, mut dev_ref, mut sum_model, mut sum_ref) =
+        (0.0, 0.0, 0.0, 0.0, 0.0);
+    let n = 10_000;
+    for k in 0..n {
+        let fp = footprint(k, 0.006);
+        let mu = field.density * fp.area() * p;
+        let flakes = field.flakes_in(&fp);
+        let model = flakes.iter().filter(|f| flake_lambda(f, cell) < p).count() as f64;
+        let reference = flakes
+            .iter()
+            .filter(|f| explicit_lit(f, wi, wo, cfg.gamma))
+            .count() as f64;
+        assert_eq!(model, glint_count(&field, &fp, wi, wo, p, &cfg));
+        mean_sum += mu;
+        sum_model += model;
+        sum_ref += reference;
+        dev_model += (model - mu).powi(2);
+        dev_ref += (reference - mu).powi(2);
+    }
+    let sigma = mean_sum.sqrt(); // Poisson: the variance of the total is its mean
+    println!(
+        "P = {p:.4}; Σ N a P = {mean_sum:.0}; model Σ = {sum_model:.0}; explicit Σ = {sum_ref:.0}; 3σ = {:.0}",
+        3.0 * sigma
+    );
+    println!(
+        "variance / mean: model {:.3}, explicit {:.3}",
+        dev_model / mean_sum,
+        dev_ref / mean_sum
+    );
+    assert!((sum_model - mean_sum).abs() < 3.0 * sigma && (sum_ref - mean_sum).abs() < 3.0 * sigma);
+    assert!((dev_model / mean_sum - 1.0).abs() < 0.2 && (dev_ref / mean_sum - 1.0).abs() < 0.2);
+}
+
+#[test]
+fn nested_footprints_give_nested_counts() {
+    let field = FlakeField {
+        density: 1.0e6,
+        seed: 9,
+    };
+    let cfg = GlintConfig {
+        gamma: 2f64.to_radians(),
+        threshold: 16.0,
+        filtered: false,
+    };
+    let mut violations = 0;
+    for k in 0..10_000u32 {
+        let wi = dir(10.0 + 60.0 * tea_unit(k, 1) as f64, 0.0);
+        let wo = dir(
+            10.0 + 60.0 * tea_unit(k, 2) as f64,
+            360.0 * tea_unit(k, 3) as f64,
+        );
+        let p = 0.3 * tea_unit(k, 4) as f64;
+        let small = footprint(k, 0.003);
+        let big = small.scaled(1.0 + tea_unit(k, 5) as f64);
+        if glint_count(&field, &small, wi, wo, p, &cfg) > glint_count(&field, &big, wi, wo, p, &cfg)
+        {
+            violations += 1;
+        }
+    }
+    assert_eq!(violations, 0);
+}
+
+#[test]
+fn filtered_value_is_the_unfiltered_mean() {
+    let field = FlakeField {
+        density: 4.0e6,
+        seed: 5,
+    };
+    let (wi, wo) = (dir(35.0, 0.0), dir(30.0, 180.0));
+    let gamma = 10f64.to_radians();
+    let p = dpf(&ndf(), wi, wo, gamma);
+    let on = GlintConfig {
+        gamma,
+        threshold: 16.0,
+        filtered: true,
+    };
+    let off = GlintConfig {
+        filtered: false,
+        ..on
+    };
+    let (mut filtered, mut counted) = (0.0, 0.0);
+    for k in 0..2000 {
+        let fp = footprint(k, 0.004);
+        filtered += glint_count(&field, &fp, wi, wo, p, &on);
+        counted += glint_count(&field, &fp, wi, wo, p, &off);
+    }
+    println!(
+        "expected count per footprint {:.1}; filtered Σ {filtered:.0}, counted Σ {counted:.0}",
+        filtered / 2000.0
+    );
+    assert!(
+        filtered / 2000.0 > on.threshold,
+        "the filter must have taken over"
+    );
+    assert!((counted - filtered).abs() < 3.0 * filtered.sqrt());
+}
+
+#[test]
+fn large_footprints_converge_to_the_smooth_brdf() {
+    let model = MicrofacetBrdf {
+        name: "beckmann".into(),
+        ndf: ndf(),
+        fresnel: Fresnel::Schlick {
+            f0: [0.04, 0.5, 0.9],
+        },
+        diffuse: [0.0; 3],
+    };
+    let field = FlakeField {
+        density: 1.0e9,
+        seed: 1,
+    };
+    let cfg = GlintConfig::standard();
+    let fp = Footprint {
+        center: DVec2::splat(0.5),
+        a: DVec2::new(0.05, 0.0),
+        b: DVec2::new(0.0, 0.04),
+    };
+    for (wi, wo) in [
+        (dir(0.0, 0.0), dir(10.0, 90.0)),
+        (dir(30.0, 0.0), dir(30.0, 180.0)),
+        (dir(60.0, 0.0), dir(45.0, 160.0)),
+    ] {
+        let p = dpf(&model.ndf, wi, wo, cfg.gamma);
+        let glint = glint_eval(&model, &field, &fp, wi, wo, p, &cfg);
+        let smooth = facet_fit::brdf::Brdf::eval(&model, wi, wo).unwrap();
+        println!("glint {glint:.5?} smooth {smooth:.5?}");
+        assert!((0..3).all(|c| (glint[c] / smooth[c] - 1.0).abs() < 0.01));
+    }
+}
+
+#[test]
+fn moving_the_light_changes_which_flakes_are_lit() {
+    let field = FlakeField {
+        density: 4.0e6,
+        seed: 11,
+    };
+    let gamma = 2f64.to_radians();
+    let p = 0.05; // a fixed threshold: what changes is which flakes draw λ < P
+    let (mut kept_small, mut lit_small, mut overlap_big, mut chance_big) = (0.0, 0.0, 0.0, 0.0);
+    for k in 0..300u32 {
+        let fp = footprint(k, 0.004);
+        let flakes = field.flakes_in(&fp);
+        let wo = dir(30.0, 180.0);
+        let wi = dir(
+            20.0 + 20.0 * tea_unit(k, 1) as f64,
+            360.0 * tea_unit(k, 2) as f64 * 0.1,
+        );
+        let lit = |w: DVec3| -> Vec<u64> {
+            let cell = direction_cell(w, wo, gamma);
+            flakes
+                .iter()
+                .filter(|f| flake_lambda(f, cell) < p)
+                .map(|f| f.id)
+                .collect()
+        };
+        // Rotate the light about the view direction's plane: small (γ/5) and large (2.5γ).
+        let turn = |deg: f64| {
+            let axis = wi.cross(DVec3::Z).normalize();
+            glam::DQuat::from_axis_angle(axis, deg.to_radians()) * wi
+        };
+        let a = lit(wi);
+        let small = lit(turn(gamma.to_degrees() / 5.0));
+        let big = lit(turn(2.5 * gamma.to_degrees()));
+        kept_small += a.iter().filter(|id| small.contains(id)).count() as f64;
+        lit_small += a.len() as f64;
+        overlap_big += a.iter().filter(|id| big.contains(id)).count() as f64;
+        chance_big += a.len() as f64 * big.len() as f64 / flakes.len().max(1) as f64;
+    }
+    println!(
+        "small move keeps {:.2} of the lit flakes; large move overlap {overlap_big:.0} against {chance_big:.0} by chance",
+        kept_small / lit_small
+    );
+    assert!(kept_small / lit_small > 0.6);
+    assert!(overlap_big < chance_big + 3.0 * chance_big.sqrt());
+}
