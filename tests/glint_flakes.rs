@@ -235,3 +235,68 @@ fn moving_the_light_changes_which_flakes_are_lit() {
     assert!(kept_small / lit_small > 0.6);
     assert!(overlap_big < chance_big + 3.0 * chance_big.sqrt());
 }
+
+/// Sampling from the smooth lobe is unbiased for the glint BRDF: the Monte Carlo estimate of
+/// the directional albedo ∫ f cos θi dωi (filtered, huge density) equals the quadrature.
+#[test]
+fn sampling_estimates_the_albedo() {
+    use facet_glint::glint_brdf::{glint_pdf, glint_sample};
+    let model = MicrofacetBrdf {
+        name: "ggx".into(),
+        ndf: Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Ggx, 0.3)),
+        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
+        diffuse: [0.0; 3],
+    };
+    let field = FlakeField {
+        density: 1.0e10,
+        seed: 2,
+    };
+    let cfg = GlintConfig {
+        gamma: 1f64.to_radians(),
+        ..GlintConfig::standard()
+    };
+    let fp = Footprint {
+        center: DVec2::splat(0.5),
+        a: DVec2::new(0.05, 0.0),
+        b: DVec2::new(0.0, 0.05),
+    };
+    let wo = dir(40.0, 0.0);
+    let f = |wi: DVec3| {
+        glint_eval(
+            &model,
+            &field,
+            &fp,
+            wi,
+            wo,
+            dpf(&model.ndf, wi, wo, cfg.gamma),
+            &cfg,
+        )[0] * wi.z
+    };
+    // Quadrature over the hemisphere of ωi.
+    let (nt, np) = (120, 120);
+    let mut quad = 0.0;
+    for a in 0..nt {
+        let t = (a as f64 + 0.5) / nt as f64 * PI / 2.0;
+        for b in 0..np {
+            let wi = facet_fit::geometry::spherical(t, (b as f64 + 0.5) / np as f64 * 2.0 * PI);
+            quad += f(wi) * t.sin() * (PI / 2.0 / nt as f64) * (2.0 * PI / np as f64);
+        }
+    }
+    // Monte Carlo with the lobe's samples; the pdf integrates to at most 1.
+    let n = 4000;
+    let (mut mc, mut sq) = (0.0, 0.0);
+    for k in 0..n {
+        if let Some((wi, pdf)) =
+            glint_sample(&model, wo, [tea_unit(k, 1) as f64, tea_unit(k, 2) as f64])
+        {
+            assert!((pdf - glint_pdf(&model, wi, wo)).abs() <= 1e-12 * pdf);
+            let x = f(wi) / pdf;
+            mc += x;
+            sq += x * x;
+        }
+    }
+    let mean = mc / n as f64;
+    let sigma = ((sq / n as f64 - mean * mean) / n as f64).sqrt();
+    println!("albedo: quadrature {quad:.4}, sampled {mean:.4} ± {sigma:.4}");
+    assert!((mean - quad).abs() < 4.0 * sigma + 0.01 * quad);
+}

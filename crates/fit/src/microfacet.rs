@@ -80,6 +80,21 @@ impl AnalyticNdf {
         }
     }
 
+    /// Samples a normal with density D(h) cos θh over solid angle: a slope of the unit
+    /// distribution (GGX: tan θ = sqrt(u/(1 − u)); Beckmann: tan θ = sqrt(−ln(1 − u))),
+    /// stretched by (αx, αy) and rotated.
+    pub fn sample(&self, u: [f64; 2]) -> DVec3 {
+        let r = match self.kind {
+            NdfKind::Ggx => (u[0] / (1.0 - u[0]).max(1e-300)).sqrt(),
+            NdfKind::Beckmann => (-(1.0 - u[0]).max(1e-300).ln()).sqrt(),
+        };
+        let phi = 2.0 * PI * u[1];
+        let (sx, sy) = (r * phi.cos() * self.alpha_x, r * phi.sin() * self.alpha_y);
+        let h = DVec3::new(sx, sy, 1.0).normalize();
+        let (sn, c) = self.rotation.sin_cos();
+        DVec3::new(c * h.x - sn * h.y, sn * h.x + c * h.y, h.z)
+    }
+
     /// Smith Λ(w), exact for both families.
     pub fn lambda(&self, w: DVec3) -> f64 {
         let w = to_local(w, self.rotation);
@@ -147,6 +162,23 @@ impl Ndf {
             Ndf::Tabulated(t) => t.is_isotropic(),
         }
     }
+
+    /// Samples a microfacet normal; its density over solid angle is [`Ndf::pdf`].
+    pub fn sample(&self, u: [f64; 2]) -> DVec3 {
+        match self {
+            Ndf::Analytic(n) => n.sample(u),
+            Ndf::Tabulated(t) => t.sample(u),
+        }
+    }
+
+    /// The density of [`Ndf::sample`]: D(h) cos θh (analytic), the table's sampling density
+    /// (tabulated).
+    pub fn pdf(&self, h: DVec3) -> f64 {
+        match self {
+            Ndf::Analytic(n) => n.d(h) * h.z.max(0.0),
+            Ndf::Tabulated(t) => t.pdf(h),
+        }
+    }
 }
 
 /// λ(φ) = 4.41φ / (4.41φ + 1) of the height-direction-correlated Smith G2 (Ashikhmin et al.).
@@ -208,6 +240,41 @@ impl Brdf for MicrofacetBrdf {
 mod tests {
     use super::*;
     use crate::geometry::spherical;
+
+    /// Sampled slopes have the first absolute moments of the NDF along its own axes:
+    /// E|x~| = αx (GGX) or αx/√π (Beckmann), likewise for y.
+    #[test]
+    fn sampling_reproduces_slope_moments() {
+        for kind in NdfKind::ALL {
+            let ndf = AnalyticNdf {
+                kind,
+                alpha_x: 0.2,
+                alpha_y: 0.5,
+                rotation: 0.6,
+            };
+            let n = 200_000;
+            let (mut mx, mut my) = (0.0, 0.0);
+            for k in 0..n {
+                // A (0.5, golden-ratio) low-discrepancy sequence.
+                let u = [
+                    (k as f64 + 0.5) / n as f64,
+                    (k as f64 * 0.618_033_988_749_895).fract(),
+                ];
+                let h = to_local(ndf.sample(u), ndf.rotation);
+                mx += (h.x / h.z).abs();
+                my += (h.y / h.z).abs();
+            }
+            let c = match kind {
+                NdfKind::Ggx => 1.0,
+                NdfKind::Beckmann => 1.0 / PI.sqrt(),
+            };
+            let (ex, ey) = (mx / n as f64 / (0.2 * c), my / n as f64 / (0.5 * c));
+            assert!(
+                (ex - 1.0).abs() < 0.01 && (ey - 1.0).abs() < 0.01,
+                "{kind:?}: {ex} {ey}"
+            );
+        }
+    }
 
     /// ∫ D cos θ dω = 1 and ∫ <k,h>+ D dω = cos θk (1 + Λ(k)), by brute-force quadrature.
     #[test]

@@ -82,3 +82,25 @@ pub fn glint_eval(
         / wo.z;
     f.map(|c| c * scale)
 }
+
+/// Samples ωi for a given ωo from the smooth lobe (a normal from the NDF, ωo reflected about
+/// it); `None` below the horizon. The returned pdf is over solid angle of ωi:
+/// pdf_h(h) / (4 |ωo·h|).
+pub fn glint_sample(model: &MicrofacetBrdf, wo: DVec3, u: [f64; 2]) -> Option<(DVec3, f64)> {
+    let h = model.ndf.sample(u);
+    let cos = wo.dot(h);
+    if cos <= 0.0 {
+        return None;
+    }
+    let wi = 2.0 * cos * h - wo;
+    (wi.z > 0.0).then(|| (wi, glint_pdf(model, wi, wo)))
+}
+
+/// The density of [`glint_sample`] at ωi.
+pub fn glint_pdf(model: &MicrofacetBrdf, wi: DVec3, wo: DVec3) -> f64 {
+    if wi.z <= 0.0 || wo.z <= 0.0 {
+        return 0.0;
+    }
+    let h = (wi + wo).normalize();
+    model.ndf.pdf(h) / (4.0 * wo.dot(h).abs())
+}

@@ -1,0 +1,100 @@
+//! Glint benchmarks: DPF pyramid build (CPU and GPU) and its memory, and the cost of one
+//! glint query against footprint size, filter on and off.
+//!
+//! `cargo bench --bench glint`.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+use facet_glint::dpf::{DpfConfig, DpfPyramid, dpf};
+use facet_glint::flakes::{FlakeField, Footprint};
+use facet_glint::glint_brdf::{GlintConfig, glint_count};
+use glam::DVec2;
+use std::time::{Duration, Instant};
+
+fn ndf() -> Ndf {
+    Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Beckmann, 0.1))
+}
+
+fn pyramid(c: &mut Criterion) {
+    let mut g = c.benchmark_group("dpf_pyramid");
+    g.sample_size(10);
+    let cfg = DpfConfig::preview();
+    g.bench_function("cpu_preview_12x12x24", |b| {
+        b.iter(|| DpfPyramid::build(&ndf(), cfg))
+    });
+    g.finish();
+    for cfg in [DpfConfig::preview(), DpfConfig::standard()] {
+        let cells = cfg.n_theta * cfg.n_theta * cfg.n_dphi;
+        eprintln!(
+            "pyramid {}x{}x{}: {} cells per level, {:.2} MiB for nine f32 levels",
+            cfg.n_theta,
+            cfg.n_theta,
+            cfg.n_dphi,
+            cells,
+            (9 * cells * 4) as f64 / (1 << 20) as f64
+        );
+        match facet_gpu::Gpu::new() {
+            Ok(gpu) => {
+                let _ = facet_glint::gpu::build_levels(&gpu, &ndf(), cfg, &[0]).unwrap(); // pipeline warm-up
+                let t = Instant::now();
+                facet_glint::gpu::build_pyramid(&gpu, &ndf(), cfg).unwrap();
+                eprintln!(
+                    "  GPU build on {}: {:.0} ms",
+                    gpu.describe(),
+                    t.elapsed().as_secs_f64() * 1e3
+                );
+            }
+            Err(e) => eprintln!("  GPU build skipped: {e}"),
+        }
+        if cfg == DpfConfig::standard() {
+            let t = Instant::now();
+            DpfPyramid::build(&ndf(), cfg);
+            eprintln!("  CPU build: {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+}
+
+fn queries(c: &mut Criterion) {
+    let field = FlakeField {
+        density: 1.0e7,
+        seed: 1,
+    };
+    let (wi, wo) = (
+        facet_fit::geometry::spherical(0.4, 0.0),
+        facet_fit::geometry::spherical(0.45, 3.0),
+    );
+    let gamma = 1f64.to_radians();
+    let p = dpf(&ndf(), wi, wo, gamma);
+    let mut g = c.benchmark_group("glint_query");
+    for r in [1e-4, 1e-3, 1e-2] {
+        let fp = Footprint {
+            center: DVec2::splat(0.3),
+            a: DVec2::new(r, 0.0),
+            b: DVec2::new(0.0, r),
+        };
+        eprintln!(
+            "footprint radius {r}: {:.0} flakes, expected lit {:.2}",
+            field.density * fp.area(),
+            field.density * fp.area() * p
+        );
+        for filtered in [true, false] {
+            let cfg = GlintConfig {
+                gamma,
+                threshold: 16.0,
+                filtered,
+            };
+            let label = if filtered { "filtered" } else { "unfiltered" };
+            g.bench_function(format!("{label}/r{r}"), |b| {
+                b.iter(|| glint_count(&field, &fp, wi, wo, p, &cfg))
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
+    targets = pyramid, queries
+}
+criterion_main!(benches);
