@@ -300,3 +300,63 @@ fn sampling_estimates_the_albedo() {
     println!("albedo: quadrature {quad:.4}, sampled {mean:.4} ± {sigma:.4}");
     assert!((mean - quad).abs() < 4.0 * sigma + 0.01 * quad);
 }
+
+/// ≥ 10⁵ random queries counted on the GPU and on the CPU. Counts are integers computed from
+/// the same hashes; f32 against f64 can move a flake across the ellipse's edge, λ across P, or
+/// a large split across an integer (normal approximation): stated budget, at most 0.5 % of the
+/// queries may differ (by more than 1e-4 relative), by at most 2 flakes per flake counted.
+#[test]
+fn gpu_counts_match_cpu_counts() {
+    let Some(gpu) = facet_gpu::gpu_for_tests("gpu_counts_match_cpu_counts") else {
+        return;
+    };
+    use facet_glint::gpu::{GlintCounter, GlintQuery};
+    let counter = GlintCounter::new(&gpu.device).unwrap();
+    let field = FlakeField {
+        density: 3.0e5,
+        seed: 21,
+    };
+    let cfg = GlintConfig {
+        gamma: 2f64.to_radians(),
+        threshold: 16.0,
+        filtered: true,
+    };
+    let n = 100_000u32;
+    let mut qs = Vec::new();
+    let mut cpu = Vec::new();
+    for k in 0..n {
+        let fp = footprint(k, 0.002 + 0.01 * tea_unit(k, 9) as f64);
+        let wi = dir(70.0 * tea_unit(k, 10) as f64, 0.0);
+        let wo = dir(
+            70.0 * tea_unit(k, 11) as f64,
+            360.0 * tea_unit(k, 12) as f64,
+        );
+        let p = (0.2 * tea_unit(k, 13) as f64) as f32 as f64; // as the GPU sees it
+        let cell = direction_cell(wi, wo, cfg.gamma);
+        qs.push(GlintQuery::new(&fp, p, cell));
+        cpu.push(glint_count(&field, &fp, wi, wo, p, &cfg));
+    }
+    let g = counter.count(&gpu, &field, &cfg, &qs).unwrap();
+    let differ = g
+        .iter()
+        .zip(&cpu)
+        .filter(|(a, b)| (*a - *b).abs() > 1e-4 * b.max(1.0))
+        .count();
+    let worst = g
+        .iter()
+        .zip(&cpu)
+        .map(|(a, b)| (a - b).abs() / b.max(1.0))
+        .fold(0.0, f64::max);
+    let counted = cpu.iter().filter(|c| c.fract() == 0.0).count();
+    println!(
+        "{differ} of {n} queries differ ({counted} counted flake by flake, the rest filtered); worst relative difference {worst}"
+    );
+    assert!(
+        differ as f64 <= 0.005 * n as f64 && worst <= 2.0,
+        "{differ} differ, worst {worst}"
+    );
+    assert!(
+        counted > n as usize / 2,
+        "most queries must be counted, not filtered: {counted}"
+    );
+}

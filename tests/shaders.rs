@@ -99,3 +99,34 @@ fn dpf_params_match_naga() {
         );
     }
 }
+
+#[test]
+fn glint_structs_match_naga() {
+    use facet_glint::gpu::{GlintField, GlintQuery};
+    let (size, members) = layout("glint/glint_count.wgsl", "Field");
+    assert_eq!(size as usize, size_of::<GlintField>());
+    for (name, off) in [
+        ("density", offset_of!(GlintField, density)),
+        ("root_count", offset_of!(GlintField, root_count)),
+        ("threshold", offset_of!(GlintField, threshold)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Field.{name}: {members:?}"
+        );
+    }
+    let (size, members) = layout("glint/glint_count.wgsl", "Query");
+    assert_eq!(size as usize, size_of::<GlintQuery>());
+    for (name, off) in [
+        ("center", offset_of!(GlintQuery, center)),
+        ("a", offset_of!(GlintQuery, a)),
+        ("b", offset_of!(GlintQuery, b)),
+        ("p", offset_of!(GlintQuery, p)),
+        ("cell_x", offset_of!(GlintQuery, cell)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Query.{name}: {members:?}"
+        );
+    }
+}

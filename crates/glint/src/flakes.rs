@@ -16,6 +16,9 @@ use glam::{DMat2, DVec2, DVec3};
 pub const LEAF_FLAKES: u64 = 8;
 /// Deepest level of the quadtree (2²⁰ cells per side).
 pub const MAX_DEPTH: u32 = 20;
+/// Binomial splits of up to this many flakes are exact inverse CDFs (½ⁿ stays a normal f32);
+/// larger ones use the normal approximation.
+pub const BINOMIAL_EXACT_MAX: u64 = 100;
 
 /// A procedural flake field.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,7 +91,7 @@ impl FlakeField {
     }
 
     /// Flakes in the root (the whole torus).
-    fn root_count(&self) -> u64 {
+    pub fn root_count(&self) -> u64 {
         poisson(self.density, tea_unit(0xffff_ffff, self.seed) as f64)
     }
 
@@ -203,12 +206,12 @@ pub fn poisson(mean: f64, u: f64) -> u64 {
     k
 }
 
-/// Inverse CDF of Binomial(n, ½) at u; a normal approximation above n = 500.
+/// Inverse CDF of Binomial(n, ½) at u; the normal approximation above [`BINOMIAL_EXACT_MAX`].
 pub fn binomial(n: u64, u: f64) -> u64 {
     if n == 0 {
         return 0;
     }
-    if n > 500 {
+    if n > BINOMIAL_EXACT_MAX {
         let x = n as f64 / 2.0 + (n as f64).sqrt() / 2.0 * normal_quantile(u) + 0.5;
         return (x.max(0.0) as u64).min(n);
     }
@@ -222,8 +225,9 @@ pub fn binomial(n: u64, u: f64) -> u64 {
     k
 }
 
-/// The standard normal quantile (Acklam's rational approximation, |error| < 1.2e-9).
-fn normal_quantile(u: f64) -> f64 {
+/// The standard normal quantile (Acklam's rational approximation, |error| < 1.2e-9); the WGSL
+/// twin is in `shaders/glint/flakes.inc.wgsl`.
+pub fn normal_quantile(u: f64) -> f64 {
     let p = u.clamp(1e-12, 1.0 - 1e-12);
     const A: [f64; 6] = [
         -3.969683028665376e1,

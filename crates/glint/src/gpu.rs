@@ -200,3 +200,126 @@ pub fn build_levels(
         textures,
     })
 }
+
+/// The flake field as `shaders/glint/glint_count.wgsl` takes it (WGSL `Field`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GlintField {
+    pub density: f32,
+    pub seed: u32,
+    pub root_count: u32,
+    pub filtered: u32,
+    pub threshold: f32,
+    pub pad: [u32; 3],
+}
+
+/// One glint query (WGSL `Query`): the footprint, P, and the direction cell.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GlintQuery {
+    pub center: [f32; 2],
+    pub a: [f32; 2],
+    pub b: [f32; 2],
+    pub p: f32,
+    pub cell: [u32; 2],
+    pub pad: [u32; 3],
+}
+
+impl GlintQuery {
+    pub fn new(fp: &crate::flakes::Footprint, p: f64, cell: (u32, u32)) -> Self {
+        GlintQuery {
+            center: fp.center.as_vec2().to_array(),
+            a: fp.a.as_vec2().to_array(),
+            b: fp.b.as_vec2().to_array(),
+            p: p as f32,
+            cell: [cell.0, cell.1],
+            pad: [0; 3],
+        }
+    }
+}
+
+/// Host driver of `shaders/glint/glint_count.wgsl`.
+pub struct GlintCounter {
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl GlintCounter {
+    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
+        let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
+        constants.extend([
+            ("LEAF_FLAKES", LEAF_FLAKES as f64),
+            ("MAX_DEPTH", MAX_DEPTH as f64),
+            ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
+        ]);
+        Ok(GlintCounter {
+            pipeline: shader::compute_pipeline(
+                device,
+                "glint/glint_count.wgsl",
+                "glint_count",
+                &constants,
+            )?,
+        })
+    }
+
+    /// Counts (or filtered means) for each query.
+    pub fn count(
+        &self,
+        gpu: &Gpu,
+        field: &crate::flakes::FlakeField,
+        cfg: &crate::glint_brdf::GlintConfig,
+        queries: &[GlintQuery],
+    ) -> Result<Vec<f64>, GpuError> {
+        let d = &gpu.device;
+        let uniform = GlintField {
+            density: field.density as f32,
+            seed: field.seed,
+            root_count: field.root_count() as u32,
+            filtered: cfg.filtered as u32,
+            threshold: cfg.threshold as f32,
+            pad: [0; 3],
+        };
+        let (ub, qb, cb) = gpu.scoped(|| {
+            (
+                buffer::uniform(d, "glint field", &uniform),
+                buffer::storage(d, "glint queries", queries),
+                buffer::storage_zeroed(d, "glint counts", (queries.len() * 4) as u64),
+            )
+        })?;
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("glint count"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: ub.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: qb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: cb.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("glint count"),
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("glint count"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            let groups = (queries.len() as u32).div_ceil(64);
+            let x = groups.min(65_535);
+            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let out: Vec<f32> = buffer::read(d, &gpu.queue, &cb, queries.len())?;
+        Ok(out.into_iter().map(f64::from).collect())
+    }
+}

@@ -1,9 +1,11 @@
 //! # facet-glint: discrete stochastic microfacets with the filterable DPF
 //!
-//! Work in progress (issue 4): [`tea`] (the per-flake hash, Rust and WGSL) and [`dpf`] (the
-//! Directional Probability Function by cone integration, its tables with documented cell
-//! centres and the nine-level pyramid, CPU reference). The GPU table build, 3D textures, flake
-//! counting and the glint BRDF come next.
+//! [`tea`]: the per-flake hash (Rust and WGSL). [`dpf`]: the Directional Probability Function
+//! by cone integration, its tables (documented cell centres) and the nine-level pyramid, with
+//! the paper's Gaussian-blurred levels for comparison. [`flakes`]: the procedural flake field,
+//! its consistent quadtree and counting over footprints. [`glint_brdf`]: the glint BRDF with its
+//! filtered switch, sampling and pdf. [`gpu`]: the pyramid built on the GPU into 3D textures and
+//! glint counting in WGSL.
 //!
 //! ```
 //! use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
