@@ -140,3 +140,33 @@ fn glint_structs_match_naga() {
         );
     }
 }
+
+#[test]
+fn glint_eval_structs_match_naga() {
+    use facet_glint::gpu::{GlintEvalParams, GlintEvalQuery};
+    let (size, members) = layout("glint/glint_eval.wgsl", "EvalParams");
+    assert_eq!(size as usize, size_of::<GlintEvalParams>());
+    for (name, off) in [
+        ("sigma1", offset_of!(GlintEvalParams, sigma1)),
+        ("level_t", offset_of!(GlintEvalParams, level_t)),
+        ("ndf_kind", offset_of!(GlintEvalParams, ndf_kind)),
+        ("rotation", offset_of!(GlintEvalParams, rotation)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "EvalParams.{name}: {members:?}"
+        );
+    }
+    let (size, members) = layout("glint/glint_eval.wgsl", "EvalQuery");
+    assert_eq!(size as usize, size_of::<GlintEvalQuery>());
+    for (name, off) in [
+        ("wo", offset_of!(GlintEvalQuery, wo)),
+        ("center", offset_of!(GlintEvalQuery, center)),
+        ("b", offset_of!(GlintEvalQuery, b)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "EvalQuery.{name}: {members:?}"
+        );
+    }
+}

@@ -323,3 +323,198 @@ impl GlintCounter {
         Ok(out.into_iter().map(f64::from).collect())
     }
 }
+
+/// Uniforms of `shaders/glint/glint_eval.wgsl` (WGSL `EvalParams`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GlintEvalParams {
+    pub gamma: f32,
+    pub sigma: f32,
+    pub sigma0: f32,
+    pub sigma1: f32,
+    pub level_t: f32,
+    pub n_theta: u32,
+    pub n_dphi: u32,
+    /// 0 GGX, 1 Beckmann.
+    pub ndf_kind: u32,
+    pub alpha_x: f32,
+    pub alpha_y: f32,
+    pub rotation: f32,
+    pub pad0: u32,
+}
+
+/// One evaluation (WGSL `EvalQuery`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GlintEvalQuery {
+    pub wi: [f32; 4],
+    pub wo: [f32; 4],
+    pub center: [f32; 2],
+    pub a: [f32; 2],
+    pub b: [f32; 2],
+    pub pad: [f32; 2],
+}
+
+impl GlintEvalQuery {
+    pub fn new(wi: glam::DVec3, wo: glam::DVec3, fp: &crate::flakes::Footprint) -> Self {
+        GlintEvalQuery {
+            wi: wi.as_vec3().extend(0.0).to_array(),
+            wo: wo.as_vec3().extend(0.0).to_array(),
+            center: fp.center.as_vec2().to_array(),
+            a: fp.a.as_vec2().to_array(),
+            b: fp.b.as_vec2().to_array(),
+            pad: [0.0; 2],
+        }
+    }
+}
+
+/// Host driver of `shaders/glint/glint_eval.wgsl`: the glint BRDF of an analytic NDF with a
+/// Fresnel table, P from the pyramid's textures.
+pub struct GlintEvaluator {
+    pipeline: wgpu::ComputePipeline,
+}
+
+impl GlintEvaluator {
+    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
+        let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
+        constants.extend([
+            ("LEAF_FLAKES", LEAF_FLAKES as f64),
+            ("MAX_DEPTH", MAX_DEPTH as f64),
+            ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
+        ]);
+        Ok(GlintEvaluator {
+            pipeline: shader::compute_pipeline(
+                device,
+                "glint/glint_eval.wgsl",
+                "glint_eval",
+                &constants,
+            )?,
+        })
+    }
+
+    /// f(ωi, ωo) per query. `dpf` must hold the two levels bracketing `cfg.gamma`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn eval(
+        &self,
+        gpu: &Gpu,
+        field: &crate::flakes::FlakeField,
+        cfg: &crate::glint_brdf::GlintConfig,
+        ndf: &facet_fit::microfacet::AnalyticNdf,
+        fresnel: &facet_fit::fresnel::FresnelTable,
+        dpf: &GpuDpf,
+        queries: &[GlintEvalQuery],
+    ) -> Result<Vec<[f64; 3]>, GpuError> {
+        use crate::dpf::cone_solid_angle;
+        let d = &gpu.device;
+        let ([k0, k1], t) = DpfPyramid::levels_for(cfg.gamma);
+        let level = |k: usize| -> Result<(&DpfTable, &wgpu::Texture), GpuError> {
+            let built: Vec<usize> = (0..LEVELS_DEG.len())
+                .filter(|&j| dpf.pyramid.levels[j].is_some())
+                .collect();
+            let pos = built.iter().position(|&j| j == k).ok_or_else(|| {
+                GpuError::Validation(format!("DPF level {}° was not built", LEVELS_DEG[k]))
+            })?;
+            Ok((dpf.pyramid.levels[k].as_ref().unwrap(), &dpf.textures[pos]))
+        };
+        let ((l0, t0), (l1, t1)) = (level(k0)?, level(k1)?);
+        let params = GlintEvalParams {
+            gamma: cfg.gamma as f32,
+            sigma: cone_solid_angle(cfg.gamma) as f32,
+            sigma0: cone_solid_angle(l0.gamma) as f32,
+            sigma1: cone_solid_angle(l1.gamma) as f32,
+            level_t: t as f32,
+            n_theta: l0.config.n_theta as u32,
+            n_dphi: l0.config.n_dphi as u32,
+            ndf_kind: match ndf.kind {
+                facet_fit::microfacet::NdfKind::Ggx => 0,
+                facet_fit::microfacet::NdfKind::Beckmann => 1,
+            },
+            alpha_x: ndf.alpha_x as f32,
+            alpha_y: ndf.alpha_y as f32,
+            rotation: ndf.rotation as f32,
+            pad0: 0,
+        };
+        let uniform = GlintField {
+            density: field.density as f32,
+            seed: field.seed,
+            root_count: field.root_count() as u32,
+            filtered: cfg.filtered as u32,
+            threshold: cfg.threshold as f32,
+            pad: [0; 3],
+        };
+        let f: Vec<[f32; 4]> = fresnel
+            .rgb
+            .iter()
+            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, 0.0])
+            .collect();
+        let (fb, pb, frb, qb, ob) = gpu.scoped(|| {
+            (
+                buffer::uniform(d, "glint field", &uniform),
+                buffer::uniform(d, "glint eval params", &params),
+                buffer::storage(d, "fresnel", &f),
+                buffer::storage(d, "glint eval queries", queries),
+                buffer::storage_zeroed(d, "glint values", (queries.len() * 16) as u64),
+            )
+        })?;
+        let (v0, v1) = (
+            t0.create_view(&Default::default()),
+            t1.create_view(&Default::default()),
+        );
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("glint eval"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: fb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: pb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&v0),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&v1),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: frb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: qb.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: ob.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("glint eval"),
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("glint eval"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            let groups = (queries.len() as u32).div_ceil(64);
+            let x = groups.min(65_535);
+            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
+        }
+        gpu.queue.submit([enc.finish()]);
+        let out: Vec<[f32; 4]> = buffer::read(d, &gpu.queue, &ob, queries.len())?;
+        gpu.check_lost()?;
+        Ok(out
+            .into_iter()
+            .map(|v| [v[0] as f64, v[1] as f64, v[2] as f64])
+            .collect())
+    }
+}
