@@ -3,6 +3,8 @@
 // Gauss–Legendre in the cone's polar angle ψ (nodes from Rust) × midpoint in its azimuth χ,
 // the same rule as the CPU reference (facet_glint::dpf::dpf).
 
+#include "common/microfacet.inc.wgsl"
+
 const WG: u32 = 64u;
 const PI: f32 = 3.14159265358979;
 
@@ -52,20 +54,7 @@ fn ndf(h: vec3<f32>) -> f32 {
         let row1 = mix(ndf_table[(k + 1u) * np + l], ndf_table[(k + 1u) * np + l1], s);
         return mix(row0, row1, t);
     }
-    let c = cos(params.rotation);
-    let sn = sin(params.rotation);
-    let hl = vec3<f32>(c * h.x + sn * h.y, -sn * h.x + c * h.y, h.z);
-    let ax = params.alpha_x;
-    let ay = params.alpha_y;
-    let e = (hl.x / ax) * (hl.x / ax) + (hl.y / ay) * (hl.y / ay);
-    if (params.ndf_kind == 0u) {
-        // GGX: 1 / (π αx αy (hx²/αx² + hy²/αy² + hz²)²)
-        let q = e + hl.z * hl.z;
-        return 1.0 / (PI * ax * ay * q * q);
-    }
-    // Beckmann: exp(−(hx²/αx² + hy²/αy²)/hz²) / (π αx αy hz⁴)
-    let z2 = hl.z * hl.z;
-    return exp(-e / z2) / (PI * ax * ay * z2 * z2);
+    return ndf_d(AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation), h);
 }
 
 fn density(wi: vec3<f32>, w: vec3<f32>) -> f32 {

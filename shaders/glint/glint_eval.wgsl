@@ -3,6 +3,7 @@
 //   f = F G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo).
 
 #include "glint/tea.inc.wgsl"
+#include "common/microfacet.inc.wgsl"
 
 const WG: u32 = 64u;
 
@@ -74,32 +75,6 @@ fn azimuth(w: vec3<f32>) -> f32 {
     return atan2(w.y, w.x);
 }
 
-// erf by Abramowitz–Stegun 7.1.26 (|error| < 1.5e-7; the CPU uses libm's erf).
-fn erf_approx(x: f32) -> f32 {
-    let t = 1.0 / (1.0 + 0.3275911 * abs(x));
-    let y = 1.0 - (((((1.061405429 * t - 1.453152027) * t) + 1.421413741) * t - 0.284496736) * t + 0.254829592) * t * exp(-x * x);
-    return select(-y, y, x >= 0.0);
-}
-
-// Smith Λ: facet_fit::microfacet::AnalyticNdf::lambda.
-fn smith_lambda(w: vec3<f32>) -> f32 {
-    let c = cos(params.rotation);
-    let s = sin(params.rotation);
-    let l = vec3<f32>(c * w.x + s * w.y, -s * w.x + c * w.y, w.z);
-    let a2t2 = ((l.x * params.alpha_x) * (l.x * params.alpha_x) + (l.y * params.alpha_y) * (l.y * params.alpha_y)) / (l.z * l.z);
-    if (a2t2 <= 0.0) {
-        return 0.0;
-    }
-    if (params.ndf_kind == 0u) {
-        return 0.5 * (sqrt(1.0 + a2t2) - 1.0);
-    }
-    let a = 1.0 / sqrt(a2t2);
-    if (a > 6.0) {
-        return 0.0;
-    }
-    return 0.5 * (erf_approx(a) - 1.0) + exp(-a * a) / (2.0 * a * sqrt(PI_F));
-}
-
 // The direction cell: facet_glint::flakes::direction_cell.
 fn direction_cell(wi: vec3<f32>, wo: vec3<f32>) -> vec2<u32> {
     let h = normalize(wi + wo);
@@ -156,8 +131,9 @@ fn glint_eval(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
         phi = acos(clamp(dot(wi.xy, wo.xy) / (li * lo), -1.0, 1.0));
     }
     let corr = 4.41 * phi / (4.41 * phi + 1.0);
-    let lam_i = smith_lambda(wi);
-    let lam_o = smith_lambda(wo);
+    let ndf = AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation);
+    let lam_i = ndf_lambda(ndf, wi);
+    let lam_o = ndf_lambda(ndf, wo);
     let g2 = 1.0 / (1.0 + max(lam_i, lam_o) + corr * min(lam_i, lam_o));
     let theta_d = acos(clamp(dot(wi, h), 0.0, 1.0));
     let n = arrayLength(&fresnel);
