@@ -4,8 +4,8 @@
 //! by cone integration, its tables (documented cell centres) and the nine-level pyramid, with
 //! the paper's Gaussian-blurred levels for comparison. [`flakes`]: the procedural flake field,
 //! its consistent quadtree and counting over footprints. [`glint_brdf`]: the glint BRDF with its
-//! filtered switch, sampling and pdf. [`gpu`]: the pyramid built on the GPU into 3D textures and
-//! glint counting in WGSL.
+//! filtered switch, sampling and pdf. [`gpu`]: the pyramid built on the GPU into 3D textures,
+//! glint counting, evaluation and sampling in WGSL.
 //!
 //! ```
 //! use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
