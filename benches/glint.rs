@@ -91,7 +91,9 @@ fn queries(c: &mut Criterion) {
     }
     g.finish();
     // GPU evaluation throughput: 10⁵ queries per dispatch, upload and read-back included.
-    let Ok(gpu) = facet_gpu::Gpu::new() else { return };
+    let Ok(gpu) = facet_gpu::Gpu::new() else {
+        return;
+    };
     let model_ndf = AnalyticNdf::isotropic(NdfKind::Beckmann, 0.1);
     let levels = facet_glint::gpu::build_levels(&gpu, &ndf(), DpfConfig::preview(), &[0]).unwrap();
     let evaluator = facet_glint::gpu::GlintEvaluator::new(&gpu.device).unwrap();
@@ -99,18 +101,46 @@ fn queries(c: &mut Criterion) {
     for r in [1e-4, 1e-3, 1e-2] {
         let qs: Vec<_> = (0..100_000)
             .map(|k| {
-                let c = DVec2::new((k as f64 * 0.618_033_988_7).fract(), (k as f64 * 0.414_213_562_4).fract());
-                let fp = Footprint { center: c, a: DVec2::new(r, 0.0), b: DVec2::new(0.0, r) };
+                let c = DVec2::new(
+                    (k as f64 * 0.618_033_988_7).fract(),
+                    (k as f64 * 0.414_213_562_4).fract(),
+                );
+                let fp = Footprint {
+                    center: c,
+                    a: DVec2::new(r, 0.0),
+                    b: DVec2::new(0.0, r),
+                };
                 facet_glint::gpu::GlintEvalQuery::new(wi, wo, &fp)
             })
             .collect();
         for filtered in [true, false] {
-            let cfg = GlintConfig { gamma, threshold: 16.0, filtered };
-            let _ = evaluator.eval(&gpu, &field, &cfg, &model_ndf, &fresnel, &levels, &qs[..1000]).unwrap();
+            let cfg = GlintConfig {
+                gamma,
+                threshold: 16.0,
+                filtered,
+            };
+            let _ = evaluator
+                .eval(
+                    &gpu,
+                    &field,
+                    &cfg,
+                    &model_ndf,
+                    &fresnel,
+                    &levels,
+                    &qs[..1000],
+                )
+                .unwrap();
             let t = Instant::now();
-            evaluator.eval(&gpu, &field, &cfg, &model_ndf, &fresnel, &levels, &qs).unwrap();
+            evaluator
+                .eval(&gpu, &field, &cfg, &model_ndf, &fresnel, &levels, &qs)
+                .unwrap();
             let s = t.elapsed().as_secs_f64();
-            eprintln!("GPU glint eval ({}), radius {r}, filter {}: {:.2} M queries/s", gpu.describe(), if filtered { "on" } else { "off" }, 1e-1 / s);
+            eprintln!(
+                "GPU glint eval ({}), radius {r}, filter {}: {:.2} M queries/s",
+                gpu.describe(),
+                if filtered { "on" } else { "off" },
+                1e-1 / s
+            );
         }
     }
 }

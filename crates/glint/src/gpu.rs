@@ -408,6 +408,8 @@ impl GlintEvaluator {
         use crate::dpf::cone_solid_angle;
         let d = &gpu.device;
         let ([k0, k1], t) = DpfPyramid::levels_for(cfg.gamma);
+        // With no weight on the second level (γ on a level) only the first is needed.
+        let k1 = if t > 0.0 { k1 } else { k0 };
         let level = |k: usize| -> Result<(&DpfTable, &wgpu::Texture), GpuError> {
             let built: Vec<usize> = (0..LEVELS_DEG.len())
                 .filter(|&j| dpf.pyramid.levels[j].is_some())
