@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use facet_fit::geometry::spherical;
 use facet_fit::microfacet::Ndf;
 use facet_fit::quadrature::gauss_legendre;
-use facet_gpu::{Gpu, GpuError, buffer, shader};
+use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Uniforms of the build (WGSL `Params`).
 #[repr(C)]
@@ -91,6 +91,7 @@ pub fn build_levels(
 ) -> Result<GpuDpf, GpuError> {
     let d = &gpu.device;
     let pipeline = shader::compute_pipeline(d, "glint/dpf_build.wgsl", "dpf_build", &[])?;
+    let wg = shader::workgroup_size("glint/dpf_build.wgsl", "dpf_build")?;
     let (base, table) = ndf_upload(ndf);
     let cells = config.n_theta * config.n_theta * config.n_dphi;
     let table_buf = gpu.scoped(|| buffer::storage(d, "ndf table", &table))?;
@@ -122,43 +123,21 @@ pub fn build_levels(
                 buffer::storage_zeroed(d, "dpf level", (cells * 4) as u64),
             )
         })?;
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dpf build"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: pb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: gb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: table_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: ob.as_entire_binding(),
-                },
-            ],
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("dpf build"),
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("dpf build"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            let groups = (cells as u32).div_ceil(64);
-            let x = groups.min(65_535);
-            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
-        }
-        gpu.queue.submit([enc.finish()]);
+        let resources = [
+            pb.as_entire_binding(),
+            gb.as_entire_binding(),
+            table_buf.as_entire_binding(),
+            ob.as_entire_binding(),
+        ];
+        dispatch::run(
+            d,
+            &gpu.queue,
+            &pipeline,
+            "dpf build",
+            &resources,
+            cells as u32,
+            wg,
+        );
         let values: Vec<f32> = buffer::read(d, &gpu.queue, &ob, cells)?;
         gpu.check_lost()?;
         let size = wgpu::Extent3d {
@@ -238,20 +217,41 @@ impl GlintQuery {
     }
 }
 
+/// The override constants of the flake shaders (TEA and the quadtree), from Rust.
+fn flake_constants() -> Vec<(&'static str, f64)> {
+    use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
+    let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
+    constants.extend([
+        ("LEAF_FLAKES", LEAF_FLAKES as f64),
+        ("MAX_DEPTH", MAX_DEPTH as f64),
+        ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
+    ]);
+    constants
+}
+
+impl GlintField {
+    pub fn new(field: &crate::flakes::FlakeField, cfg: &crate::glint_brdf::GlintConfig) -> Self {
+        GlintField {
+            density: field.density as f32,
+            seed: field.seed,
+            root_count: field.root_count() as u32,
+            filtered: cfg.filtered as u32,
+            threshold: cfg.threshold as f32,
+            pad: [0; 3],
+        }
+    }
+}
+
 /// Host driver of `shaders/glint/glint_count.wgsl`.
 pub struct GlintCounter {
     pipeline: wgpu::ComputePipeline,
+    /// `@workgroup_size` of the shader, read by naga.
+    workgroup_size: u32,
 }
 
 impl GlintCounter {
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
-        use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
-        let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
-        constants.extend([
-            ("LEAF_FLAKES", LEAF_FLAKES as f64),
-            ("MAX_DEPTH", MAX_DEPTH as f64),
-            ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
-        ]);
+        let constants = flake_constants();
         Ok(GlintCounter {
             pipeline: shader::compute_pipeline(
                 device,
@@ -259,6 +259,7 @@ impl GlintCounter {
                 "glint_count",
                 &constants,
             )?,
+            workgroup_size: shader::workgroup_size("glint/glint_count.wgsl", "glint_count")?,
         })
     }
 
@@ -271,14 +272,7 @@ impl GlintCounter {
         queries: &[GlintQuery],
     ) -> Result<Vec<f64>, GpuError> {
         let d = &gpu.device;
-        let uniform = GlintField {
-            density: field.density as f32,
-            seed: field.seed,
-            root_count: field.root_count() as u32,
-            filtered: cfg.filtered as u32,
-            threshold: cfg.threshold as f32,
-            pad: [0; 3],
-        };
+        let uniform = GlintField::new(field, cfg);
         let (ub, qb, cb) = gpu.scoped(|| {
             (
                 buffer::uniform(d, "glint field", &uniform),
@@ -286,39 +280,20 @@ impl GlintCounter {
                 buffer::storage_zeroed(d, "glint counts", (queries.len() * 4) as u64),
             )
         })?;
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("glint count"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: ub.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: qb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: cb.as_entire_binding(),
-                },
-            ],
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("glint count"),
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("glint count"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            let groups = (queries.len() as u32).div_ceil(64);
-            let x = groups.min(65_535);
-            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
-        }
-        gpu.queue.submit([enc.finish()]);
+        let resources = [
+            ub.as_entire_binding(),
+            qb.as_entire_binding(),
+            cb.as_entire_binding(),
+        ];
+        dispatch::run(
+            d,
+            &gpu.queue,
+            &self.pipeline,
+            "glint count",
+            &resources,
+            queries.len() as u32,
+            self.workgroup_size,
+        );
         let out: Vec<f32> = buffer::read(d, &gpu.queue, &cb, queries.len())?;
         Ok(out.into_iter().map(f64::from).collect())
     }
@@ -372,17 +347,13 @@ impl GlintEvalQuery {
 /// Fresnel table, P from the pyramid's textures.
 pub struct GlintEvaluator {
     pipeline: wgpu::ComputePipeline,
+    /// `@workgroup_size` of the shader, read by naga.
+    workgroup_size: u32,
 }
 
 impl GlintEvaluator {
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
-        use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
-        let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
-        constants.extend([
-            ("LEAF_FLAKES", LEAF_FLAKES as f64),
-            ("MAX_DEPTH", MAX_DEPTH as f64),
-            ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
-        ]);
+        let constants = flake_constants();
         Ok(GlintEvaluator {
             pipeline: shader::compute_pipeline(
                 device,
@@ -390,6 +361,7 @@ impl GlintEvaluator {
                 "glint_eval",
                 &constants,
             )?,
+            workgroup_size: shader::workgroup_size("glint/glint_eval.wgsl", "glint_eval")?,
         })
     }
 
@@ -437,14 +409,7 @@ impl GlintEvaluator {
             rotation: ndf.rotation as f32,
             pad0: 0,
         };
-        let uniform = GlintField {
-            density: field.density as f32,
-            seed: field.seed,
-            root_count: field.root_count() as u32,
-            filtered: cfg.filtered as u32,
-            threshold: cfg.threshold as f32,
-            pad: [0; 3],
-        };
+        let uniform = GlintField::new(field, cfg);
         let f: Vec<[f32; 4]> = fresnel
             .rgb
             .iter()
@@ -463,55 +428,24 @@ impl GlintEvaluator {
             t0.create_view(&Default::default()),
             t1.create_view(&Default::default()),
         );
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("glint eval"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: fb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: pb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&v0),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&v1),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: frb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: qb.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: ob.as_entire_binding(),
-                },
-            ],
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("glint eval"),
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("glint eval"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            let groups = (queries.len() as u32).div_ceil(64);
-            let x = groups.min(65_535);
-            pass.dispatch_workgroups(x, groups.div_ceil(x), 1);
-        }
-        gpu.queue.submit([enc.finish()]);
+        let resources = [
+            fb.as_entire_binding(),
+            pb.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&v0),
+            wgpu::BindingResource::TextureView(&v1),
+            frb.as_entire_binding(),
+            qb.as_entire_binding(),
+            ob.as_entire_binding(),
+        ];
+        dispatch::run(
+            d,
+            &gpu.queue,
+            &self.pipeline,
+            "glint eval",
+            &resources,
+            queries.len() as u32,
+            self.workgroup_size,
+        );
         let out: Vec<[f32; 4]> = buffer::read(d, &gpu.queue, &ob, queries.len())?;
         gpu.check_lost()?;
         Ok(out

@@ -13,6 +13,7 @@
 
 pub mod buffer;
 pub mod context;
+pub mod dispatch;
 pub mod error;
 pub mod shader;
 pub mod timer;

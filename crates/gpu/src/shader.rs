@@ -140,3 +140,18 @@ pub fn struct_layout(module: &naga::Module, name: &str) -> Option<(u32, Vec<(Str
             _ => None,
         })
 }
+
+/// `@workgroup_size` x of entry point `entry` of shader file `name`, as naga reads it: drivers
+/// take it from the shader, where it is written once.
+pub fn workgroup_size(name: &str, entry: &str) -> Result<u32, GpuError> {
+    let module = validate(name, &expand(name)?)?;
+    module
+        .entry_points
+        .iter()
+        .find(|e| e.name == entry)
+        .map(|e| e.workgroup_size[0])
+        .ok_or_else(|| GpuError::Shader {
+            name: name.into(),
+            message: format!("no entry point {entry}"),
+        })
+}

@@ -5,10 +5,12 @@ use super::GpuSample;
 use crate::brdf::Rgb;
 use crate::grid::{GridSamples, IsoTables, fresnel_from_sums, sample_geometry};
 use crate::merl::THETA_D_RES;
-use facet_gpu::{Gpu, GpuError, buffer, shader};
+use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 pub struct FresnelAverage {
     pipeline: wgpu::ComputePipeline,
+    /// `@workgroup_size` of the shader, read by naga (written once, there).
+    workgroup_size: u32,
 }
 
 /// A source's samples on the GPU, sorted by θd bin.
@@ -21,6 +23,7 @@ impl FresnelAverage {
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         Ok(FresnelAverage {
             pipeline: shader::compute_pipeline(device, "fit/fresnel.wgsl", "fresnel_sums", &[])?,
+            workgroup_size: shader::workgroup_size("fit/fresnel.wgsl", "fresnel_sums")?,
         })
     }
 
@@ -79,45 +82,24 @@ impl FresnelAverage {
                 buffer::storage_zeroed(d, "fresnel sums", (THETA_D_RES * 16) as u64),
             )
         })?;
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fresnel"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: samples.samples.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: samples.offsets.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ndf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: lambda_cos.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: sums.as_entire_binding(),
-                },
-            ],
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("fresnel"),
-        });
-        {
-            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("fresnel"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(THETA_D_RES as u32, 1, 1);
-        }
-        gpu.queue.submit([enc.finish()]);
+        let resources = [
+            samples.samples.as_entire_binding(),
+            samples.offsets.as_entire_binding(),
+            ndf.as_entire_binding(),
+            lambda_cos.as_entire_binding(),
+            sums.as_entire_binding(),
+        ];
+        // One workgroup per θd bin: the shader strides over the bin's samples.
+        let wg = self.workgroup_size;
+        dispatch::run(
+            d,
+            &gpu.queue,
+            &self.pipeline,
+            "fresnel",
+            &resources,
+            THETA_D_RES as u32 * wg,
+            wg,
+        );
         let raw: Vec<[f32; 4]> = buffer::read(d, &gpu.queue, &sums, THETA_D_RES)?;
         let acc: Vec<([f64; 3], f64)> = raw
             .iter()

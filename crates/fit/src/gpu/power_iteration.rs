@@ -7,7 +7,7 @@
 use super::{GpuFitter, GpuNode, GpuState, gpu_error};
 use crate::error::FitError;
 use crate::extract::{Eigen, Problem, Solver, Stopping};
-use facet_gpu::{Gpu, GpuError, buffer, shader};
+use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Iterations per submission.
 const BATCH: usize = 8;
@@ -40,27 +40,6 @@ fn gpu_nodes(p: &Problem) -> Vec<GpuNode> {
         .collect()
 }
 
-/// `@workgroup_size` x of an entry point, as naga reads it.
-fn workgroup_size(file: &str, entry: &str) -> Result<u32, GpuError> {
-    let module = shader::validate(file, &shader::expand(file)?)?;
-    module
-        .entry_points
-        .iter()
-        .find(|e| e.name == entry)
-        .map(|e| e.workgroup_size[0])
-        .ok_or_else(|| GpuError::Shader {
-            name: file.into(),
-            message: format!("no entry point {entry}"),
-        })
-}
-
-/// (x, y) workgroup counts covering `n` threads within the 65,535-per-dimension limit.
-fn dispatch_size(n: usize, wg: u32) -> (u32, u32) {
-    let groups = (n as u32).div_ceil(wg).max(1);
-    let x = groups.min(65_535);
-    (x, groups.div_ceil(x))
-}
-
 impl PowerIteration {
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         let k = "fit/kernel.wgsl";
@@ -70,8 +49,8 @@ impl PowerIteration {
             kernel_aniso: shader::compute_pipeline(device, k, "kernel", &[("ISOTROPIC", 0.0)])?,
             reduce: shader::compute_pipeline(device, n, "reduce", &[])?,
             rescale: shader::compute_pipeline(device, n, "rescale", &[])?,
-            kernel_wg: workgroup_size(k, "kernel")?,
-            rescale_wg: workgroup_size(n, "rescale")?,
+            kernel_wg: shader::workgroup_size(k, "kernel")?,
+            rescale_wg: shader::workgroup_size(n, "rescale")?,
         })
     }
 
@@ -164,8 +143,8 @@ impl PowerIteration {
         };
         let reduce_bg = bind(&self.reduce, &[0, 1, 2, 3, 4]);
         let rescale_bg = bind(&self.rescale, &[1, 2, 3]);
-        let (kx, ky) = dispatch_size(n, self.kernel_wg);
-        let (rx, ry) = dispatch_size(n, self.rescale_wg);
+        let (kx, ky) = dispatch::workgroups(n as u32, self.kernel_wg);
+        let (rx, ry) = dispatch::workgroups(n as u32, self.rescale_wg);
         let (mut done, mut last, mut best) = (0usize, (0.0f32, f32::INFINITY), f32::INFINITY);
         while done < max_it {
             let batch = BATCH.min(max_it - done);
@@ -259,7 +238,7 @@ impl PowerIteration {
             });
             pass.set_pipeline(self.kernel(p.isotropic));
             pass.set_bind_group(0, &bg, &[]);
-            let (x, y) = dispatch_size(qs.len(), self.kernel_wg);
+            let (x, y) = dispatch::workgroups(qs.len() as u32, self.kernel_wg);
             pass.dispatch_workgroups(x, y, 1);
         }
         gpu.queue.submit([enc.finish()]);
@@ -286,7 +265,7 @@ impl PowerIteration {
             )
         })?;
         let bg = self.kernel_bind_group(gpu, p.isotropic, &nb, &nb, &vb, &yb);
-        let (x, y) = dispatch_size(n, self.kernel_wg);
+        let (x, y) = dispatch::workgroups(n as u32, self.kernel_wg);
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("time kernel"),
         });
