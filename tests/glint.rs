@@ -125,28 +125,16 @@ fn tea_in_wgsl_matches_rust() {
     .unwrap();
     let kb = buffer::storage(&gpu.device, "keys", &keys);
     let hb = buffer::storage_zeroed(&gpu.device, "hashes", (keys.len() * 16) as u64);
-    let bg = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: kb.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: hb.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bg, &[]);
-        pass.dispatch_workgroups((keys.len() as u32).div_ceil(64), 1, 1);
-    }
-    gpu.queue.submit([enc.finish()]);
+    let wg = facet_gpu::shader::workgroup_size("glint/tea_check.wgsl", "tea_check").unwrap();
+    facet_gpu::dispatch::run(
+        &gpu.device,
+        &gpu.queue,
+        &pipeline,
+        "tea",
+        &[kb.as_entire_binding(), hb.as_entire_binding()],
+        keys.len() as u32,
+        wg,
+    );
     let out: Vec<[u32; 4]> = buffer::read(&gpu.device, &gpu.queue, &hb, keys.len()).unwrap();
     for (k, h) in keys.iter().zip(&out) {
         let want = tea(k[0], k[1]);

@@ -498,32 +498,21 @@ fn gpu_sampling_matches_cpu() {
         let ub = buffer::uniform(&gpu.device, "ndf", &params);
         let ib = buffer::storage(&gpu.device, "inputs", &inputs);
         let ob = buffer::storage_zeroed(&gpu.device, "samples", (n as u64) * 16);
-        let bg = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: None,
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: ub.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: ib.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: ob.as_entire_binding(),
-                },
+        let wg =
+            facet_gpu::shader::workgroup_size("glint/glint_sample.wgsl", "glint_sample").unwrap();
+        facet_gpu::dispatch::run(
+            &gpu.device,
+            &gpu.queue,
+            &pipeline,
+            "sample",
+            &[
+                ub.as_entire_binding(),
+                ib.as_entire_binding(),
+                ob.as_entire_binding(),
             ],
-        });
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.dispatch_workgroups(n.div_ceil(64), 1, 1);
-        }
-        gpu.queue.submit([enc.finish()]);
+            n,
+            wg,
+        );
         let out: Vec<[f32; 4]> = buffer::read(&gpu.device, &gpu.queue, &ob, n as usize).unwrap();
         let mut mismatched = 0;
         for (g, c) in out.iter().zip(&cpu) {
