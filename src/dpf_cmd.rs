@@ -20,8 +20,10 @@ pub struct DpfArgs {
     /// Cone half-angle γ in degrees.
     #[arg(long)]
     gamma: Option<f64>,
+    /// Polar angle of ωo in degrees.
     #[arg(long)]
     theta_o: Option<f64>,
+    /// Polar angle of ωi in degrees.
     #[arg(long)]
     theta_i: Option<f64>,
     /// φo − φi in degrees; 180 is the mirror configuration.
