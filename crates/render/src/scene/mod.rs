@@ -1,0 +1,157 @@
+//! Scenes: what the renderer consumes, loaded from glTF 2.0 ([`load_gltf`]) or built in code.
+//!
+//! Everything is flattened to world space: one indexed triangle list for the whole scene, one
+//! material per triangle, textures as RGBA8, punctual lights, one camera. glTF is Y-up and
+//! right-handed; so is the scene.
+
+use glam::{Vec2, Vec3, Vec4};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+pub mod environment;
+pub mod gltf_file;
+
+pub use environment::{Environment, EnvironmentMap};
+pub use gltf_file::{LoadOptions, load_gltf};
+
+/// A whole scene in world space.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    /// World-space vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Unit shading normals per vertex (generated, area-weighted, when the mesh has none).
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates per vertex (zero when the mesh has none).
+    pub uvs: Vec<Vec2>,
+    /// Tangent per vertex, xyz unit and w = ±1 the bitangent sign (glTF convention);
+    /// generated from UVs when absent (any orthogonal tangent where UVs are degenerate).
+    pub tangents: Vec<Vec4>,
+    /// Triangles as vertex indices.
+    pub indices: Vec<[u32; 3]>,
+    /// Index into `materials` per triangle.
+    pub triangle_material: Vec<u32>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub lights: Vec<Light>,
+    pub camera: Camera,
+    /// Messages about things skipped or defaulted (a missing texture, a dropped triangle).
+    pub warnings: Vec<String>,
+}
+
+/// A pinhole camera.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit up vector, orthogonal to `forward`.
+    pub up: Vec3,
+    /// Vertical field of view, radians.
+    pub yfov: f32,
+}
+
+/// A glTF metallic-roughness material, optionally replaced by a Facet material.
+#[derive(Clone, Debug)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGBA base colour factor.
+    pub base_color: Vec4,
+    pub base_color_texture: Option<u32>,
+    pub metallic: f32,
+    pub roughness: f32,
+    /// glTF layout: roughness in G, metallic in B.
+    pub metallic_roughness_texture: Option<u32>,
+    pub normal_texture: Option<u32>,
+    pub normal_scale: f32,
+    /// Linear emitted radiance factor (emissiveFactor × KHR_materials_emissive_strength).
+    pub emissive: Vec3,
+    pub emissive_texture: Option<u32>,
+    /// A fitted material from `extras.facet` or `--material NAME=FILE`.
+    pub facet: Option<FacetMaterial>,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: "default".into(),
+            base_color: Vec4::splat(0.8),
+            base_color_texture: None,
+            metallic: 0.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
+            facet: None,
+        }
+    }
+}
+
+/// Which model of a fit a Facet material renders with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FacetModel {
+    Tabulated,
+    Ggx,
+    Beckmann,
+}
+
+/// A fitted material attached to a glTF material.
+#[derive(Clone, Debug)]
+pub struct FacetMaterial {
+    /// The fit JSON it was loaded from.
+    pub source: PathBuf,
+    pub fit: Arc<facet_fit::material::FittedMaterial>,
+    pub model: FacetModel,
+    pub glint: Option<GlintParams>,
+}
+
+/// Glint parameters of a Facet material (the NDF is the material's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlintParams {
+    /// Flakes per unit UV area.
+    pub density: f32,
+    /// Cone half-angle γ, degrees.
+    pub gamma_deg: f32,
+    /// Expected count above which the count is replaced by its mean.
+    pub threshold: f32,
+}
+
+/// An RGBA8 texture; `srgb` says whether RGB is sRGB-encoded (base colour, emissive).
+#[derive(Clone, Debug)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub texels: Vec<[u8; 4]>,
+    pub srgb: bool,
+}
+
+/// KHR_lights_punctual, in world space. Intensity already multiplied into `color`
+/// (W/sr-like radiometric units as glTF defines: candela for point/spot, lux for directional).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    Point {
+        position: Vec3,
+        intensity: Vec3,
+    },
+    Spot {
+        position: Vec3,
+        direction: Vec3,
+        intensity: Vec3,
+        inner_cone: f32,
+        outer_cone: f32,
+    },
+    /// `direction` is where the light travels (glTF: the node's −Z).
+    Directional { direction: Vec3, irradiance: Vec3 },
+}
+
+impl Scene {
+    /// Axis-aligned bounds of all vertices (min, max).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.positions.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        )
+    }
+}
