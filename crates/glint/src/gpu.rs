@@ -218,7 +218,7 @@ impl GlintQuery {
 }
 
 /// The override constants of the flake shaders (TEA and the quadtree), from Rust.
-fn flake_constants() -> Vec<(&'static str, f64)> {
+pub fn flake_constants() -> Vec<(&'static str, f64)> {
     use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
     let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
     constants.extend([
