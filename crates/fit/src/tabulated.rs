@@ -137,6 +137,12 @@ impl TabulatedNdf {
         &self.tables
     }
 
+    /// The sampling cells' cumulative mass and pdf, index k · nphi + l over (nu − 1) × nphi
+    /// cells: what a GPU twin of [`Self::sample`] and [`Self::pdf`] needs.
+    pub fn sampling_tables(&self) -> (&[f64], &[f64]) {
+        (&self.cdf, &self.cell_pdf)
+    }
+
     /// The same tables under another stretch.
     pub fn with_stretch(&self, stretch: Stretch) -> Self {
         TabulatedNdf {

@@ -377,38 +377,8 @@ impl GlintEvaluator {
         dpf: &GpuDpf,
         queries: &[GlintEvalQuery],
     ) -> Result<Vec<[f64; 3]>, GpuError> {
-        use crate::dpf::cone_solid_angle;
         let d = &gpu.device;
-        let ([k0, k1], t) = DpfPyramid::levels_for(cfg.gamma);
-        // With no weight on the second level (γ on a level) only the first is needed.
-        let k1 = if t > 0.0 { k1 } else { k0 };
-        let level = |k: usize| -> Result<(&DpfTable, &wgpu::Texture), GpuError> {
-            let built: Vec<usize> = (0..LEVELS_DEG.len())
-                .filter(|&j| dpf.pyramid.levels[j].is_some())
-                .collect();
-            let pos = built.iter().position(|&j| j == k).ok_or_else(|| {
-                GpuError::Validation(format!("DPF level {}° was not built", LEVELS_DEG[k]))
-            })?;
-            Ok((dpf.pyramid.levels[k].as_ref().unwrap(), &dpf.textures[pos]))
-        };
-        let ((l0, t0), (l1, t1)) = (level(k0)?, level(k1)?);
-        let params = GlintEvalParams {
-            gamma: cfg.gamma as f32,
-            sigma: cone_solid_angle(cfg.gamma) as f32,
-            sigma0: cone_solid_angle(l0.gamma) as f32,
-            sigma1: cone_solid_angle(l1.gamma) as f32,
-            level_t: t as f32,
-            n_theta: l0.config.n_theta as u32,
-            n_dphi: l0.config.n_dphi as u32,
-            ndf_kind: match ndf.kind {
-                facet_fit::microfacet::NdfKind::Ggx => 0,
-                facet_fit::microfacet::NdfKind::Beckmann => 1,
-            },
-            alpha_x: ndf.alpha_x as f32,
-            alpha_y: ndf.alpha_y as f32,
-            rotation: ndf.rotation as f32,
-            pad0: 0,
-        };
+        let (params, t0, t1) = eval_params(cfg, ndf, dpf)?;
         let uniform = GlintField::new(field, cfg);
         let f: Vec<[f32; 4]> = fresnel
             .rgb
@@ -453,4 +423,45 @@ impl GlintEvaluator {
             .map(|v| [v[0] as f64, v[1] as f64, v[2] as f64])
             .collect())
     }
+}
+
+/// The WGSL `EvalParams` for γ = `cfg.gamma` and the two pyramid textures bracketing it (the same
+/// one twice when γ is on a level). Fails when `dpf` lacks a level it needs.
+pub fn eval_params<'a>(
+    cfg: &crate::glint_brdf::GlintConfig,
+    ndf: &facet_fit::microfacet::AnalyticNdf,
+    dpf: &'a GpuDpf,
+) -> Result<(GlintEvalParams, &'a wgpu::Texture, &'a wgpu::Texture), GpuError> {
+    use crate::dpf::cone_solid_angle;
+    let ([k0, k1], t) = DpfPyramid::levels_for(cfg.gamma);
+    // With no weight on the second level (γ on a level) only the first is needed.
+    let k1 = if t > 0.0 { k1 } else { k0 };
+    let level = |k: usize| -> Result<(&DpfTable, &wgpu::Texture), GpuError> {
+        let built: Vec<usize> = (0..LEVELS_DEG.len())
+            .filter(|&j| dpf.pyramid.levels[j].is_some())
+            .collect();
+        let pos = built.iter().position(|&j| j == k).ok_or_else(|| {
+            GpuError::Validation(format!("DPF level {}° was not built", LEVELS_DEG[k]))
+        })?;
+        Ok((dpf.pyramid.levels[k].as_ref().unwrap(), &dpf.textures[pos]))
+    };
+    let ((l0, t0), (l1, t1)) = (level(k0)?, level(k1)?);
+    let params = GlintEvalParams {
+        gamma: cfg.gamma as f32,
+        sigma: cone_solid_angle(cfg.gamma) as f32,
+        sigma0: cone_solid_angle(l0.gamma) as f32,
+        sigma1: cone_solid_angle(l1.gamma) as f32,
+        level_t: t as f32,
+        n_theta: l0.config.n_theta as u32,
+        n_dphi: l0.config.n_dphi as u32,
+        ndf_kind: match ndf.kind {
+            facet_fit::microfacet::NdfKind::Ggx => 0,
+            facet_fit::microfacet::NdfKind::Beckmann => 1,
+        },
+        alpha_x: ndf.alpha_x as f32,
+        alpha_y: ndf.alpha_y as f32,
+        rotation: ndf.rotation as f32,
+        pad0: 0,
+    };
+    Ok((params, t0, t1))
 }
