@@ -95,6 +95,18 @@ pub fn compute_pipeline(
     entry: &str,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, GpuError> {
+    compute_pipeline_with_layout(device, name, entry, None, constants)
+}
+
+/// [`compute_pipeline`] with an explicit pipeline layout (None: derived from the shader), for
+/// stages that share bind groups.
+pub fn compute_pipeline_with_layout(
+    device: &wgpu::Device,
+    name: &str,
+    entry: &str,
+    layout: Option<&wgpu::PipelineLayout>,
+    constants: &[(&str, f64)],
+) -> Result<wgpu::ComputePipeline, GpuError> {
     let source = expand(name)?;
     validate(name, &source)?;
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -107,7 +119,7 @@ pub fn compute_pipeline(
     Ok(
         device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some(entry),
-            layout: None,
+            layout,
             module: &module,
             entry_point: Some(entry),
             compilation_options: wgpu::PipelineCompilationOptions {
@@ -119,7 +131,6 @@ pub fn compute_pipeline(
     )
 }
 
-/// Size and member offsets of WGSL struct `name` in a module, as naga lays it out.
 pub fn struct_layout(module: &naga::Module, name: &str) -> Option<(u32, Vec<(String, u32)>)> {
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).ok()?;

@@ -1,5 +1,36 @@
 //! # facet-render: a wavefront path tracer on wgpu
+//!
+//! glTF scenes ([`scene::load_gltf`]), an obvhs CWBVH traversed in WGSL ([`bvh`]), and a
+//! wavefront integrator ([`Integrator`]) whose stages — logic, generate, extend, shade per
+//! material class (glTF metallic-roughness, fitted analytic or tabulated microfacet, glints),
+//! connect — are separate compute passes over queues.
+//!
+//! ```no_run
+//! use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, camera::CameraFrame};
+//! let gpu = facet_gpu::Gpu::new()?;
+//! let scene = facet_render::scene::load_gltf("scene.gltf".as_ref(), &Default::default())?;
+//! let env = facet_render::scene::Environment::Constant(glam::Vec3::splat(1.0));
+//! let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard())?;
+//! let integrator = Integrator::new(&gpu.device, &res)?;
+//! let camera = CameraFrame::new(&scene.camera)?;
+//! let (image, stats) = integrator.render(&gpu, &res, &camera, &RenderConfig::preview(), &mut |_| {})?;
+//! image.write_png("out.png".as_ref(), 0.0)?;
+//! # Ok::<(), facet_render::RenderError>(())
+//! ```
+
+pub mod bvh;
+pub mod camera;
 pub mod error;
+pub mod film;
+pub mod gpu_types;
+pub mod integrator;
+pub mod queues;
+pub mod resources;
 pub mod scene;
+pub mod stages;
+pub mod trace;
 
 pub use error::RenderError;
+pub use film::Image;
+pub use integrator::{Integrator, RenderConfig, RenderStats};
+pub use resources::{Built, ResourceConfig, SceneResources};

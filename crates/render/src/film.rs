@@ -1,0 +1,145 @@
+//! Images out of the film: linear HDR pixels, written as EXR (linear, as rendered) and PNG.
+//!
+//! PNG tone mapping, documented once here: v = 1 − exp(−2^exposure · L) per channel (a soft
+//! clip that keeps highlights' hue ordering and never exceeds 1), then the sRGB transfer function,
+//! then 8 bits. Exposure 0 leaves mid-tones nearly linear (v ≈ L for small L).
+
+use crate::error::RenderError;
+use std::path::Path;
+
+/// A linear RGB image, row-major, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+    /// Samples each pixel received.
+    pub samples: Vec<u32>,
+}
+
+impl Image {
+    /// Divides the film's sums by its counts (a pixel with no sample is black).
+    pub fn from_film(width: u32, height: u32, film: &[[f32; 4]]) -> Self {
+        Image {
+            width,
+            height,
+            pixels: film
+                .iter()
+                .map(|v| {
+                    let n = v[3].max(1.0);
+                    [v[0] / n, v[1] / n, v[2] / n]
+                })
+                .collect(),
+            samples: film.iter().map(|v| v[3] as u32).collect(),
+        }
+    }
+
+    /// Mean of each channel over the pixels where `mask` is true.
+    pub fn mean_where(&self, mask: impl Fn(u32, u32) -> bool) -> [f64; 3] {
+        let mut sum = [0.0f64; 3];
+        let mut n = 0usize;
+        for y in 0..self.height {
+            for x in 0..self.width {
+                if mask(x, y) {
+                    let p = self.pixels[(y * self.width + x) as usize];
+                    for c in 0..3 {
+                        sum[c] += p[c] as f64;
+                    }
+                    n += 1;
+                }
+            }
+        }
+        sum.map(|s| s / n.max(1) as f64)
+    }
+
+    pub fn mean(&self) -> [f64; 3] {
+        self.mean_where(|_, _| true)
+    }
+
+    /// Root-mean-square difference to another image of the same size, over all channels.
+    pub fn rmse(&self, other: &Image) -> f64 {
+        let n = self.pixels.len() * 3;
+        let s: f64 = self
+            .pixels
+            .iter()
+            .zip(&other.pixels)
+            .flat_map(|(a, b)| (0..3).map(move |c| (a[c] as f64 - b[c] as f64).powi(2)))
+            .sum();
+        (s / n.max(1) as f64).sqrt()
+    }
+
+    /// Linear f32 RGB EXR, as rendered.
+    pub fn write_exr(&self, path: &Path) -> Result<(), RenderError> {
+        let w = self.width as usize;
+        let px = &self.pixels;
+        write_atomically(path, |tmp| {
+            exr::prelude::write_rgb_file(tmp, w, self.height as usize, |x, y| {
+                let p = px[y * w + x];
+                (p[0], p[1], p[2])
+            })
+            .map_err(|e| e.to_string())
+        })
+    }
+
+    /// 8-bit sRGB PNG after the tone mapping in the module doc.
+    pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), RenderError> {
+        let scale = exposure.exp2();
+        let bytes: Vec<u8> = self
+            .pixels
+            .iter()
+            .flat_map(|p| p.map(|v| encode_srgb(1.0 - (-scale * v.max(0.0)).exp())))
+            .collect();
+        let (w, h) = (self.width, self.height);
+        write_atomically(path, |tmp| {
+            image::save_buffer_with_format(
+                tmp,
+                &bytes,
+                w,
+                h,
+                image::ExtendedColorType::Rgb8,
+                image::ImageFormat::Png,
+            )
+            .map_err(|e| e.to_string())
+        })
+    }
+}
+
+/// The sRGB transfer function of a value in [0, 1], to 8 bits.
+fn encode_srgb(v: f32) -> u8 {
+    let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+    let s = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// Writes through a temporary file beside `path` and renames it, so a failed write never leaves
+/// a truncated file where a good one was.
+fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), RenderError> {
+    let err = |message: String| RenderError::Output {
+        path: path.to_owned(),
+        message,
+    };
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
+    }
+    let name = path
+        .file_name()
+        .ok_or_else(|| err("not a file name".into()))?
+        .to_string_lossy();
+    let ext = path.extension().map(|e| e.to_string_lossy().to_string());
+    let tmp = path.with_file_name(format!(
+        ".{name}.tmp{}",
+        ext.map_or(String::new(), |e| format!(".{e}"))
+    ));
+    write(&tmp).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        err(e)
+    })?;
+    std::fs::rename(&tmp, path).map_err(|e| err(e.to_string()))
+}

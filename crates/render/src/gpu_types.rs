@@ -1,0 +1,106 @@
+//! Structs shared with WGSL, `#[repr(C)]` + Pod; `tests/shaders.rs` checks each size and offsets
+//! against what naga computes for its WGSL twin.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Texture index meaning "none" (WGSL `NONE`).
+pub const NONE: u32 = u32::MAX;
+
+/// Regions of the path-state buffer (`shaders/render/frame.inc.wgsl`), one vec4 per slot each.
+pub const PATH_REGIONS: u64 = 8;
+
+/// WGSL `Frame` (`shaders/render/frame.inc.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuFrame {
+    pub width: u32,
+    pub height: u32,
+    pub tile_base: u32,
+    pub tile_pixels: u32,
+    pub wavefront: u32,
+    pub sample_end: u32,
+    pub max_depth: u32,
+    pub seed: u32,
+    pub rr_depth: u32,
+    pub n_vertices: u32,
+    pub n_lights: u32,
+    pub light_cdf: u32,
+    /// 0 none, 1 constant, 2 map.
+    pub env_kind: u32,
+    pub env_width: u32,
+    pub env_height: u32,
+    pub env_texels: u32,
+    pub env_marginal: u32,
+    pub env_conditional: u32,
+    pub scene_radius: f32,
+    pub ray_epsilon: f32,
+    pub env_color: [f32; 4],
+    pub cam_pos: [f32; 4],
+    pub cam_forward: [f32; 4],
+    pub cam_up: [f32; 4],
+    pub cam_right: [f32; 4],
+}
+
+/// Material kinds (WGSL `MAT_*`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum MaterialKind {
+    Gltf = 0,
+    Analytic = 1,
+    Tabulated = 2,
+    Glint = 3,
+}
+
+/// WGSL `Material` (`shaders/render/scene.inc.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub base_color: [f32; 4],
+    /// rgb emitted radiance, w the specular weight of a glTF material.
+    pub emissive: [f32; 4],
+    /// rgb Lambertian albedo of a fitted material.
+    pub diffuse: [f32; 4],
+    pub kind: u32,
+    /// 0 GGX, 1 Beckmann.
+    pub ndf_kind: u32,
+    pub alpha_x: f32,
+    pub alpha_y: f32,
+    pub rotation: f32,
+    pub metallic: f32,
+    /// glTF roughness; for fitted materials the effective GGX α the ray cone widens by.
+    pub roughness: f32,
+    pub normal_scale: f32,
+    pub tex_base: u32,
+    pub tex_mr: u32,
+    pub tex_normal: u32,
+    pub tex_emissive: u32,
+    pub fresnel_offset: u32,
+    pub fresnel_count: u32,
+    pub tab_offset: u32,
+    /// The shading queue its hits go to.
+    pub queue: u32,
+}
+
+/// Light kinds (WGSL `LIGHT_*`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum LightKind {
+    Point = 0,
+    Spot = 1,
+    Directional = 2,
+    Triangle = 3,
+    Environment = 4,
+}
+
+/// WGSL `Light`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct GpuLight {
+    pub kind: u32,
+    pub prim: u32,
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+    pub position: [f32; 4],
+    pub direction: [f32; 4],
+    pub intensity: [f32; 4],
+}

@@ -1,0 +1,123 @@
+// Include-only. Group 0 of every integrator stage: the frame, the path state in
+// structure-of-arrays form, the queues and the film (Rust twin: facet_render::gpu_types).
+//
+// Path state: `paths` holds one vec4 region per field, W = frame.wavefront slots each:
+// region r of slot s is paths[r * W + s]. `info` is per slot (flags, next sample, depth, -).
+
+const WG: u32 = 64u;
+
+// Queues, numbered from Rust (facet_render::queues::Queue).
+override Q_GEN: u32;
+override Q_EXTEND: u32;
+override Q_SHADOW: u32;
+
+// Path-state regions (facet_render::gpu_types::Region).
+const R_ORIGIN: u32 = 0u;    // xyz origin, w cone width at the origin
+const R_DIR: u32 = 1u;       // xyz direction, w cone spread angle
+const R_BETA: u32 = 2u;      // rgb throughput β, w pdf of the BSDF sample that made the ray (0: no MIS)
+const R_L: u32 = 3u;         // rgb radiance so far
+const R_HIT: u32 = 4u;       // t, primitive (bits), barycentrics u, v
+const R_SHADOW_O: u32 = 5u;  // xyz shadow-ray origin, w tmax
+const R_SHADOW_D: u32 = 6u;  // xyz shadow-ray direction
+const R_SHADOW_C: u32 = 7u;  // rgb unoccluded contribution
+
+// info.x: what the slot holds.
+const SLOT_START: u32 = 0u;    // nothing yet: start a path
+const SLOT_FLYING: u32 = 1u;   // a ray to trace
+const SLOT_ENDED: u32 = 2u;    // a finished path to accumulate
+const SLOT_IDLE: u32 = 3u;     // all its samples done
+
+// Rust: facet_render::gpu_types::GpuFrame.
+struct Frame {
+    width: u32,
+    height: u32,
+    tile_base: u32,
+    tile_pixels: u32,
+    wavefront: u32,
+    sample_end: u32,
+    max_depth: u32,
+    seed: u32,
+    rr_depth: u32,
+    n_vertices: u32,
+    n_lights: u32,
+    light_cdf: u32,
+    env_kind: u32,
+    env_width: u32,
+    env_height: u32,
+    env_texels: u32,
+    env_marginal: u32,
+    env_conditional: u32,
+    scene_radius: f32,
+    ray_epsilon: f32,
+    // Constant environment radiance (env_kind 1); w: 1 / Σ weights of the map (env_kind 2).
+    env_color: vec4<f32>,
+    // xyz position, w tan(yfov / 2)
+    cam_pos: vec4<f32>,
+    // xyz forward, w aspect
+    cam_forward: vec4<f32>,
+    // xyz up, w pixel spread angle
+    cam_up: vec4<f32>,
+    // xyz right
+    cam_right: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read_write> paths: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> info: array<vec4<u32>>;
+@group(0) @binding(3) var<storage, read_write> counters: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read> sizes: array<u32>;
+@group(0) @binding(5) var<storage, read_write> queues: array<u32>;
+@group(0) @binding(6) var<storage, read_write> film: array<vec4<f32>>;
+
+fn path_get(region: u32, slot: u32) -> vec4<f32> {
+    return paths[region * frame.wavefront + slot];
+}
+
+fn path_set(region: u32, slot: u32, v: vec4<f32>) {
+    paths[region * frame.wavefront + slot] = v;
+}
+
+fn push(q: u32, slot: u32) {
+    let k = atomicAdd(&counters[q], 1u);
+    queues[q * frame.wavefront + k] = slot;
+}
+
+// Thread index of a 2D dispatch.
+fn thread_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * WG;
+}
+
+// The slot of thread i of a dispatch over queue q, or 0xffffffff past its end.
+fn queue_slot(q: u32, i: u32) -> u32 {
+    if (i >= sizes[q]) {
+        return 0xffffffffu;
+    }
+    return queues[q * frame.wavefront + i];
+}
+
+// Stateless random numbers: PCG hash (Jarzynski & Olano 2020) of (pixel, sample, dimension),
+// so an image depends only on the seed, never on scheduling.
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+// Dimension d of sample s of pixel p: a uniform number in [0, 1).
+fn rand(p: u32, s: u32, d: u32) -> f32 {
+    let h = pcg(pcg(pcg(p ^ pcg(frame.seed)) + s) + d);
+    return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// Random dimensions used per bounce.
+const DIMS_PER_BOUNCE: u32 = 8u;
+
+fn slot_pixel(slot: u32) -> u32 {
+    return frame.tile_base + slot;
+}
+
+// The random number k of the current bounce of a slot's path.
+fn path_rand(slot: u32, k: u32) -> f32 {
+    let i = info[slot];
+    return rand(slot_pixel(slot), i.y - 1u, 2u + i.z * DIMS_PER_BOUNCE + k);
+}

@@ -1,0 +1,452 @@
+// Include-only. Group 1 of the integrator stages: the scene (Rust: facet_render::scene_gpu).
+// Geometry, BVH, materials, textures, lights and one f32 `tables` buffer holding the light CDF,
+// the environment map and its CDFs, the Fresnel tables and the tabulated NDFs at offsets.
+
+const PI: f32 = 3.14159265358979;
+const NONE: u32 = 0xffffffffu;
+
+// Material kinds (facet_render::gpu_types::MaterialKind).
+const MAT_GLTF: u32 = 0u;
+const MAT_ANALYTIC: u32 = 1u;
+const MAT_TABULATED: u32 = 2u;
+const MAT_GLINT: u32 = 3u;
+
+// Rust: facet_render::gpu_types::GpuMaterial.
+struct Material {
+    base_color: vec4<f32>,
+    // rgb emitted radiance, w the specular weight of a glTF material (KHR_materials_specular)
+    emissive: vec4<f32>,
+    // rgb Lambertian albedo of a fitted material
+    diffuse: vec4<f32>,
+    kind: u32,
+    ndf_kind: u32,
+    alpha_x: f32,
+    alpha_y: f32,
+    rotation: f32,
+    metallic: f32,
+    roughness: f32,
+    normal_scale: f32,
+    tex_base: u32,
+    tex_mr: u32,
+    tex_normal: u32,
+    tex_emissive: u32,
+    fresnel_offset: u32,
+    fresnel_count: u32,
+    tab_offset: u32,
+    queue: u32,
+}
+
+// Light kinds (facet_render::gpu_types::LightKind).
+const LIGHT_POINT: u32 = 0u;
+const LIGHT_SPOT: u32 = 1u;
+const LIGHT_DIRECTIONAL: u32 = 2u;
+const LIGHT_TRIANGLE: u32 = 3u;
+const LIGHT_ENVIRONMENT: u32 = 4u;
+
+// Rust: facet_render::gpu_types::GpuLight.
+struct Light {
+    kind: u32,
+    // the triangle of a LIGHT_TRIANGLE
+    prim: u32,
+    cos_inner: f32,
+    cos_outer: f32,
+    position: vec4<f32>,
+    // unit direction the light travels (spot, directional)
+    direction: vec4<f32>,
+    // point/spot intensity, directional irradiance
+    intensity: vec4<f32>,
+}
+
+@group(1) @binding(0) var<storage, read> bvh_nodes: array<CwNode>;
+@group(1) @binding(1) var<storage, read> bvh_primitives: array<u32>;
+@group(1) @binding(2) var<storage, read> bvh_triangles: array<vec4<f32>>;
+// Regions of n_vertices each: position, normal, tangent (w the bitangent sign), uv (xy).
+@group(1) @binding(3) var<storage, read> vertices: array<vec4<f32>>;
+// i0, i1, i2, material.
+@group(1) @binding(4) var<storage, read> triangles: array<vec4<u32>>;
+@group(1) @binding(5) var<storage, read> materials: array<Material>;
+// Headers (offset, width, height, srgb) per texture, then RGBA8 texels.
+@group(1) @binding(6) var<storage, read> textures: array<u32>;
+@group(1) @binding(7) var<storage, read> lights: array<Light>;
+@group(1) @binding(8) var<storage, read> tables: array<f32>;
+// Light index of each triangle, NONE when it does not emit (one entry when nothing emits).
+@group(1) @binding(9) var<storage, read> triangle_light: array<u32>;
+
+fn vertex(region: u32, i: u32) -> vec4<f32> {
+    return vertices[region * frame.n_vertices + i];
+}
+
+fn luminance(c: vec3<f32>) -> f32 {
+    return dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+}
+
+// ---- textures: bilinear, repeat, sRGB decoded --------------------------------------------
+
+fn srgb_to_linear(c: f32) -> f32 {
+    return select(pow((c + 0.055) / 1.055, 2.4), c / 12.92, c <= 0.04045);
+}
+
+fn texel(t: u32, x: i32, y: i32) -> vec4<f32> {
+    let off = textures[4u * t];
+    let w = i32(textures[4u * t + 1u]);
+    let h = i32(textures[4u * t + 2u]);
+    let xx = ((x % w) + w) % w;
+    let yy = ((y % h) + h) % h;
+    let c = unpack4x8unorm(textures[off + u32(yy * w + xx)]);
+    if (textures[4u * t + 3u] != 0u) {
+        return vec4<f32>(srgb_to_linear(c.x), srgb_to_linear(c.y), srgb_to_linear(c.z), c.w);
+    }
+    return c;
+}
+
+fn texture_sample(t: u32, uv: vec2<f32>) -> vec4<f32> {
+    let w = f32(textures[4u * t + 1u]);
+    let h = f32(textures[4u * t + 2u]);
+    let x = uv.x * w - 0.5;
+    let y = uv.y * h - 0.5;
+    let x0 = floor(x);
+    let y0 = floor(y);
+    let fx = x - x0;
+    let fy = y - y0;
+    let a = mix(texel(t, i32(x0), i32(y0)), texel(t, i32(x0) + 1, i32(y0)), fx);
+    let b = mix(texel(t, i32(x0), i32(y0) + 1), texel(t, i32(x0) + 1, i32(y0) + 1), fx);
+    return mix(a, b, fy);
+}
+
+// ---- surfaces -------------------------------------------------------------------------------
+
+struct Surface {
+    p: vec3<f32>,
+    // geometric normal, facing the incoming ray's origin
+    ng: vec3<f32>,
+    // shading frame (normal-mapped), n on the side of ng
+    n: vec3<f32>,
+    t: vec3<f32>,
+    b: vec3<f32>,
+    uv: vec2<f32>,
+    material: u32,
+    // world-space dP/du and dP/dv of the triangle's UV mapping
+    dpdu: vec3<f32>,
+    dpdv: vec3<f32>,
+    // |Δn| / |Δp| over the triangle's edges: the curvature the ray cone sees
+    curvature: f32,
+    area: f32,
+    front: bool,
+}
+
+fn surface_at(prim: u32, bu: f32, bv: f32, wo: vec3<f32>) -> Surface {
+    let tri = triangles[prim];
+    let p0 = vertex(0u, tri.x).xyz;
+    let p1 = vertex(0u, tri.y).xyz;
+    let p2 = vertex(0u, tri.z).xyz;
+    let bw = 1.0 - bu - bv;
+    var s: Surface;
+    s.p = bw * p0 + bu * p1 + bv * p2;
+    let c = cross(p1 - p0, p2 - p0);
+    s.area = 0.5 * length(c);
+    var ng = normalize(c);
+    let n0 = vertex(1u, tri.x).xyz;
+    let n1 = vertex(1u, tri.y).xyz;
+    let n2 = vertex(1u, tri.z).xyz;
+    var n = normalize(bw * n0 + bu * n1 + bv * n2);
+    let tg = bw * vertex(2u, tri.x) + bu * vertex(2u, tri.y) + bv * vertex(2u, tri.z);
+    let uv0 = vertex(3u, tri.x).xy;
+    let uv1 = vertex(3u, tri.y).xy;
+    let uv2 = vertex(3u, tri.z).xy;
+    s.uv = bw * uv0 + bu * uv1 + bv * uv2;
+    s.material = tri.w;
+    // Two-sided: the geometric normal faces wo, the shading normal follows it.
+    s.front = dot(ng, wo) >= 0.0;
+    if (!s.front) {
+        ng = -ng;
+    }
+    if (dot(n, ng) < 0.0) {
+        n = -n;
+    }
+    // [dp1 dp2] = [dP/du dP/dv] [duv1 duv2]
+    let dp1 = p1 - p0;
+    let dp2 = p2 - p0;
+    let duv1 = uv1 - uv0;
+    let duv2 = uv2 - uv0;
+    let det = duv1.x * duv2.y - duv1.y * duv2.x;
+    if (abs(det) > 1e-12) {
+        s.dpdu = (dp1 * duv2.y - dp2 * duv1.y) / det;
+        s.dpdv = (dp2 * duv1.x - dp1 * duv2.x) / det;
+    } else {
+        s.dpdu = vec3<f32>(0.0);
+        s.dpdv = vec3<f32>(0.0);
+    }
+    s.curvature = max(max(length(n1 - n0) / max(length(dp1), 1e-20), length(n2 - n0) / max(length(dp2), 1e-20)),
+                      length(n2 - n1) / max(length(p2 - p1), 1e-20));
+    let m = materials[s.material];
+    if (m.tex_normal != NONE) {
+        // Tangent-space normal map (glTF): n' = normalize(t x + b y + n z), xy scaled.
+        let tn = texture_sample(m.tex_normal, s.uv).xyz * 2.0 - 1.0;
+        let t0 = normalize(tg.xyz - n * dot(n, tg.xyz));
+        let b0 = cross(n, t0) * select(-1.0, 1.0, tg.w >= 0.0);
+        let mapped = normalize(t0 * tn.x * m.normal_scale + b0 * tn.y * m.normal_scale + n * max(tn.z, 1e-3));
+        if (all(mapped == mapped)) {
+            n = mapped;
+        }
+    }
+    s.ng = ng;
+    s.n = n;
+    // Tangent frame: x along the interpolated tangent (the NDF's rotation is relative to it).
+    var t = tg.xyz - n * dot(n, tg.xyz);
+    if (dot(t, t) < 1e-12) {
+        t = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
+        t = t - n * dot(n, t);
+    }
+    s.t = normalize(t);
+    s.b = cross(n, s.t);
+    return s;
+}
+
+fn to_local(s: Surface, w: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(w, s.t), dot(w, s.b), dot(w, s.n));
+}
+
+fn to_world(s: Surface, w: vec3<f32>) -> vec3<f32> {
+    return w.x * s.t + w.y * s.b + w.z * s.n;
+}
+
+// A ray origin off the surface on the side of w (self-intersection).
+fn offset_origin(s: Surface, w: vec3<f32>) -> vec3<f32> {
+    let e = frame.ray_epsilon * (1.0 + max(max(abs(s.p.x), abs(s.p.y)), abs(s.p.z)));
+    return s.p + select(-s.ng, s.ng, dot(w, s.ng) >= 0.0) * e;
+}
+
+fn emitted(s: Surface) -> vec3<f32> {
+    let m = materials[s.material];
+    var le = m.emissive.xyz;
+    if (m.tex_emissive != NONE) {
+        le *= texture_sample(m.tex_emissive, s.uv).xyz;
+    }
+    return select(vec3<f32>(0.0), le, s.front);
+}
+
+// ---- Fresnel tables (θd nodes evenly spaced over [0, π/2], inclusive) ----------------------
+
+fn fresnel_table(m: Material, cos_d: f32) -> vec3<f32> {
+    let n = m.fresnel_count;
+    let theta_d = acos(clamp(cos_d, 0.0, 1.0));
+    let x = clamp(theta_d / (0.5 * PI) * f32(n - 1u), 0.0, f32(n - 1u));
+    let j = min(u32(x), n - 2u);
+    let o = m.fresnel_offset + 3u * j;
+    let a = vec3<f32>(tables[o], tables[o + 1u], tables[o + 2u]);
+    let b = vec3<f32>(tables[o + 3u], tables[o + 4u], tables[o + 5u]);
+    return mix(a, b, x - f32(j));
+}
+
+// ---- environment ---------------------------------------------------------------------------
+// Equirectangular, Y up (facet_render::scene::environment): φ = atan2(z, x) in [0, 2π),
+// u = φ / 2π, θ = acos(y), v = θ / π, row 0 straight up.
+
+fn env_uv(d: vec3<f32>) -> vec2<f32> {
+    var phi = atan2(d.z, d.x);
+    if (phi < 0.0) {
+        phi += 2.0 * PI;
+    }
+    return vec2<f32>(phi / (2.0 * PI), acos(clamp(d.y, -1.0, 1.0)) / PI);
+}
+
+fn env_pixel(d: vec3<f32>) -> vec2<u32> {
+    let uv = env_uv(d);
+    return vec2<u32>(min(u32(uv.x * f32(frame.env_width)), frame.env_width - 1u),
+                     min(u32(uv.y * f32(frame.env_height)), frame.env_height - 1u));
+}
+
+fn env_radiance(d: vec3<f32>) -> vec3<f32> {
+    if (frame.env_kind == 1u) {
+        return frame.env_color.xyz;
+    }
+    if (frame.env_kind == 2u) {
+        let px = env_pixel(d);
+        let o = frame.env_texels + 3u * (px.y * frame.env_width + px.x);
+        return vec3<f32>(tables[o], tables[o + 1u], tables[o + 2u]);
+    }
+    return vec3<f32>(0.0);
+}
+
+// Discrete probability of a pixel: cdf differences of its row and column.
+fn env_pixel_prob(px: vec2<u32>) -> f32 {
+    let w1 = frame.env_width + 1u;
+    let row = tables[frame.env_marginal + px.y + 1u] - tables[frame.env_marginal + px.y];
+    let c = frame.env_conditional + px.y * w1 + px.x;
+    return row * (tables[c + 1u] - tables[c]);
+}
+
+// Solid-angle density of env_sample: p · w · h / (2π² sin θ).
+fn env_pdf(d: vec3<f32>) -> f32 {
+    if (frame.env_kind == 1u) {
+        return 1.0 / (4.0 * PI);
+    }
+    if (frame.env_kind != 2u) {
+        return 0.0;
+    }
+    let sin_t = sqrt(max(1.0 - d.y * d.y, 0.0));
+    if (sin_t <= 0.0) {
+        return 0.0;
+    }
+    let px = env_pixel(d);
+    return env_pixel_prob(px) * f32(frame.env_width * frame.env_height) / (2.0 * PI * PI * sin_t);
+}
+
+// Largest i in [0, n) with cdf[base + i] <= u.
+fn cdf_search(base: u32, n: u32, u: f32) -> u32 {
+    var lo = 0u;
+    var hi = n;
+    while (hi - lo > 1u) {
+        let mid = (lo + hi) / 2u;
+        if (tables[base + mid] <= u) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+fn env_sample(u: vec2<f32>) -> vec3<f32> {
+    if (frame.env_kind != 2u) {
+        // Uniform sphere.
+        let y = 1.0 - 2.0 * u.x;
+        let r = sqrt(max(1.0 - y * y, 0.0));
+        let phi = 2.0 * PI * u.y;
+        return vec3<f32>(r * cos(phi), y, r * sin(phi));
+    }
+    let h = frame.env_height;
+    let w = frame.env_width;
+    let row = cdf_search(frame.env_marginal, h + 1u, u.y);
+    let r0 = tables[frame.env_marginal + row];
+    let r1 = tables[frame.env_marginal + row + 1u];
+    let fy = clamp((u.y - r0) / max(r1 - r0, 1e-30), 0.0, 1.0);
+    let base = frame.env_conditional + row * (w + 1u);
+    let col = cdf_search(base, w + 1u, u.x);
+    let c0 = tables[base + col];
+    let c1 = tables[base + col + 1u];
+    let fx = clamp((u.x - c0) / max(c1 - c0, 1e-30), 0.0, 1.0);
+    let uu = (f32(col) + fx) / f32(w);
+    let vv = (f32(row) + fy) / f32(h);
+    let phi = 2.0 * PI * uu;
+    let theta = PI * vv;
+    return vec3<f32>(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
+}
+
+// ---- lights ----------------------------------------------------------------------------------
+
+fn light_pmf(i: u32) -> f32 {
+    return tables[frame.light_cdf + i + 1u] - tables[frame.light_cdf + i];
+}
+
+struct LightSample {
+    wi: vec3<f32>,
+    dist: f32,
+    // Le · (geometry) / pdf, everything but the BSDF and cos θi
+    weight: vec3<f32>,
+    // solid-angle pdf including the light choice; 0 for delta lights (no MIS)
+    pdf: f32,
+}
+
+fn triangle_light_pdf(prim: u32, p: vec3<f32>, q: vec3<f32>, nq: vec3<f32>, area: f32) -> f32 {
+    let l = triangle_light[prim];
+    if (l == NONE) {
+        return 0.0;
+    }
+    let d = q - p;
+    let d2 = dot(d, d);
+    let cos_l = abs(dot(nq, normalize(d)));
+    if (cos_l <= 0.0 || area <= 0.0) {
+        return 0.0;
+    }
+    return light_pmf(l) * d2 / (cos_l * area);
+}
+
+fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
+    var ls: LightSample;
+    ls.pdf = 0.0;
+    ls.weight = vec3<f32>(0.0);
+    ls.dist = 0.0;
+    ls.wi = vec3<f32>(0.0, 0.0, 1.0);
+    if (frame.n_lights == 0u) {
+        return ls;
+    }
+    let i = min(cdf_search(frame.light_cdf, frame.n_lights + 1u, u0), frame.n_lights - 1u);
+    let pmf = light_pmf(i);
+    if (pmf <= 0.0) {
+        return ls;
+    }
+    let l = lights[i];
+    if (l.kind == LIGHT_POINT || l.kind == LIGHT_SPOT) {
+        let d = l.position.xyz - p;
+        let d2 = dot(d, d);
+        ls.dist = sqrt(d2);
+        ls.wi = d / ls.dist;
+        var falloff = 1.0;
+        if (l.kind == LIGHT_SPOT) {
+            // glTF: smooth attenuation between the outer and inner cone.
+            let c = dot(-ls.wi, l.direction.xyz);
+            let t = clamp((c - l.cos_outer) / max(l.cos_inner - l.cos_outer, 1e-4), 0.0, 1.0);
+            falloff = t * t;
+        }
+        ls.weight = l.intensity.xyz * falloff / (d2 * pmf);
+        ls.pdf = 0.0;
+    } else if (l.kind == LIGHT_DIRECTIONAL) {
+        ls.wi = -l.direction.xyz;
+        ls.dist = 4.0 * frame.scene_radius;
+        ls.weight = l.intensity.xyz / pmf;
+        ls.pdf = 0.0;
+    } else if (l.kind == LIGHT_TRIANGLE) {
+        let tri = triangles[l.prim];
+        let p0 = vertex(0u, tri.x).xyz;
+        let p1 = vertex(0u, tri.y).xyz;
+        let p2 = vertex(0u, tri.z).xyz;
+        // Uniform point on the triangle: b0 = 1 − √u0', b1 = u1 √u0'.
+        let su = sqrt(u.x);
+        let q = (1.0 - su) * p0 + su * (1.0 - u.y) * p1 + su * u.y * p2;
+        let c = cross(p1 - p0, p2 - p0);
+        let area = 0.5 * length(c);
+        let nq = normalize(c);
+        let d = q - p;
+        ls.dist = length(d);
+        ls.wi = d / ls.dist;
+        ls.pdf = triangle_light_pdf(l.prim, p, q, nq, area);
+        let m = materials[tri.w];
+        // One-sided emitters: only the front (counter-clockwise) side emits.
+        var le = m.emissive.xyz;
+        if (m.tex_emissive != NONE) {
+            let uv = (1.0 - su) * vertex(3u, tri.x).xy + su * (1.0 - u.y) * vertex(3u, tri.y).xy + su * u.y * vertex(3u, tri.z).xy;
+            le *= texture_sample(m.tex_emissive, uv).xyz;
+        }
+        if (dot(nq, -ls.wi) > 0.0 && ls.pdf > 0.0) {
+            ls.weight = le / ls.pdf;
+        } else {
+            ls.pdf = 0.0;
+        }
+    } else {
+        ls.wi = env_sample(u);
+        ls.dist = 4.0 * frame.scene_radius;
+        ls.pdf = pmf * env_pdf(ls.wi);
+        if (ls.pdf > 0.0) {
+            ls.weight = env_radiance(ls.wi) / ls.pdf;
+        }
+    }
+    return ls;
+}
+
+// The light index of the environment, if it is one of the lights.
+fn env_light_pmf() -> f32 {
+    for (var i = 0u; i < frame.n_lights; i++) {
+        if (lights[i].kind == LIGHT_ENVIRONMENT) {
+            return light_pmf(i);
+        }
+    }
+    return 0.0;
+}
+
+// Power heuristic, β = 2.
+fn mis_weight(a: f32, b: f32) -> f32 {
+    let a2 = a * a;
+    let b2 = b * b;
+    return select(1.0, a2 / (a2 + b2), a2 + b2 > 0.0);
+}

@@ -1,0 +1,118 @@
+// Shading stage of one glint material (Wang et al. 2018 over Jakob et al. 2014), dispatched once
+// per glint material with its own DPF pyramid levels:
+//   f = F(θd) G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo)   (glint/glint_brdf.inc.wgsl),
+// the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
+// N a P once that exceeds the threshold. Sampling: the smooth lobe, D cos θh.
+
+#include "render/frame.inc.wgsl"
+#include "common/microfacet.inc.wgsl"
+#include "render/bvh.inc.wgsl"
+#include "render/scene.inc.wgsl"
+#include "render/shade.inc.wgsl"
+#include "glint/tea.inc.wgsl"
+
+override Q_SHADE: u32;
+
+@group(2) @binding(0) var<uniform> field: Field;
+@group(2) @binding(1) var<uniform> params: EvalParams;
+@group(2) @binding(2) var level0: texture_3d<f32>;
+@group(2) @binding(3) var level1: texture_3d<f32>;
+
+#include "glint/flakes.inc.wgsl"
+#include "glint/glint_brdf.inc.wgsl"
+
+struct Bsdf {
+    material: u32,
+    ndf: AnalyticNdf,
+    center: vec2<f32>,
+    a: vec2<f32>,
+    b: vec2<f32>,
+}
+
+// A world vector in the tangent plane to UV: least squares through J = [dP/du dP/dv],
+// (JᵀJ)⁻¹ Jᵀ t.
+fn world_to_uv(s: Surface, t: vec3<f32>) -> vec2<f32> {
+    let a = dot(s.dpdu, s.dpdu);
+    let b = dot(s.dpdu, s.dpdv);
+    let c = dot(s.dpdv, s.dpdv);
+    let det = a * c - b * b;
+    let r = vec2<f32>(dot(s.dpdu, t), dot(s.dpdv, t));
+    return vec2<f32>(c * r.x - b * r.y, a * r.y - b * r.x) / det;
+}
+
+// Largest UV semi-axis: half the unit torus.
+const MAX_AXIS: f32 = 0.5;
+
+fn clamp_axis(v: vec2<f32>) -> vec2<f32> {
+    let l = length(v);
+    return select(v, v * (MAX_AXIS / l), l > MAX_AXIS);
+}
+
+fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
+    let m = materials[s.material];
+    var b: Bsdf;
+    b.material = s.material;
+    b.ndf = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
+    b.center = s.uv;
+    // The cone's circle of radius w/2 around the ray, projected onto the tangent plane: an
+    // ellipse with semi-axes r (across the ray) and r / |cos θ| (along it).
+    let d = path_get(R_DIR, slot).xyz;
+    let r = max(0.5 * path_get(R_ORIGIN, slot).w, 1e-7);
+    let cos_t = max(abs(dot(d, s.ng)), 0.05);
+    var along = d - s.ng * dot(d, s.ng);
+    if (dot(along, along) < 1e-12) {
+        along = s.t;
+    }
+    along = normalize(along);
+    let across = cross(s.ng, along);
+    let det = dot(s.dpdu, s.dpdu) * dot(s.dpdv, s.dpdv) - dot(s.dpdu, s.dpdv) * dot(s.dpdu, s.dpdv);
+    if (det > 1e-30) {
+        b.a = clamp_axis(world_to_uv(s, across * r));
+        b.b = clamp_axis(world_to_uv(s, along * (r / cos_t)));
+    } else {
+        // No UV mapping: the largest footprint, where the filter's mean takes over.
+        b.a = vec2<f32>(MAX_AXIS, 0.0);
+        b.b = vec2<f32>(0.0, MAX_AXIS);
+    }
+    // A degenerate ellipse has no area: give it a sliver so the count stays defined.
+    if (abs(b.a.x * b.b.y - b.a.y * b.b.x) < 1e-14) {
+        b.b += vec2<f32>(-b.a.y, b.a.x) * 1e-3 + vec2<f32>(1e-7, 1e-7);
+    }
+    return b;
+}
+
+fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    let k = glint_factor(wi, wo, b.center, b.a, b.b);
+    if (k == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let h = normalize(wi + wo);
+    return fresnel_table(materials[b.material], dot(wi, h)) * k;
+}
+
+fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+    if (wi.z <= 0.0 || wo.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wi + wo);
+    return ndf_d(b.ndf, h) * h.z / (4.0 * abs(dot(wo, h)));
+}
+
+fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
+    let h = ndf_sample(b.ndf, u.xy);
+    let wi = 2.0 * dot(wo, h) * h - wo;
+    return BsdfSample(wi, bsdf_eval(b, wi, wo), bsdf_pdf(b, wi, wo));
+}
+
+fn bsdf_roughness(b: Bsdf) -> f32 {
+    return sqrt(b.ndf.alpha_x * b.ndf.alpha_y);
+}
+
+@compute @workgroup_size(WG)
+fn shade_glint(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let slot = queue_slot(Q_SHADE, thread_index(gid, nwg));
+    if (slot == 0xffffffffu) {
+        return;
+    }
+    shade(slot);
+}

@@ -1,0 +1,114 @@
+// Shading stage of fitted microfacet materials (facet_fit::microfacet::MicrofacetBrdf):
+//   f = F(θd) D(h) G2(ωi, ωo) / (4 cos θi cos θo) + ρd / π,
+// F the fit's Fresnel table, D and Λ analytic (GGX / Beckmann, TABULATED = 0) or the fit's
+// tables (TABULATED = 1), the correlated G2. Sampling: D cos θh with probability p_spec, else
+// the cosine lobe when the fit has a diffuse term.
+
+#include "render/frame.inc.wgsl"
+#include "common/microfacet.inc.wgsl"
+#include "render/bvh.inc.wgsl"
+#include "render/scene.inc.wgsl"
+#include "render/shade.inc.wgsl"
+#include "render/tabulated.inc.wgsl"
+
+override Q_SHADE: u32;
+override TABULATED: bool;
+
+struct Bsdf {
+    material: u32,
+    analytic: AnalyticNdf,
+    tab: TabNdf,
+    diffuse: vec3<f32>,
+    p_spec: f32,
+}
+
+fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
+    let m = materials[s.material];
+    var b: Bsdf;
+    b.material = s.material;
+    b.analytic = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
+    if (TABULATED) {
+        b.tab = tab_ndf(m);
+    }
+    b.diffuse = m.diffuse.xyz;
+    // Lobe choice by albedo: the specular lobe's is at most ~F(0); compare with ρd.
+    let spec = luminance(fresnel_table(m, 1.0));
+    let diff = luminance(b.diffuse);
+    b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
+    return b;
+}
+
+fn mf_d(b: Bsdf, h: vec3<f32>) -> f32 {
+    if (TABULATED) {
+        return tab_d(b.tab, h);
+    }
+    return ndf_d(b.analytic, h);
+}
+
+fn mf_lambda(b: Bsdf, w: vec3<f32>) -> f32 {
+    if (TABULATED) {
+        return tab_lambda(b.tab, w);
+    }
+    return ndf_lambda(b.analytic, w);
+}
+
+// pdf of the sampled normal over solid angle (D cos θh for analytic NDFs).
+fn mf_pdf_h(b: Bsdf, h: vec3<f32>) -> f32 {
+    if (TABULATED) {
+        return tab_pdf(b.tab, h);
+    }
+    return ndf_d(b.analytic, h) * max(h.z, 0.0);
+}
+
+fn mf_sample_h(b: Bsdf, u: vec2<f32>) -> vec3<f32> {
+    if (TABULATED) {
+        return tab_sample(b.tab, u);
+    }
+    return ndf_sample(b.analytic, u);
+}
+
+fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    if (wi.z <= 0.0 || wo.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let h = normalize(wi + wo);
+    let f = fresnel_table(materials[b.material], dot(wi, h));
+    let g = g2_correlated(mf_lambda(b, wi), mf_lambda(b, wo), wi, wo);
+    return f * mf_d(b, h) * g / (4.0 * wi.z * wo.z) + b.diffuse / PI;
+}
+
+fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+    if (wi.z <= 0.0 || wo.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wi + wo);
+    // Reflection Jacobian: p(ωi) = p(h) / (4 |ωo·h|).
+    let spec = mf_pdf_h(b, h) / (4.0 * abs(dot(wo, h)));
+    return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
+}
+
+fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
+    var wi: vec3<f32>;
+    if (u.z < b.p_spec) {
+        let h = mf_sample_h(b, u.xy);
+        wi = 2.0 * dot(wo, h) * h - wo;
+    } else {
+        wi = sample_cosine(u.xy);
+    }
+    return BsdfSample(wi, bsdf_eval(b, wi, wo), bsdf_pdf(b, wi, wo));
+}
+
+fn bsdf_roughness(b: Bsdf) -> f32 {
+    let m = materials[b.material];
+    // m.roughness: the fit's effective α (GGX), the stretch included.
+    return mix(1.0, m.roughness, b.p_spec);
+}
+
+@compute @workgroup_size(WG)
+fn shade_microfacet(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let slot = queue_slot(Q_SHADE, thread_index(gid, nwg));
+    if (slot == 0xffffffffu) {
+        return;
+    }
+    shade(slot);
+}
