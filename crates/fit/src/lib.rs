@@ -29,6 +29,7 @@
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod albedo;
 pub mod analytic;
 pub mod brdf;
 pub mod error;
