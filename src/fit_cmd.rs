@@ -389,10 +389,9 @@ fn print_medians(rows: &[FittedMaterial], seconds: f64) {
 /// and fitted, so that `cargo run --release` shows the whole pipeline with no input file.
 pub const DEFAULT_MATERIAL: &str = "ggx?alpha=0.15&conductor=gold";
 
-pub fn run_default() -> Result<ExitCode> {
-    println!(
-        "facet: no command given; fitting the embedded default material analytic:{DEFAULT_MATERIAL}"
-    );
+/// Fits the embedded default material (sampled into a MERL table, then extracted and fitted),
+/// writes `default-gold-ggx.json` and its tables CSV into `out`, prints the summary.
+pub fn fit_default(out: &Path) -> Result<(FittedMaterial, std::path::PathBuf)> {
     println!(
         "        (sampled into a MERL table, then extracted and fitted; see `facet fit --help`)"
     );
@@ -411,9 +410,9 @@ pub fn run_default() -> Result<ExitCode> {
         backend,
     )?;
     fit.record.timings_ms.load = load_ms;
-    let out = Path::new("out");
-    std::fs::create_dir_all(out).context("creating out/")?;
-    fit.save(&out.join("default-gold-ggx.json"))?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let json = out.join("default-gold-ggx.json");
+    fit.save(&json)?;
     write_tables(&fit, &out.join("default-gold-ggx.tables.csv"))?;
     print_summary(std::slice::from_ref(&fit));
     let r = &fit.record;
@@ -433,6 +432,9 @@ pub fn run_default() -> Result<ExitCode> {
         r.iterations,
         r.residual
     );
-    println!("wrote out/default-gold-ggx.json and out/default-gold-ggx.tables.csv");
-    Ok(ExitCode::SUCCESS)
+    println!(
+        "wrote {} and default-gold-ggx.tables.csv",
+        json.display()
+    );
+    Ok((fit, json))
 }

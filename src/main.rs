@@ -1,7 +1,9 @@
 //! `facet`: measured materials to microfacet models.
 
+mod demo_cmd;
 mod dpf_cmd;
 mod fit_cmd;
+mod render_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -9,7 +11,7 @@ use clap::{Parser, Subcommand};
 #[command(
     name = "facet",
     version,
-    about = "Measured materials to microfacet models: NDF extraction, fitting, glint DPF tables"
+    about = "Measured materials to microfacet models: NDF extraction, fitting, glints, path-traced renders.\nWith no command, runs `facet demo`."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -22,6 +24,10 @@ enum Command {
     Fit(fit_cmd::FitArgs),
     /// The glint model's Directional Probability Function: one query, or the tables as EXR.
     Dpf(dpf_cmd::DpfArgs),
+    /// Path-trace a glTF scene (wavefront, on the GPU) to PNG and EXR.
+    Render(render_cmd::RenderArgs),
+    /// Fit the embedded default material and render the demo scene with it (the default).
+    Demo(demo_cmd::DemoArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -29,7 +35,9 @@ fn main() -> std::process::ExitCode {
     let result = match cli.command {
         Some(Command::Fit(args)) => fit_cmd::run(&args),
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
-        None => fit_cmd::run_default(),
+        Some(Command::Render(args)) => render_cmd::run(&args),
+        Some(Command::Demo(args)) => demo_cmd::run(&args),
+        None => demo_cmd::run(&demo_cmd::DemoArgs::default()),
     };
     match result {
         Ok(code) => code,

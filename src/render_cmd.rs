@@ -1,0 +1,254 @@
+//! `facet render`: a glTF scene through the wavefront path tracer to PNG + EXR.
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use facet_render::bvh::{BvhConfig, BvhPreset};
+use facet_render::camera::CameraFrame;
+use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
+use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};
+use glam::Vec3;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Args, Clone, Debug)]
+pub struct RenderArgs {
+    /// The scene: a glTF 2.0 file (.gltf or .glb).
+    pub scene: PathBuf,
+    /// Equirectangular environment map (EXR, Y up). Default: none, unless --env-color.
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// A constant environment radiance, "r,g,b" or one value (ignored with --env).
+    #[arg(long, value_name = "RGB")]
+    pub env_color: Option<String>,
+    /// Output image; the PNG and the EXR are both written, with this stem.
+    #[arg(long, default_value = "out/render.png")]
+    pub out: PathBuf,
+    #[arg(long, default_value_t = 960)]
+    pub width: u32,
+    #[arg(long, default_value_t = 540)]
+    pub height: u32,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 32)]
+    pub spp: u32,
+    /// Bounces after the camera ray.
+    #[arg(long, default_value_t = 5)]
+    pub max_depth: u32,
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
+    /// Stop after the pass during which this many seconds have passed.
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+    /// PNG exposure in stops (the EXR is always linear).
+    #[arg(long, default_value_t = 0.0)]
+    pub exposure: f32,
+    /// Camera by index or name (default: the first perspective camera).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Attach a fit JSON to the glTF material NAME (repeatable): NAME=FILE.
+    #[arg(long = "material", value_name = "NAME=FILE")]
+    pub materials: Vec<String>,
+    /// Paths in flight at once.
+    #[arg(long, default_value_t = 1 << 20)]
+    pub wavefront: u32,
+    /// BVH build preset.
+    #[arg(long, value_enum, default_value_t = PresetArg::Medium)]
+    pub bvh: PresetArg,
+    /// Count flakes everywhere (no mean above the glint threshold): slow, for comparison.
+    #[arg(long)]
+    pub no_glint_filter: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    Fastest,
+    VeryFast,
+    Fast,
+    Medium,
+    Slow,
+    VerySlow,
+}
+
+impl PresetArg {
+    fn preset(self) -> BvhPreset {
+        match self {
+            PresetArg::Fastest => BvhPreset::Fastest,
+            PresetArg::VeryFast => BvhPreset::VeryFast,
+            PresetArg::Fast => BvhPreset::Fast,
+            PresetArg::Medium => BvhPreset::Medium,
+            PresetArg::Slow => BvhPreset::Slow,
+            PresetArg::VerySlow => BvhPreset::VerySlow,
+        }
+    }
+}
+
+fn parse_rgb(s: &str) -> Result<Vec3> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .with_context(|| format!("--env-color {s:?}: expected r,g,b or one number"))?;
+    let c = match v.as_slice() {
+        [x] => Vec3::splat(*x),
+        [r, g, b] => Vec3::new(*r, *g, *b),
+        _ => bail!("--env-color {s:?}: expected r,g,b or one number"),
+    };
+    if !c.is_finite() || c.min_element() < 0.0 {
+        bail!("--env-color {s:?}: values must be finite and non-negative");
+    }
+    Ok(c)
+}
+
+/// The two outputs of `--out`: (png, exr).
+pub fn outputs(out: &Path) -> (PathBuf, PathBuf) {
+    (out.with_extension("png"), out.with_extension("exr"))
+}
+
+/// Everything a render needs, loaded and checked before the GPU is touched.
+pub struct Job {
+    pub scene: facet_render::scene::Scene,
+    pub environment: Option<Environment>,
+    pub config: RenderConfig,
+    pub resources: ResourceConfig,
+}
+
+pub fn prepare(args: &RenderArgs) -> Result<Job> {
+    let mut materials = Vec::new();
+    for m in &args.materials {
+        let (name, file) = m
+            .split_once('=')
+            .with_context(|| format!("--material {m:?}: expected NAME=FILE"))?;
+        materials.push((name.to_owned(), PathBuf::from(file)));
+    }
+    let inputs: Vec<&Path> = std::iter::once(args.scene.as_path())
+        .chain(args.env.as_deref())
+        .chain(materials.iter().map(|(_, f)| f.as_path()))
+        .collect();
+    let (png, exr) = outputs(&args.out);
+    for o in [&png, &exr] {
+        if inputs.iter().any(|i| same_file(i, o)) {
+            bail!("{}: the output would overwrite an input", o.display());
+        }
+    }
+    let options = LoadOptions {
+        camera: args.camera.clone(),
+        materials,
+    };
+    let scene = load_gltf(&args.scene, &options)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let environment = match (&args.env, &args.env_color) {
+        (Some(path), _) => {
+            let (map, warnings) = EnvironmentMap::load(path)?;
+            for w in warnings {
+                eprintln!("warning: {w}");
+            }
+            Some(Environment::Map(std::sync::Arc::new(map)))
+        }
+        (None, Some(c)) => Some(Environment::Constant(parse_rgb(c)?)),
+        (None, None) => None,
+    };
+    let config = RenderConfig {
+        width: args.width,
+        height: args.height,
+        spp: args.spp,
+        max_depth: args.max_depth,
+        seed: args.seed,
+        wavefront: args.wavefront,
+        time_limit: args.time_limit,
+        ..RenderConfig::standard()
+    };
+    let resources = ResourceConfig {
+        bvh: BvhConfig {
+            preset: args.bvh.preset(),
+        },
+        glint_filter: !args.no_glint_filter,
+        ..ResourceConfig::standard()
+    };
+    Ok(Job {
+        scene,
+        environment,
+        config,
+        resources,
+    })
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// Timings of one render, ms.
+pub struct Timings {
+    pub resources: f64,
+    pub pipelines: f64,
+    pub render: f64,
+    pub stats: facet_render::RenderStats,
+    pub built: facet_render::Built,
+}
+
+/// Renders a job and writes both outputs.
+pub fn render_job(job: &Job, out: &Path, exposure: f32) -> Result<Timings> {
+    let gpu = facet_gpu::Gpu::new().context("the renderer needs a GPU adapter")?;
+    println!("adapter: {}", gpu.describe());
+    let t = std::time::Instant::now();
+    let res = SceneResources::new(&gpu, &job.scene, job.environment.as_ref(), job.resources)?;
+    let resources = t.elapsed().as_secs_f64() * 1e3;
+    let t = std::time::Instant::now();
+    let integrator = Integrator::new(&gpu.device, &res)?;
+    let pipelines = t.elapsed().as_secs_f64() * 1e3;
+    let camera = CameraFrame::new(&job.scene.camera)?;
+    let bar = ProgressBar::new(1000);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed} (eta {eta})")
+            .expect("static template"),
+    );
+    let (image, stats) = integrator.render(&gpu, &res, &camera, &job.config, &mut |f| {
+        bar.set_position((f * 1000.0) as u64)
+    })?;
+    bar.finish_and_clear();
+    let (png, exr) = outputs(out);
+    image.write_png(&png, exposure)?;
+    image.write_exr(&exr)?;
+    println!("wrote {} and {}", png.display(), exr.display());
+    Ok(Timings {
+        resources,
+        pipelines,
+        render: stats.ms,
+        stats,
+        built: res.built.clone(),
+    })
+}
+
+pub fn print_timings(t: &Timings, triangles: usize) {
+    let b = &t.built;
+    println!(
+        "scene: {} triangles, BVH {} nodes in {:.0} ms; classes {:?}; glint pyramids {:?} in {:.0} ms; {} lights",
+        triangles,
+        b.bvh_nodes,
+        b.bvh_build_ms,
+        b.classes,
+        b.glint_pyramids,
+        b.glint_build_ms,
+        b.lights
+    );
+    println!(
+        "timings (ms): resources {:.0}, pipelines {:.0}, render {:.0} ({} spp, {} iterations, {:.2} Msamples/s)",
+        t.resources,
+        t.pipelines,
+        t.render,
+        t.stats.spp,
+        t.stats.iterations,
+        t.stats.samples as f64 / (t.render * 1e3)
+    );
+}
+
+pub fn run(args: &RenderArgs) -> Result<ExitCode> {
+    let job = prepare(args)?;
+    let timings = render_job(&job, &args.out, args.exposure)?;
+    print_timings(&timings, job.scene.indices.len());
+    Ok(ExitCode::SUCCESS)
+}
