@@ -10,6 +10,7 @@ use std::sync::Arc;
 
 pub mod environment;
 pub mod gltf_file;
+pub mod shapes;
 
 pub use environment::{Environment, EnvironmentMap};
 pub use gltf_file::{LoadOptions, load_gltf};
