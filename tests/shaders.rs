@@ -170,3 +170,50 @@ fn glint_eval_structs_match_naga() {
         );
     }
 }
+
+/// Every member of a WGSL struct at the offset of the Rust field of the same name.
+macro_rules! check_struct {
+    ($file:expr, $wgsl:expr, $rust:ty, [$($field:ident),* $(,)?]) => {{
+        let (size, members) = layout($file, $wgsl);
+        assert_eq!(size as usize, size_of::<$rust>(), "{} size", $wgsl);
+        $(
+            assert!(
+                members.contains(&(stringify!($field).to_string(), offset_of!($rust, $field) as u32)),
+                "{}.{}: {members:?}", $wgsl, stringify!($field)
+            );
+        )*
+        assert_eq!(members.len(), [$(stringify!($field)),*].len(), "{} members: {members:?}", $wgsl);
+    }};
+}
+
+#[test]
+fn render_structs_match_naga() {
+    use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial};
+    check_struct!(
+        "render/extend.wgsl",
+        "Frame",
+        GpuFrame,
+        [
+            width, height, tile_base, tile_pixels, wavefront, sample_end, max_depth, seed,
+            rr_depth, n_vertices, n_lights, light_cdf, env_kind, env_width, env_height,
+            env_texels, env_marginal, env_conditional, scene_radius, ray_epsilon, env_color,
+            cam_pos, cam_forward, cam_up, cam_right
+        ]
+    );
+    check_struct!(
+        "render/extend.wgsl",
+        "Material",
+        GpuMaterial,
+        [
+            base_color, emissive, diffuse, kind, ndf_kind, alpha_x, alpha_y, rotation, metallic,
+            roughness, normal_scale, tex_base, tex_mr, tex_normal, tex_emissive, fresnel_offset,
+            fresnel_count, tab_offset, queue
+        ]
+    );
+    check_struct!(
+        "render/extend.wgsl",
+        "Light",
+        GpuLight,
+        [kind, prim, cos_inner, cos_outer, position, direction, intensity]
+    );
+}

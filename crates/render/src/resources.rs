@@ -84,7 +84,7 @@ pub struct ResourceConfig {
 impl ResourceConfig {
     pub const fn standard() -> Self {
         ResourceConfig {
-            bvh: BvhConfig::standard(),
+            bvh: BvhConfig::medium(),
             dpf: DpfConfig::standard(),
             glint_filter: true,
         }

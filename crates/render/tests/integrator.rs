@@ -1,0 +1,323 @@
+//! The wavefront integrator against theory: white furnaces, the glints' smooth limit and their
+//! filtered switch, only-what-is-needed resources, determinism. GPU tests (lavapipe in CI).
+
+use facet_fit::material::FittedMaterial;
+use facet_fit::merl::{MerlBrdf, MerlTable};
+use facet_fit::microfacet::MicrofacetBrdf;
+use facet_gpu::{Gpu, gpu_for_tests};
+use facet_render::camera::CameraFrame;
+use facet_render::scene::{
+    Camera, Environment, FacetMaterial, FacetModel, GlintParams, Material, Scene,
+};
+use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources};
+use glam::{DVec3, Vec3, Vec4};
+use std::sync::{Arc, OnceLock};
+
+const SIZE: u32 = 64;
+const YFOV_DEG: f32 = 36.0;
+
+/// A unit sphere at the origin seen from +z at distance 3, filling most of the frame.
+fn sphere_scene(material: Material) -> Scene {
+    let mut s = Scene {
+        materials: vec![material],
+        camera: Camera {
+            position: Vec3::new(0.0, 0.0, 3.0),
+            forward: Vec3::NEG_Z,
+            up: Vec3::Y,
+            yfov: YFOV_DEG.to_radians(),
+        },
+        ..Default::default()
+    };
+    s.add_uv_sphere(Vec3::ZERO, 1.0, 256, 128, 0);
+    s
+}
+
+fn lambert(albedo: f32) -> Material {
+    Material {
+        name: "lambert".into(),
+        base_color: Vec4::new(albedo, albedo, albedo, 1.0),
+        metallic: 0.0,
+        roughness: 1.0,
+        specular: 0.0,
+        ..Default::default()
+    }
+}
+
+/// A fit of an analytic GGX α = 0.3 with every Fresnel table set to 1: a perfect conductor.
+fn conductor_fit() -> Arc<FittedMaterial> {
+    static FIT: OnceLock<Arc<FittedMaterial>> = OnceLock::new();
+    FIT.get_or_init(|| {
+        let model = facet_fit::analytic::parse_analytic("ggx?alpha=0.3&f0=1").unwrap();
+        let src = MerlBrdf::from_table("ggx-0.3", MerlTable::sample(&model)).unwrap();
+        let fit = facet_fit::fit_material(&src, "test", &facet_fit::FitConfig::isotropic()).unwrap();
+        let mut r = fit.record.clone();
+        let one = |t: &mut facet_fit::fresnel::FresnelTable| t.rgb.iter_mut().for_each(|c| *c = [1.0; 3]);
+        one(&mut r.fresnel);
+        r.ggx.as_mut().map(|p| one(&mut p.fresnel));
+        r.beckmann.as_mut().map(|p| one(&mut p.fresnel));
+        Arc::new(FittedMaterial::from_record(r).unwrap())
+    })
+    .clone()
+}
+
+fn facet_material(model: FacetModel, glint: Option<GlintParams>) -> Material {
+    Material {
+        name: format!("{model:?}"),
+        facet: Some(FacetMaterial {
+            source: "test-fit.json".into(),
+            fit: conductor_fit(),
+            model,
+            glint,
+        }),
+        ..Default::default()
+    }
+}
+
+fn render(
+    gpu: &Gpu,
+    scene: &Scene,
+    env: &Environment,
+    res_config: ResourceConfig,
+    config: RenderConfig,
+) -> (Image, facet_render::Built, Vec<&'static str>) {
+    let res = SceneResources::new(gpu, scene, Some(env), res_config).unwrap();
+    let integrator = Integrator::new(&gpu.device, &res).unwrap();
+    let camera = CameraFrame::new(&scene.camera).unwrap();
+    let (image, _) = integrator
+        .render(gpu, &res, &camera, &config, &mut |_| {})
+        .unwrap();
+    assert!(
+        image.pixels.iter().flatten().all(|v| v.is_finite()),
+        "non-finite pixel"
+    );
+    (image, res.built.clone(), integrator.stage_names())
+}
+
+fn config(spp: u32) -> RenderConfig {
+    RenderConfig {
+        width: SIZE,
+        height: SIZE,
+        spp,
+        max_depth: 8,
+        ..RenderConfig::preview()
+    }
+}
+
+/// The view direction's angle to the sphere's normal at pixel (x, y)'s centre, or None when the
+/// pixel is not well inside the silhouette (θo below `max_deg`).
+fn theta_o(x: u32, y: u32, max_deg: f64) -> Option<f64> {
+    let t = (YFOV_DEG as f64).to_radians() * 0.5;
+    let ndc = (
+        2.0 * (x as f64 + 0.5) / SIZE as f64 - 1.0,
+        1.0 - 2.0 * (y as f64 + 0.5) / SIZE as f64,
+    );
+    let o = DVec3::new(0.0, 0.0, 3.0);
+    let d = DVec3::new(ndc.0 * t.tan(), ndc.1 * t.tan(), -1.0).normalize();
+    // |o + s d| = 1
+    let b = o.dot(d);
+    let disc = b * b - (o.length_squared() - 1.0);
+    if disc <= 0.0 {
+        return None;
+    }
+    let n = (o + (-b - disc.sqrt()) * d).normalize();
+    let theta = n.dot(-d).clamp(-1.0, 1.0).acos();
+    (theta.to_degrees() < max_deg).then_some(theta)
+}
+
+#[test]
+fn white_furnace_lambert_sphere_is_one() {
+    let Some(gpu) = gpu_for_tests("white_furnace_lambert_sphere_is_one") else {
+        return;
+    };
+    let scene = sphere_scene(lambert(1.0));
+    let env = Environment::Constant(Vec3::ONE);
+    let (img, built, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(32));
+    let on = img.mean_where(|x, y| theta_o(x, y, 80.0).is_some());
+    let all = img.mean();
+    println!("furnace lambert: sphere {on:.4?}, image {all:.4?}");
+    for c in 0..3 {
+        assert!((on[c] - 1.0).abs() < 0.01, "sphere mean {on:?}");
+        assert!((all[c] - 1.0).abs() < 0.01, "image mean {all:?}");
+    }
+    assert_eq!(built.classes, vec!["diffuse"]);
+}
+
+/// A conductor with F = 1 under a uniform environment of radiance 1 renders its directional
+/// albedo E(θo), computed on the CPU by facet_fit::albedo for the same fitted model.
+#[test]
+fn white_furnace_conductor_matches_cpu_albedo() {
+    let Some(gpu) = gpu_for_tests("white_furnace_conductor_matches_cpu_albedo") else {
+        return;
+    };
+    let env = Environment::Constant(Vec3::ONE);
+    for model in [FacetModel::Ggx, FacetModel::Beckmann, FacetModel::Tabulated] {
+        let scene = sphere_scene(facet_material(model, None));
+        let (img, built, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(32));
+        let fit = conductor_fit();
+        let brdf: &MicrofacetBrdf = fit
+            .model(match model {
+                FacetModel::Ggx => facet_fit::material::ModelChoice::Ggx,
+                FacetModel::Beckmann => facet_fit::material::ModelChoice::Beckmann,
+                FacetModel::Tabulated => facet_fit::material::ModelChoice::Tabulated,
+            })
+            .unwrap();
+        // E(θo) tabulated every degree, interpolated per pixel.
+        let table: Vec<f64> = (0..=90)
+            .map(|deg| {
+                let t = (deg as f64).to_radians();
+                facet_fit::albedo::directional_albedo(brdf, DVec3::new(t.sin(), 0.0, t.cos()), 128)[0]
+            })
+            .collect();
+        let expect = |theta: f64| {
+            let x = theta.to_degrees();
+            let i = (x as usize).min(89);
+            table[i] + (x - i as f64) * (table[i + 1] - table[i])
+        };
+        let (mut sum_img, mut sum_cpu, mut n) = (0.0, 0.0, 0);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                if let Some(t) = theta_o(x, y, 70.0) {
+                    sum_img += img.pixels[(y * SIZE + x) as usize][0] as f64;
+                    sum_cpu += expect(t);
+                    n += 1;
+                }
+            }
+        }
+        let (gpu_mean, cpu_mean) = (sum_img / n as f64, sum_cpu / n as f64);
+        println!(
+            "furnace {model:?}: image {gpu_mean:.4}, CPU albedo {cpu_mean:.4} over {n} pixels ({:+.2} %), classes {:?}",
+            100.0 * (gpu_mean / cpu_mean - 1.0),
+            built.classes
+        );
+        assert!(
+            (gpu_mean / cpu_mean - 1.0).abs() < 0.01,
+            "{model:?}: {gpu_mean} vs {cpu_mean}"
+        );
+    }
+}
+
+#[test]
+fn scene_without_glints_builds_no_glint_resources() {
+    let Some(gpu) = gpu_for_tests("scene_without_glints_builds_no_glint_resources") else {
+        return;
+    };
+    let mut scene = sphere_scene(facet_material(FacetModel::Ggx, None));
+    // A glint material that no triangle uses costs nothing either.
+    scene.materials.push(facet_material(
+        FacetModel::Ggx,
+        Some(GlintParams {
+            density: 1e6,
+            gamma_deg: 2.0,
+            threshold: 50.0,
+        }),
+    ));
+    let res = SceneResources::new(&gpu, &scene, None, ResourceConfig::standard()).unwrap();
+    let integrator = Integrator::new(&gpu.device, &res).unwrap();
+    println!("built: {:?}, stages {:?}", res.built, integrator.stage_names());
+    assert!(res.built.glint_pyramids.is_empty());
+    assert!(res.glints.is_empty());
+    assert_eq!(res.built.classes, vec!["analytic"]);
+    assert!(!res.built.environment_map);
+    assert_eq!(res.built.tabulated_tables, 0);
+    assert_eq!(
+        integrator.stage_names(),
+        vec!["logic", "generate", "extend", "shade_microfacet", "connect"]
+    );
+}
+
+fn glint(density: f32, threshold: f32) -> Material {
+    facet_material(
+        FacetModel::Ggx,
+        Some(GlintParams {
+            density,
+            gamma_deg: 5.0,
+            threshold,
+        }),
+    )
+}
+
+/// With a huge flake density the glint material is its smooth model: the image means agree.
+#[test]
+fn glints_with_huge_density_render_the_smooth_model() {
+    let Some(gpu) = gpu_for_tests("glints_with_huge_density_render_the_smooth_model") else {
+        return;
+    };
+    let env = Environment::Constant(Vec3::ONE);
+    let (smooth, _, _) = render(
+        &gpu,
+        &sphere_scene(facet_material(FacetModel::Ggx, None)),
+        &env,
+        ResourceConfig::standard(),
+        config(16),
+    );
+    let (glinty, built, stages) = render(
+        &gpu,
+        &sphere_scene(glint(1e12, 50.0)),
+        &env,
+        ResourceConfig::standard(),
+        config(16),
+    );
+    let on = |x, y| theta_o(x, y, 70.0).is_some();
+    let (a, b) = (smooth.mean_where(on)[0], glinty.mean_where(on)[0]);
+    println!(
+        "glint smooth limit: smooth {a:.4}, glints (N = 1e12) {b:.4} ({:+.2} %); pyramid {:?}; stages {stages:?}",
+        100.0 * (b / a - 1.0),
+        built.glint_pyramids
+    );
+    assert!((b / a - 1.0).abs() < 0.02, "{b} vs {a}");
+    assert_eq!(built.glint_pyramids, vec![vec![5.0]]);
+}
+
+/// The filtered switch leaves no seam: counting everywhere, the mean everywhere and a threshold
+/// in the middle of the footprints' expected counts give the same image mean.
+#[test]
+fn glint_filter_switch_leaves_no_seam() {
+    let Some(gpu) = gpu_for_tests("glint_filter_switch_leaves_no_seam") else {
+        return;
+    };
+    let env = Environment::Constant(Vec3::ONE);
+    let density = 2e6;
+    let mut means = Vec::new();
+    for (label, threshold, filter) in [
+        ("counted", 0.0, false),
+        ("switch at 20", 20.0, true),
+        ("mean", 0.0, true),
+    ] {
+        let rc = ResourceConfig {
+            glint_filter: filter,
+            ..ResourceConfig::standard()
+        };
+        let (img, _, _) = render(&gpu, &sphere_scene(glint(density, threshold)), &env, rc, config(16));
+        let m = img.mean_where(|x, y| theta_o(x, y, 70.0).is_some())[0];
+        println!("glint {label}: mean {m:.4}");
+        means.push(m);
+    }
+    for m in &means[..2] {
+        assert!((m / means[2] - 1.0).abs() < 0.03, "{means:?}");
+    }
+}
+
+#[test]
+fn same_seed_same_image() {
+    let Some(gpu) = gpu_for_tests("same_seed_same_image") else {
+        return;
+    };
+    let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
+    let scene = sphere_scene(facet_material(FacetModel::Tabulated, None));
+    let c = RenderConfig {
+        wavefront: 1000, // several tiles
+        ..config(4)
+    };
+    let (a, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
+    let (b, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
+    let (other, _, _) = render(
+        &gpu,
+        &scene,
+        &env,
+        ResourceConfig::standard(),
+        RenderConfig { seed: 7, ..c },
+    );
+    assert_eq!(a.pixels, b.pixels);
+    assert_ne!(a.pixels, other.pixels);
+    assert!(a.samples.iter().all(|&s| s == 4));
+}
