@@ -217,3 +217,62 @@ fn render_structs_match_naga() {
         [kind, prim, cos_inner, cos_outer, position, direction, intensity]
     );
 }
+
+#[test]
+fn trace_structs_match_naga() {
+    use facet_render::obvhs::cwbvh::node::CwBvhNode;
+    use facet_render::trace::{GpuHit, GpuRay};
+    let file = "render/trace.wgsl";
+    let (size, members) = layout(file, "Ray");
+    assert_eq!(size as usize, size_of::<GpuRay>());
+    for (name, off) in [
+        ("origin", offset_of!(GpuRay, origin)),
+        ("tmin", offset_of!(GpuRay, tmin)),
+        ("dir", offset_of!(GpuRay, dir)),
+        ("tmax", offset_of!(GpuRay, tmax)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Ray.{name}: {members:?}"
+        );
+    }
+    let (size, members) = layout(file, "Hit");
+    assert_eq!(size as usize, size_of::<GpuHit>());
+    for (name, off) in [
+        ("t", offset_of!(GpuHit, t)),
+        ("prim", offset_of!(GpuHit, prim)),
+        ("u", offset_of!(GpuHit, u)),
+        ("v", offset_of!(GpuHit, v)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "Hit.{name}: {members:?}"
+        );
+    }
+    // obvhs's node is uploaded as it is: WGSL CwNode packs its u8 fields into u32 words.
+    let (size, members) = layout(file, "CwNode");
+    assert_eq!(size as usize, size_of::<CwBvhNode>());
+    for (name, off) in [
+        ("p", offset_of!(CwBvhNode, p)),
+        ("e_imask", offset_of!(CwBvhNode, e)),
+        ("child_base_idx", offset_of!(CwBvhNode, child_base_idx)),
+        (
+            "primitive_base_idx",
+            offset_of!(CwBvhNode, primitive_base_idx),
+        ),
+        ("child_meta", offset_of!(CwBvhNode, child_meta)),
+        ("child_min_x", offset_of!(CwBvhNode, child_min_x)),
+        ("child_max_x", offset_of!(CwBvhNode, child_max_x)),
+        ("child_min_y", offset_of!(CwBvhNode, child_min_y)),
+        ("child_max_y", offset_of!(CwBvhNode, child_max_y)),
+        ("child_min_z", offset_of!(CwBvhNode, child_min_z)),
+        ("child_max_z", offset_of!(CwBvhNode, child_max_z)),
+    ] {
+        assert!(
+            members.contains(&(name.to_string(), off as u32)),
+            "CwNode.{name}: {members:?}"
+        );
+    }
+    // imask is the byte after e[0..3], the top byte of the e_imask word.
+    assert_eq!(offset_of!(CwBvhNode, imask), offset_of!(CwBvhNode, e) + 3);
+}

@@ -27,10 +27,15 @@ pub mod integrator;
 pub mod queues;
 pub mod resources;
 pub mod scene;
+pub mod procedural;
 pub mod stages;
 pub mod trace;
 
+pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use error::RenderError;
 pub use film::Image;
 pub use integrator::{Integrator, RenderConfig, RenderStats};
+/// The BVH library, whose types [`Bvh`] exposes.
+pub use obvhs;
 pub use resources::{Built, ResourceConfig, SceneResources};
+pub use trace::{GpuHit, GpuRay, RayTracer};

@@ -1,0 +1,243 @@
+//! Host driver of `shaders/render/trace.wgsl`: closest-hit and any-hit queries for a batch of
+//! rays against a [`GpuBvh`], one thread per ray. The CPU reference is
+//! [`Bvh::closest_hit`](crate::bvh::Bvh::closest_hit) / [`Bvh::occluded`](crate::bvh::Bvh::occluded).
+
+use crate::bvh::GpuBvh;
+use bytemuck::{Pod, Zeroable};
+use facet_gpu::{GpuError, buffer, dispatch, shader};
+
+const SHADER: &str = "render/trace.wgsl";
+
+/// One ray (WGSL `Ray`, 32 bytes). `dir` need not be unit length: t is in units of `dir`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuRay {
+    pub origin: [f32; 3],
+    /// Unused, keep 0 (triangles count from t = 0, nodes from t = 1e-4, as in obvhs).
+    pub tmin: f32,
+    pub dir: [f32; 3],
+    /// Hits count at t < tmax; `f32::INFINITY` for an unbounded ray.
+    pub tmax: f32,
+}
+
+impl GpuRay {
+    pub fn new(origin: glam::Vec3, dir: glam::Vec3, tmax: f32) -> Self {
+        GpuRay {
+            origin: origin.into(),
+            tmin: 0.0,
+            dir: dir.into(),
+            tmax,
+        }
+    }
+}
+
+/// One closest hit (WGSL `Hit`, 16 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct GpuHit {
+    /// The hit's t; the ray's tmax on a miss.
+    pub t: f32,
+    /// Original triangle index, [`GpuHit::MISS`] on a miss.
+    pub prim: u32,
+    /// Barycentrics: p = (1−u−v)·v0 + u·v1 + v·v2.
+    pub u: f32,
+    pub v: f32,
+}
+
+impl GpuHit {
+    pub const MISS: u32 = u32::MAX;
+
+    pub fn is_hit(&self) -> bool {
+        self.prim != Self::MISS
+    }
+}
+
+/// Rays per dispatch when a batch is split: a multiple of 1024 keeps every sub-binding's offset
+/// (32, 16 and 4 bytes per element) a multiple of the 256-byte storage offset alignment.
+const CHUNK_ALIGN: u64 = 1024;
+
+/// The two pipelines of `trace.wgsl`.
+pub struct RayTracer {
+    closest: wgpu::ComputePipeline,
+    any: wgpu::ComputePipeline,
+    workgroup_size: u32,
+}
+
+impl RayTracer {
+    pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        Ok(RayTracer {
+            closest: shader::compute_pipeline(device, SHADER, "trace_closest_rays", &[])?,
+            any: shader::compute_pipeline(device, SHADER, "trace_any_rays", &[])?,
+            workgroup_size: shader::workgroup_size(SHADER, "trace_closest_rays")?,
+        })
+    }
+
+    /// Most rays one dispatch takes: the ray binding (32 bytes a ray) within the device's
+    /// storage binding limit, rounded down to [`CHUNK_ALIGN`].
+    pub fn max_rays_per_dispatch(device: &wgpu::Device) -> u64 {
+        let limit = device.limits().max_storage_buffer_binding_size;
+        (limit / size_of::<GpuRay>() as u64 / CHUNK_ALIGN * CHUNK_ALIGN).max(CHUNK_ALIGN)
+    }
+
+    /// Closest hits of `rays` (uploads, runs, reads back; batched past the binding limit).
+    pub fn trace_closest(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        bvh: &GpuBvh,
+        rays: &[GpuRay],
+    ) -> Result<Vec<GpuHit>, GpuError> {
+        self.trace_batches(
+            device,
+            queue,
+            rays,
+            size_of::<GpuHit>(),
+            |enc, r, out, n| self.encode_closest(device, enc, bvh, r, out, n),
+        )
+    }
+
+    /// 1 where a triangle lies at t < tmax along the ray, else 0.
+    pub fn trace_any(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        bvh: &GpuBvh,
+        rays: &[GpuRay],
+    ) -> Result<Vec<u32>, GpuError> {
+        self.trace_batches(device, queue, rays, size_of::<u32>(), |enc, r, out, n| {
+            self.encode_any(device, enc, bvh, r, out, n)
+        })
+    }
+
+    fn trace_batches<T: Pod>(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        rays: &[GpuRay],
+        out_size: usize,
+        encode: impl Fn(&mut wgpu::CommandEncoder, &wgpu::Buffer, &wgpu::Buffer, u32),
+    ) -> Result<Vec<T>, GpuError> {
+        // One upload per chunk keeps host-side buffers within the per-buffer limit too.
+        let chunk = Self::max_rays_per_dispatch(device) as usize;
+        let mut out = Vec::with_capacity(rays.len());
+        for part in rays.chunks(chunk) {
+            let ray_buf = buffer::storage(device, "rays", part);
+            let out_buf =
+                buffer::storage_zeroed(device, "trace out", (part.len() * out_size) as u64);
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("trace"),
+            });
+            encode(&mut encoder, &ray_buf, &out_buf, part.len() as u32);
+            queue.submit([encoder.finish()]);
+            out.extend(buffer::read::<T>(device, queue, &out_buf, part.len())?);
+        }
+        Ok(out)
+    }
+
+    /// Encodes closest-hit queries for the first `count` rays of `rays` (WGSL `Ray`s) into the
+    /// first `count` entries of `hits` (WGSL `Hit`s), without submitting: for callers that keep
+    /// rays on the GPU (benchmarks, the extend stage).
+    pub fn encode_closest(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        bvh: &GpuBvh,
+        rays: &wgpu::Buffer,
+        hits: &wgpu::Buffer,
+        count: u32,
+    ) {
+        self.encode(
+            device,
+            encoder,
+            &self.closest,
+            bvh,
+            rays,
+            (4, hits, size_of::<GpuHit>()),
+            true,
+            count,
+        );
+    }
+
+    /// As [`RayTracer::encode_closest`] for any-hit queries: one u32 per ray into `occluded`.
+    pub fn encode_any(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        bvh: &GpuBvh,
+        rays: &wgpu::Buffer,
+        occluded: &wgpu::Buffer,
+        count: u32,
+    ) {
+        self.encode(
+            device,
+            encoder,
+            &self.any,
+            bvh,
+            rays,
+            (5, occluded, size_of::<u32>()),
+            false,
+            count,
+        );
+    }
+
+    /// One compute pass; several dispatches over sub-ranges when `count` exceeds what one ray
+    /// binding holds. `out` is (binding, buffer, bytes per ray). Layouts come from the shader,
+    /// so a binding an entry point does not use (any-hit never reads `bvh_primitives`) is left
+    /// out: `uses_primitives`.
+    #[allow(clippy::too_many_arguments)]
+    fn encode(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        bvh: &GpuBvh,
+        rays: &wgpu::Buffer,
+        out: (u32, &wgpu::Buffer, usize),
+        uses_primitives: bool,
+        count: u32,
+    ) {
+        let (out_binding, out_buf, out_size) = out;
+        let layout = pipeline.get_bind_group_layout(0);
+        let chunk = Self::max_rays_per_dispatch(device);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("trace"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        let mut start = 0u64;
+        while start < count as u64 {
+            let n = chunk.min(count as u64 - start);
+            let mut entries = vec![
+                entry(0, bvh.nodes.as_entire_binding()),
+                entry(2, bvh.triangles.as_entire_binding()),
+                entry(3, sub_range(rays, start, n, size_of::<GpuRay>())),
+                entry(out_binding, sub_range(out_buf, start, n, out_size)),
+            ];
+            if uses_primitives {
+                entries.push(entry(1, bvh.primitives.as_entire_binding()));
+            }
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("trace"),
+                layout: &layout,
+                entries: &entries,
+            });
+            pass.set_bind_group(0, &bind_group, &[]);
+            let (x, y) = dispatch::workgroups(n as u32, self.workgroup_size);
+            pass.dispatch_workgroups(x, y, 1);
+            start += n;
+        }
+    }
+}
+
+fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource }
+}
+
+/// Elements [start, start + n) of a buffer of `size`-byte elements.
+fn sub_range(buffer: &wgpu::Buffer, start: u64, n: u64, size: usize) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer,
+        offset: start * size as u64,
+        size: wgpu::BufferSize::new(n * size as u64),
+    })
+}
