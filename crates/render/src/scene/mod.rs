@@ -8,8 +8,11 @@ use glam::{Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
 
+pub mod data_uri;
 pub mod environment;
 pub mod gltf_file;
+pub mod gltf_material;
+pub mod mesh;
 
 pub use environment::{Environment, EnvironmentMap};
 pub use gltf_file::{LoadOptions, load_gltf};
@@ -48,6 +51,18 @@ pub struct Camera {
     pub up: Vec3,
     /// Vertical field of view, radians.
     pub yfov: f32,
+}
+
+impl Default for Camera {
+    /// At the origin looking down −Z with +Y up, 45° yfov (glTF's camera convention).
+    fn default() -> Self {
+        Camera {
+            position: Vec3::ZERO,
+            forward: Vec3::NEG_Z,
+            up: Vec3::Y,
+            yfov: std::f32::consts::FRAC_PI_4,
+        }
+    }
 }
 
 /// A glTF metallic-roughness material, optionally replaced by a Facet material.
@@ -143,7 +158,10 @@ pub enum Light {
         outer_cone: f32,
     },
     /// `direction` is where the light travels (glTF: the node's −Z).
-    Directional { direction: Vec3, irradiance: Vec3 },
+    Directional {
+        direction: Vec3,
+        irradiance: Vec3,
+    },
 }
 
 impl Scene {
