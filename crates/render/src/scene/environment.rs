@@ -43,7 +43,8 @@ pub fn direction_to_uv(d: Vec3) -> Vec2 {
     if phi < 0.0 {
         phi += 2.0 * PI;
     }
-    let theta = d.y.clamp(-1.0, 1.0).acos();
+    // θ = acos(d.y), computed as atan2(√(x² + z²), y): acos loses precision near the poles.
+    let theta = d.x.hypot(d.z).atan2(d.y);
     // atan2 can return exactly π after rounding of a tiny negative angle + 2π: keep u < 1.
     Vec2::new((phi / (2.0 * PI)).min(1.0 - f32::EPSILON / 2.0), theta / PI)
 }
@@ -207,29 +208,32 @@ impl EnvironmentMap {
     /// (0 at the poles, where sin θ = 0).
     pub fn pdf(&self, d: Vec3) -> f32 {
         let (x, y) = self.pixel(d);
-        let sin_theta = (1.0 - d.y * d.y).max(0.0).sqrt();
-        self.solid_angle_pdf(self.pixel_probability(x, y), sin_theta)
-    }
-
-    fn solid_angle_pdf(&self, p_xy: f32, sin_theta: f32) -> f32 {
-        if sin_theta <= 0.0 {
+        // sin θ = √(x² + z²), accurate near the poles (unlike √(1 − y²)).
+        let sin_theta = d.x.hypot(d.z);
+        if !(sin_theta > 0.0) {
             return 0.0;
         }
+        let p_xy = self.pixel_probability(x, y);
         p_xy * (self.width as f32 * self.height as f32) / (2.0 * PI * PI * sin_theta)
     }
 
     /// Importance-samples a direction from `u ∈ [0, 1)²`: returns (direction, solid-angle pdf,
     /// radiance). Row from `u.y` by the marginal CDF, column from `u.x` by that row's CDF, each
-    /// with a continuous offset inside its cell. A pdf of 0 (a pole, measure zero) means: discard.
+    /// with a continuous offset inside its cell.
+    ///
+    /// The pdf and radiance returned are `pdf(d)` and `lookup(d)` exactly, so that MIS weights
+    /// agree whichever strategy produced `d`. (A point within f32 rounding of a pixel edge may
+    /// land in the neighbour pixel; that pixel's values are then used, a bias of order 10⁻⁵.)
+    /// A pdf of 0 (a pole, or a rounding into a zero-probability pixel) means: discard.
     pub fn sample(&self, u: Vec2) -> (Vec3, f32, Vec3) {
         let (w, h) = (self.width as usize, self.height as usize);
         let (y, fy) = sample_cdf(&self.marginal_cdf, u.y);
         let (x, fx) = sample_cdf(&self.conditional_cdf[y * (w + 1)..(y + 1) * (w + 1)], u.x);
-        let uv = Vec2::new((x as f32 + fx) / w as f32, (y as f32 + fy) / h as f32);
-        let d = uv_to_direction(uv);
-        let sin_theta = (PI * uv.y).sin();
-        let pdf = self.solid_angle_pdf(self.pixel_probability(x, y), sin_theta);
-        (d, pdf, self.texels[y * w + x])
+        let d = uv_to_direction(Vec2::new(
+            (x as f32 + fx) / w as f32,
+            (y as f32 + fy) / h as f32,
+        ));
+        (d, self.pdf(d), self.lookup(d))
     }
 }
 

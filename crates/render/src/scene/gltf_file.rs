@@ -218,7 +218,7 @@ fn add_mesh(
             Some(it) => it.into_u32().collect(),
             None => (0..n as u32).collect(),
         };
-        if flat.len() % 3 != 0 {
+        if !flat.len().is_multiple_of(3) {
             return Err(bad(&format!(
                 "{} indices is not a multiple of 3",
                 flat.len()

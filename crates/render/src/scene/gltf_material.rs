@@ -101,6 +101,9 @@ fn parse_glint(g: &Value) -> Result<GlintParams, String> {
     Ok(p)
 }
 
+/// A decoded image: width, height, RGBA8 texels row by row.
+type Decoded = (u32, u32, Vec<[u8; 4]>);
+
 /// Builds every material of the document (same indices), its textures and Facet fits.
 pub(crate) struct MaterialLoader<'a> {
     pub gltf_path: &'a Path,
@@ -108,7 +111,7 @@ pub(crate) struct MaterialLoader<'a> {
     /// `--material NAME=FILE` overrides.
     pub overrides: &'a [(String, PathBuf)],
     /// Decoded images by image index (`None`: not tried yet).
-    images: HashMap<usize, Result<(u32, u32, Vec<[u8; 4]>), String>>,
+    images: HashMap<usize, Result<Decoded, String>>,
     /// Scene texture index by (image index, sRGB).
     textures: HashMap<(usize, bool), u32>,
     fits: HashMap<PathBuf, Arc<FittedMaterial>>,
@@ -324,7 +327,7 @@ fn decode_image(
     image: &gltf::Image,
     gltf_path: &Path,
     buffers: &[gltf::buffer::Data],
-) -> Result<(u32, u32, Vec<[u8; 4]>), String> {
+) -> Result<Decoded, String> {
     let bytes: Vec<u8> = match image.source() {
         gltf::image::Source::Uri { uri, .. } => match decode_data_uri(uri) {
             Some(decoded) => decoded?,
