@@ -40,7 +40,9 @@ fn child_under_rotated_scaled_parent_is_placed_in_world() {
         Vec3::new(1.0, 2.0, 3.0),
     );
     // The child uses the matrix form, the parent TRS.
-    let child = Mat4::from_translation(Vec3::new(1.0, 0.0, -2.0)) * Mat4::from_rotation_z(0.3);
+    let child = Mat4::from_translation(Vec3::new(1.0, 0.0, -2.0))
+        * Mat4::from_rotation_x(0.6)
+        * Mat4::from_rotation_z(0.3);
     let c = g.node(json!({"mesh": mesh, "matrix": child.to_cols_array()}));
     let root = g.node(json!({"children": [c], "translation": [1.0, 2.0, 3.0],
         "rotation": parent_q.to_array(), "scale": [2.0, 0.5, 1.5]}));
