@@ -8,8 +8,11 @@ use glam::{Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
 
+pub mod data_uri;
 pub mod environment;
 pub mod gltf_file;
+pub mod gltf_material;
+pub mod mesh;
 pub mod shapes;
 
 pub use environment::{Environment, EnvironmentMap};
@@ -51,6 +54,18 @@ pub struct Camera {
     pub yfov: f32,
 }
 
+impl Default for Camera {
+    /// At the origin looking down −Z with +Y up, 45° yfov (glTF's camera convention).
+    fn default() -> Self {
+        Camera {
+            position: Vec3::ZERO,
+            forward: Vec3::NEG_Z,
+            up: Vec3::Y,
+            yfov: std::f32::consts::FRAC_PI_4,
+        }
+    }
+}
+
 /// A glTF metallic-roughness material, optionally replaced by a Facet material.
 #[derive(Clone, Debug)]
 pub struct Material {
@@ -60,6 +75,9 @@ pub struct Material {
     pub base_color_texture: Option<u32>,
     pub metallic: f32,
     pub roughness: f32,
+    /// Weight of the dielectric specular layer (KHR_materials_specular `specularFactor`, 1 when
+    /// absent); 0 with metallic 0 makes a pure Lambertian surface. Its texture is not read.
+    pub specular: f32,
     /// glTF layout: roughness in G, metallic in B.
     pub metallic_roughness_texture: Option<u32>,
     pub normal_texture: Option<u32>,
@@ -79,6 +97,7 @@ impl Default for Material {
             base_color_texture: None,
             metallic: 0.0,
             roughness: 1.0,
+            specular: 1.0,
             metallic_roughness_texture: None,
             normal_texture: None,
             normal_scale: 1.0,
@@ -144,7 +163,10 @@ pub enum Light {
         outer_cone: f32,
     },
     /// `direction` is where the light travels (glTF: the node's −Z).
-    Directional { direction: Vec3, irradiance: Vec3 },
+    Directional {
+        direction: Vec3,
+        irradiance: Vec3,
+    },
 }
 
 impl Scene {
