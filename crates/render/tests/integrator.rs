@@ -276,7 +276,7 @@ fn glint_filter_switch_leaves_no_seam() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    let density = 2e6;
+    let density = 5e7;
     let mut means = Vec::new();
     for (label, threshold, filter) in [
         ("counted", 0.0, false),
