@@ -174,3 +174,88 @@ fn dpf_query_and_exr_slices() {
     let (ok, _, stderr) = facet(&["dpf", "--ndf", "analytic:ggx?alpha=0.3", "--gamma", "5"]);
     assert!(!ok && stderr.contains("--theta-o"), "{stderr}");
 }
+
+/// `facet render` on bad inputs: each error names the file and nothing is written.
+#[test]
+fn render_bad_inputs_name_the_file() {
+    let dir = std::env::temp_dir().join(format!("facet-cli-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("img.png");
+    let out_s = out.to_str().unwrap();
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let not_gltf = dir.join("broken.gltf");
+    std::fs::write(&not_gltf, "{ this is not json").unwrap();
+    let bad_fit = dir.join("bad_fit.json");
+    std::fs::write(&bad_fit, "{\"name\": 3}").unwrap();
+    let cases: Vec<(Vec<String>, String)> = vec![
+        (vec!["render".into(), "no/such/scene.gltf".into()], "no/such/scene.gltf".into()),
+        (vec!["render".into(), not_gltf.display().to_string()], "broken.gltf".into()),
+        (
+            vec!["render".into(), demo.into(), "--env".into(), "no/such/sky.exr".into()],
+            "no/such/sky.exr".into(),
+        ),
+        (
+            vec![
+                "render".into(),
+                demo.into(),
+                "--material".into(),
+                format!("ggx={}", bad_fit.display()),
+            ],
+            "bad_fit.json".into(),
+        ),
+        (
+            vec!["render".into(), demo.into(), "--material".into(), "nosuch=x.json".into()],
+            "nosuch".into(),
+        ),
+        (
+            // The EXR beside the PNG would be the environment map itself.
+            vec![
+                "render".into(),
+                demo.into(),
+                "--env".into(),
+                demo.replace("demo.gltf", "sky.exr"),
+                "--out".into(),
+                demo.replace("demo.gltf", "sky.png"),
+            ],
+            "overwrite".into(),
+        ),
+    ];
+    for (args, needle) in cases {
+        let mut a: Vec<&str> = args.iter().map(String::as_str).collect();
+        if !a.contains(&"--out") {
+            a.extend(["--out", out_s]);
+        }
+        let (ok, _, err) = facet(&a);
+        assert!(!ok, "{a:?} succeeded");
+        assert!(err.contains(&needle), "{a:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        println!("{a:?} -> {}", err.trim());
+    }
+    assert!(!out.exists() && !out.with_extension("exr").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// `facet render` of the committed demo scene, small: both files, an image that is not black.
+#[test]
+fn render_demo_scene_writes_png_and_exr() {
+    if facet_gpu::gpu_for_tests("render_demo_scene_writes_png_and_exr").is_none() {
+        return;
+    }
+    let dir = std::env::temp_dir().join(format!("facet-cli-demo-{}", std::process::id()));
+    let out = dir.join("demo.png");
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let sky = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/sky.exr");
+    let (ok, stdout, err) = facet(&[
+        "render", demo, "--env", sky, "--width", "64", "--height", "36", "--spp", "2", "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{err}");
+    println!("{stdout}");
+    let png = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (64, 36));
+    let mean: f64 = png.pixels().map(|p| p.0[1] as f64).sum::<f64>() / (64.0 * 36.0);
+    assert!(mean > 20.0 && mean < 250.0, "mean green {mean}");
+    assert!(out.with_extension("exr").exists());
+    assert!(stdout.contains("classes [\"diffuse\", \"analytic\", \"tabulated\", \"glint\"]"));
+    std::fs::remove_dir_all(&dir).ok();
+}

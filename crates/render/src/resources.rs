@@ -118,6 +118,7 @@ impl SceneResources {
         environment: Option<&Environment>,
         config: ResourceConfig,
     ) -> Result<Self, RenderError> {
+        validate(scene)?;
         let d = &gpu.device;
         let mut built = Built::default();
         let mut tables = Tables::default();
@@ -494,4 +495,68 @@ impl SceneResources {
         }
         Ok(res)
     }
+}
+
+/// The invariants the GPU code relies on; a scene from the loader always meets them, one built in
+/// code might not.
+pub fn validate(scene: &Scene) -> Result<(), RenderError> {
+    let n = scene.positions.len();
+    let bad = |what: String| Err(RenderError::Scene(what));
+    if scene.indices.is_empty() {
+        return bad("the scene has no triangles".into());
+    }
+    if scene.normals.len() != n || scene.uvs.len() != n || scene.tangents.len() != n {
+        return bad(format!(
+            "{n} positions but {} normals, {} uvs, {} tangents",
+            scene.normals.len(),
+            scene.uvs.len(),
+            scene.tangents.len()
+        ));
+    }
+    if scene.triangle_material.len() != scene.indices.len() {
+        return bad("one material per triangle is needed".into());
+    }
+    if let Some(i) = (0..n).find(|&i| {
+        !(scene.positions[i].is_finite()
+            && scene.normals[i].is_finite()
+            && scene.uvs[i].is_finite()
+            && scene.tangents[i].is_finite())
+    }) {
+        return bad(format!("vertex {i} is not finite"));
+    }
+    if let Some((t, _)) = scene
+        .indices
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
+    {
+        return bad(format!("triangle {t} indexes past the {n} vertices"));
+    }
+    if let Some(t) = scene
+        .triangle_material
+        .iter()
+        .position(|&m| m as usize >= scene.materials.len())
+    {
+        return bad(format!("triangle {t} has no material"));
+    }
+    if let Some(m) = scene.materials.iter().find(|m| {
+        [m.base_color_texture, m.metallic_roughness_texture, m.normal_texture, m.emissive_texture]
+            .iter()
+            .flatten()
+            .any(|&t| t as usize >= scene.textures.len())
+    }) {
+        return bad(format!("material {:?} names a missing texture", m.name));
+    }
+    let glints = scene
+        .materials
+        .iter()
+        .filter(|m| m.facet.as_ref().is_some_and(|f| f.glint.is_some()))
+        .count();
+    if glints > crate::queues::MAX_GLINT_MATERIALS as usize {
+        return bad(format!(
+            "{glints} glint materials; at most {} are supported",
+            crate::queues::MAX_GLINT_MATERIALS
+        ));
+    }
+    Ok(())
 }

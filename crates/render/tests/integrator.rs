@@ -321,3 +321,18 @@ fn same_seed_same_image() {
     assert_ne!(a.pixels, other.pixels);
     assert!(a.samples.iter().all(|&s| s == 4));
 }
+
+/// A scene built in code with a NaN vertex or an index out of range is refused with a message,
+/// before anything reaches the GPU.
+#[test]
+fn broken_scenes_are_refused() {
+    let mut scene = sphere_scene(lambert(0.5));
+    scene.positions[10].x = f32::NAN;
+    let err = facet_render::resources::validate(&scene).unwrap_err().to_string();
+    assert!(err.contains("vertex 10"), "{err}");
+    let mut scene = sphere_scene(lambert(0.5));
+    scene.indices[3][1] = 1 << 30;
+    let err = facet_render::resources::validate(&scene).unwrap_err().to_string();
+    assert!(err.contains("triangle 3"), "{err}");
+    assert!(facet_render::resources::validate(&sphere_scene(lambert(0.5))).is_ok());
+}
