@@ -25,6 +25,14 @@ impl Scene {
             .extend(std::iter::repeat_n(material, indices.len()));
     }
 
+    /// Appends bare triangles: area-weighted vertex normals, zero UVs, generated tangents.
+    pub fn add_triangles(&mut self, positions: &[Vec3], indices: &[[u32; 3]], material: u32) {
+        let normals = super::mesh::generate_normals(positions, indices);
+        let uvs = vec![Vec2::ZERO; positions.len()];
+        let tangents = super::mesh::generate_tangents(positions, &normals, &uvs, indices);
+        self.add_mesh(positions, &normals, &uvs, &tangents, indices, material);
+    }
+
     /// A UV sphere: u = φ / 2π around +Y, v = θ / π from the top; tangents along +φ.
     pub fn add_uv_sphere(
         &mut self,

@@ -1,0 +1,191 @@
+//! The wavefront integrator end to end (`cargo bench --bench render`):
+//! - `integrator/<n>`: Msamples/s (criterion's elements/s) at depth 5 with next-event estimation
+//!   (a directional light and a constant sky), procedural scenes of 10^4, 10^5, 10^6 triangles
+//!   (`FACET_RENDER_SCENES=1e4,1e5` picks them), 128 × 128 at 1 spp per sample;
+//! - `glints/<variant>`: the demo scene with its glint sphere as the smooth GGX model, as glints
+//!   with the filter, and as glints counted everywhere, at equal spp;
+//! - printed once before those: run time and RMSE against a 256 spp reference as spp grows, for
+//!   the demo scene (`FACET_RENDER_RMSE=0` skips it).
+
+use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
+use facet_gpu::Gpu;
+use facet_render::camera::CameraFrame;
+use facet_render::procedural;
+use facet_render::scene::{
+    Camera, Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf,
+};
+use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources};
+use glam::{Vec3, Vec4};
+use std::path::Path;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+fn sizes() -> Vec<usize> {
+    std::env::var("FACET_RENDER_SCENES")
+        .ok()
+        .map(|s| {
+            s.split(',')
+                .map(|x| x.trim().parse::<f64>().expect("e.g. 1e4,1e5") as usize)
+                .collect()
+        })
+        .unwrap_or_else(|| vec![10_000, 100_000, 1_000_000])
+}
+
+fn procedural_scene(triangles: usize) -> Scene {
+    let mesh = procedural::test_scene(triangles, 1);
+    let mut s = Scene {
+        materials: vec![Material {
+            base_color: Vec4::new(0.7, 0.7, 0.7, 1.0),
+            ..Default::default()
+        }],
+        lights: vec![facet_render::scene::Light::Directional {
+            direction: Vec3::new(0.3, -1.0, -0.4).normalize(),
+            irradiance: Vec3::splat(3.0),
+        }],
+        camera: Camera {
+            position: Vec3::new(-8.0, 6.0, 9.0),
+            forward: (Vec3::new(2.0, 2.0, -3.0) - Vec3::new(-8.0, 6.0, 9.0)).normalize(),
+            up: Vec3::Y,
+            yfov: 60f32.to_radians(),
+        },
+        ..Default::default()
+    };
+    s.add_triangles(&mesh.positions, &mesh.indices, 0);
+    s
+}
+
+struct Prepared {
+    res: SceneResources,
+    integrator: Integrator,
+    camera: CameraFrame,
+}
+
+fn prepare(gpu: &Gpu, scene: &Scene, env: &Environment, rc: ResourceConfig) -> Prepared {
+    let res = SceneResources::new(gpu, scene, Some(env), rc).unwrap();
+    let integrator = Integrator::new(&gpu.device, &res).unwrap();
+    Prepared {
+        res,
+        integrator,
+        camera: CameraFrame::new(&scene.camera).unwrap(),
+    }
+}
+
+fn render(gpu: &Gpu, p: &Prepared, config: &RenderConfig) -> Image {
+    p.integrator
+        .render(gpu, &p.res, &p.camera, config, &mut |_| {})
+        .unwrap()
+        .0
+}
+
+fn demo() -> (Scene, Environment) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo");
+    let scene = load_gltf(&dir.join("demo.gltf"), &LoadOptions::default()).unwrap();
+    let (map, _) = EnvironmentMap::load(&dir.join("sky.exr")).unwrap();
+    (scene, Environment::Map(Arc::new(map)))
+}
+
+fn rmse_against_spp(gpu: &Gpu) {
+    let (scene, env) = demo();
+    let p = prepare(gpu, &scene, &env, ResourceConfig::standard());
+    let base = RenderConfig {
+        width: 160,
+        height: 90,
+        ..RenderConfig::standard()
+    };
+    let reference = render(
+        gpu,
+        &p,
+        &RenderConfig {
+            spp: 256,
+            seed: 999,
+            spp_per_pass: 16,
+            ..base
+        },
+    );
+    println!("demo scene 160×90, RMSE against 256 spp (another seed):");
+    println!("  spp      ms     RMSE");
+    for spp in [1, 2, 4, 8, 16, 32, 64] {
+        let t = Instant::now();
+        let img = render(gpu, &p, &RenderConfig { spp, ..base });
+        println!(
+            "  {spp:>3} {:>7.0} {:>8.4}",
+            t.elapsed().as_secs_f64() * 1e3,
+            img.rmse(&reference)
+        );
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let Some(gpu) = facet_gpu::gpu_for_tests("bench render") else {
+        return;
+    };
+    println!("adapter: {}", gpu.describe());
+    if std::env::var("FACET_RENDER_RMSE").as_deref() != Ok("0") {
+        rmse_against_spp(&gpu);
+    }
+    let sky = Environment::Constant(Vec3::new(0.4, 0.5, 0.7));
+    let mut g = c.benchmark_group("integrator");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(10));
+    let config = RenderConfig {
+        width: 128,
+        height: 128,
+        spp: 1,
+        max_depth: 5,
+        ..RenderConfig::standard()
+    };
+    g.throughput(Throughput::Elements(128 * 128));
+    for n in sizes() {
+        let scene = procedural_scene(n);
+        let p = prepare(&gpu, &scene, &sky, ResourceConfig::standard());
+        println!(
+            "{} triangles: BVH {:.0} ms",
+            scene.indices.len(),
+            p.res.built.bvh_build_ms
+        );
+        g.bench_function(format!("{n}"), |b| b.iter(|| render(&gpu, &p, &config)));
+    }
+    g.finish();
+
+    let (scene, env) = demo();
+    let glint = scene
+        .materials
+        .iter()
+        .position(|m| m.name == "glint")
+        .unwrap();
+    let mut smooth = scene.clone();
+    if let Some(f) = smooth.materials[glint].facet.as_mut() {
+        f.glint = None;
+    }
+    let mut g = c.benchmark_group("glints");
+    g.sample_size(10)
+        .sampling_mode(SamplingMode::Flat)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(10));
+    let config = RenderConfig {
+        width: 240,
+        height: 135,
+        spp: 2,
+        ..RenderConfig::standard()
+    };
+    g.throughput(Throughput::Elements(240 * 135 * 2));
+    let filtered = ResourceConfig::standard();
+    let counted = ResourceConfig {
+        glint_filter: false,
+        ..filtered
+    };
+    for (name, s, rc) in [
+        ("smooth", &smooth, filtered),
+        ("filtered", &scene, filtered),
+        ("counted", &scene, counted),
+    ] {
+        let p = prepare(&gpu, s, &env, rc);
+        g.bench_function(name, |b| b.iter(|| render(&gpu, &p, &config)));
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
