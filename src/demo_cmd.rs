@@ -5,11 +5,11 @@
 use crate::fit_cmd;
 use crate::render_cmd::{self, RenderArgs};
 use anyhow::Result;
-use clap::Args;
+use clap::Parser;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-#[derive(Args, Clone, Debug)]
+#[derive(Parser, Clone, Debug)]
 pub struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "out")]
@@ -22,14 +22,10 @@ pub struct DemoArgs {
     pub spp: u32,
 }
 
-impl Default for DemoArgs {
-    fn default() -> Self {
-        DemoArgs {
-            out: "out".into(),
-            width: 480,
-            height: 270,
-            spp: 16,
-        }
+impl DemoArgs {
+    /// The defaults above, as `facet demo` with no options gets them.
+    pub fn defaults() -> Self {
+        DemoArgs::parse_from(["demo"])
     }
 }
 

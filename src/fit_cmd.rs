@@ -432,9 +432,6 @@ pub fn fit_default(out: &Path) -> Result<(FittedMaterial, std::path::PathBuf)> {
         r.iterations,
         r.residual
     );
-    println!(
-        "wrote {} and default-gold-ggx.tables.csv",
-        json.display()
-    );
+    println!("wrote {} and default-gold-ggx.tables.csv", json.display());
     Ok((fit, json))
 }

@@ -37,7 +37,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),
-        None => demo_cmd::run(&demo_cmd::DemoArgs::default()),
+        None => demo_cmd::run(&demo_cmd::DemoArgs::defaults()),
     };
     match result {
         Ok(code) => code,

@@ -188,10 +188,21 @@ fn render_bad_inputs_name_the_file() {
     let bad_fit = dir.join("bad_fit.json");
     std::fs::write(&bad_fit, "{\"name\": 3}").unwrap();
     let cases: Vec<(Vec<String>, String)> = vec![
-        (vec!["render".into(), "no/such/scene.gltf".into()], "no/such/scene.gltf".into()),
-        (vec!["render".into(), not_gltf.display().to_string()], "broken.gltf".into()),
         (
-            vec!["render".into(), demo.into(), "--env".into(), "no/such/sky.exr".into()],
+            vec!["render".into(), "no/such/scene.gltf".into()],
+            "no/such/scene.gltf".into(),
+        ),
+        (
+            vec!["render".into(), not_gltf.display().to_string()],
+            "broken.gltf".into(),
+        ),
+        (
+            vec![
+                "render".into(),
+                demo.into(),
+                "--env".into(),
+                "no/such/sky.exr".into(),
+            ],
             "no/such/sky.exr".into(),
         ),
         (
@@ -204,7 +215,12 @@ fn render_bad_inputs_name_the_file() {
             "bad_fit.json".into(),
         ),
         (
-            vec!["render".into(), demo.into(), "--material".into(), "nosuch=x.json".into()],
+            vec![
+                "render".into(),
+                demo.into(),
+                "--material".into(),
+                "nosuch=x.json".into(),
+            ],
             "nosuch".into(),
         ),
         (
@@ -246,7 +262,17 @@ fn render_demo_scene_writes_png_and_exr() {
     let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
     let sky = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/sky.exr");
     let (ok, stdout, err) = facet(&[
-        "render", demo, "--env", sky, "--width", "64", "--height", "36", "--spp", "2", "--out",
+        "render",
+        demo,
+        "--env",
+        sky,
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--spp",
+        "2",
+        "--out",
         out.to_str().unwrap(),
     ]);
     assert!(ok, "{stdout}\n{err}");

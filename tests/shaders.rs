@@ -194,10 +194,31 @@ fn render_structs_match_naga() {
         "Frame",
         GpuFrame,
         [
-            width, height, tile_base, tile_pixels, wavefront, sample_end, max_depth, seed,
-            rr_depth, n_vertices, n_lights, light_cdf, env_kind, env_width, env_height,
-            env_texels, env_marginal, env_conditional, scene_radius, ray_epsilon, env_color,
-            cam_pos, cam_forward, cam_up, cam_right
+            width,
+            height,
+            tile_base,
+            tile_pixels,
+            wavefront,
+            sample_end,
+            max_depth,
+            seed,
+            rr_depth,
+            n_vertices,
+            n_lights,
+            light_cdf,
+            env_kind,
+            env_width,
+            env_height,
+            env_texels,
+            env_marginal,
+            env_conditional,
+            scene_radius,
+            ray_epsilon,
+            env_color,
+            cam_pos,
+            cam_forward,
+            cam_up,
+            cam_right
         ]
     );
     check_struct!(
@@ -205,16 +226,34 @@ fn render_structs_match_naga() {
         "Material",
         GpuMaterial,
         [
-            base_color, emissive, diffuse, kind, ndf_kind, alpha_x, alpha_y, rotation, metallic,
-            roughness, normal_scale, tex_base, tex_mr, tex_normal, tex_emissive, fresnel_offset,
-            fresnel_count, tab_offset, queue
+            base_color,
+            emissive,
+            diffuse,
+            kind,
+            ndf_kind,
+            alpha_x,
+            alpha_y,
+            rotation,
+            metallic,
+            roughness,
+            normal_scale,
+            tex_base,
+            tex_mr,
+            tex_normal,
+            tex_emissive,
+            fresnel_offset,
+            fresnel_count,
+            tab_offset,
+            queue
         ]
     );
     check_struct!(
         "render/extend.wgsl",
         "Light",
         GpuLight,
-        [kind, prim, cos_inner, cos_outer, position, direction, intensity]
+        [
+            kind, prim, cos_inner, cos_outer, position, direction, intensity
+        ]
     );
 }
 

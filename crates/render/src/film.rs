@@ -106,7 +106,11 @@ impl Image {
 
 /// The sRGB transfer function of a value in [0, 1], to 8 bits.
 fn encode_srgb(v: f32) -> u8 {
-    let v = if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+    let v = if v.is_finite() {
+        v.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let s = if v <= 0.003_130_8 {
         12.92 * v
     } else {

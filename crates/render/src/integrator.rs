@@ -319,7 +319,8 @@ impl Integrator {
                 gpu.queue
                     .write_buffer(&frame_buf, 0, bytemuck::bytes_of(&frame));
                 let start: Vec<[u32; 4]> = vec![[0, begin, 0, 0]; frame.tile_pixels as usize];
-                gpu.queue.write_buffer(&info, 0, bytemuck::cast_slice(&start));
+                gpu.queue
+                    .write_buffer(&info, 0, bytemuck::cast_slice(&start));
                 gpu.queue
                     .write_buffer(&counters, 0, &vec![0u8; (nq * 4) as usize]);
                 loop {

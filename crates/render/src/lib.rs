@@ -27,10 +27,10 @@ pub mod error;
 pub mod film;
 pub mod gpu_types;
 pub mod integrator;
+pub mod procedural;
 pub mod queues;
 pub mod resources;
 pub mod scene;
-pub mod procedural;
 pub mod stages;
 pub mod trace;
 

@@ -225,8 +225,8 @@ impl SceneResources {
                         g.alpha_x = tab.stretch.alpha_x as f32;
                         g.alpha_y = tab.stretch.alpha_y as f32;
                         g.rotation = tab.stretch.rotation as f32;
-                        g.roughness = cone_alpha
-                            * (tab.stretch.alpha_x * tab.stretch.alpha_y).sqrt() as f32;
+                        g.roughness =
+                            cone_alpha * (tab.stretch.alpha_x * tab.stretch.alpha_y).sqrt() as f32;
                         g.queue = Queue::Tabulated.index();
                         built.tabulated_tables += 1;
                     }
@@ -540,10 +540,15 @@ pub fn validate(scene: &Scene) -> Result<(), RenderError> {
         return bad(format!("triangle {t} has no material"));
     }
     if let Some(m) = scene.materials.iter().find(|m| {
-        [m.base_color_texture, m.metallic_roughness_texture, m.normal_texture, m.emissive_texture]
-            .iter()
-            .flatten()
-            .any(|&t| t as usize >= scene.textures.len())
+        [
+            m.base_color_texture,
+            m.metallic_roughness_texture,
+            m.normal_texture,
+            m.emissive_texture,
+        ]
+        .iter()
+        .flatten()
+        .any(|&t| t as usize >= scene.textures.len())
     }) {
         return bad(format!("material {:?} names a missing texture", m.name));
     }

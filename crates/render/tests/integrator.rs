@@ -49,12 +49,15 @@ fn conductor_fit() -> Arc<FittedMaterial> {
     FIT.get_or_init(|| {
         let model = facet_fit::analytic::parse_analytic("ggx?alpha=0.3&f0=1").unwrap();
         let src = MerlBrdf::from_table("ggx-0.3", MerlTable::sample(&model)).unwrap();
-        let fit = facet_fit::fit_material(&src, "test", &facet_fit::FitConfig::isotropic()).unwrap();
+        let fit =
+            facet_fit::fit_material(&src, "test", &facet_fit::FitConfig::isotropic()).unwrap();
         let mut r = fit.record.clone();
-        let one = |t: &mut facet_fit::fresnel::FresnelTable| t.rgb.iter_mut().for_each(|c| *c = [1.0; 3]);
+        let one =
+            |t: &mut facet_fit::fresnel::FresnelTable| t.rgb.iter_mut().for_each(|c| *c = [1.0; 3]);
         one(&mut r.fresnel);
-        r.ggx.as_mut().map(|p| one(&mut p.fresnel));
-        r.beckmann.as_mut().map(|p| one(&mut p.fresnel));
+        for p in [r.ggx.as_mut(), r.beckmann.as_mut()].into_iter().flatten() {
+            one(&mut p.fresnel);
+        }
         Arc::new(FittedMaterial::from_record(r).unwrap())
     })
     .clone()
@@ -165,7 +168,8 @@ fn white_furnace_conductor_matches_cpu_albedo() {
         let table: Vec<f64> = (0..=90)
             .map(|deg| {
                 let t = (deg as f64).to_radians();
-                facet_fit::albedo::directional_albedo(brdf, DVec3::new(t.sin(), 0.0, t.cos()), 128)[0]
+                facet_fit::albedo::directional_albedo(brdf, DVec3::new(t.sin(), 0.0, t.cos()), 128)
+                    [0]
             })
             .collect();
         let expect = |theta: f64| {
@@ -213,7 +217,11 @@ fn scene_without_glints_builds_no_glint_resources() {
     ));
     let res = SceneResources::new(&gpu, &scene, None, ResourceConfig::standard()).unwrap();
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
-    println!("built: {:?}, stages {:?}", res.built, integrator.stage_names());
+    println!(
+        "built: {:?}, stages {:?}",
+        res.built,
+        integrator.stage_names()
+    );
     assert!(res.built.glint_pyramids.is_empty());
     assert!(res.glints.is_empty());
     assert_eq!(res.built.classes, vec!["analytic"]);
@@ -287,7 +295,13 @@ fn glint_filter_switch_leaves_no_seam() {
             glint_filter: filter,
             ..ResourceConfig::standard()
         };
-        let (img, _, _) = render(&gpu, &sphere_scene(glint(density, threshold)), &env, rc, config(16));
+        let (img, _, _) = render(
+            &gpu,
+            &sphere_scene(glint(density, threshold)),
+            &env,
+            rc,
+            config(16),
+        );
         let m = img.mean_where(|x, y| theta_o(x, y, 70.0).is_some())[0];
         println!("glint {label}: mean {m:.4}");
         means.push(m);
@@ -328,11 +342,15 @@ fn same_seed_same_image() {
 fn broken_scenes_are_refused() {
     let mut scene = sphere_scene(lambert(0.5));
     scene.positions[10].x = f32::NAN;
-    let err = facet_render::resources::validate(&scene).unwrap_err().to_string();
+    let err = facet_render::resources::validate(&scene)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("vertex 10"), "{err}");
     let mut scene = sphere_scene(lambert(0.5));
     scene.indices[3][1] = 1 << 30;
-    let err = facet_render::resources::validate(&scene).unwrap_err().to_string();
+    let err = facet_render::resources::validate(&scene)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("triangle 3"), "{err}");
     assert!(facet_render::resources::validate(&sphere_scene(lambert(0.5))).is_ok());
 }

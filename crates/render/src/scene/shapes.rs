@@ -47,10 +47,17 @@ impl Scene {
             let theta = std::f32::consts::PI * r as f32 / rings as f32;
             for s in 0..=segments {
                 let phi = std::f32::consts::TAU * s as f32 / segments as f32;
-                let d = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+                let d = Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.cos(),
+                    theta.sin() * phi.sin(),
+                );
                 p.push(center + radius * d);
                 n.push(d);
-                uv.push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
+                uv.push(Vec2::new(
+                    s as f32 / segments as f32,
+                    r as f32 / rings as f32,
+                ));
                 t.push(Vec4::new(-phi.sin(), 0.0, phi.cos(), 1.0));
             }
         }
@@ -73,10 +80,22 @@ impl Scene {
 
     /// A parallelogram `corner + s·edge_u + t·edge_v`, s, t ∈ [0, 1], UVs (s, t) scaled by
     /// `uv_scale`, facing edge_u × edge_v.
-    pub fn add_quad(&mut self, corner: Vec3, edge_u: Vec3, edge_v: Vec3, uv_scale: f32, material: u32) {
+    pub fn add_quad(
+        &mut self,
+        corner: Vec3,
+        edge_u: Vec3,
+        edge_v: Vec3,
+        uv_scale: f32,
+        material: u32,
+    ) {
         let n = edge_u.cross(edge_v).normalize();
         let t = edge_u.normalize().extend(1.0);
-        let p = [corner, corner + edge_u, corner + edge_u + edge_v, corner + edge_v];
+        let p = [
+            corner,
+            corner + edge_u,
+            corner + edge_u + edge_v,
+            corner + edge_v,
+        ];
         let uv = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].map(|u| u * uv_scale);
         self.add_mesh(&p, &[n; 4], &uv, &[t; 4], &[[0, 1, 2], [0, 2, 3]], material);
     }
