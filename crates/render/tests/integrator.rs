@@ -284,11 +284,14 @@ fn glint_filter_switch_leaves_no_seam() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    let density = 5e7;
+    // Density and threshold put the switch inside the range of the footprints' expected counts
+    // N·a·P (≈ 0.01 … 2 here). Footprints of more than ~2000 flakes are avoided: lavapipe's
+    // counting truncates them (see `gpu_count_matches_cpu_on_large_footprints`).
+    let density = 2e6;
     let mut means = Vec::new();
     for (label, threshold, filter) in [
         ("counted", 0.0, false),
-        ("switch at 20", 20.0, true),
+        ("switch at 0.5", 0.5, true),
         ("mean", 0.0, true),
     ] {
         let rc = ResourceConfig {
@@ -353,4 +356,51 @@ fn broken_scenes_are_refused() {
         .to_string();
     assert!(err.contains("triangle 3"), "{err}");
     assert!(facet_render::resources::validate(&sphere_scene(lambert(0.5))).is_ok());
+}
+
+/// Known failure on lavapipe, kept as a regression probe (`--ignored`): GPU flake counting finds
+/// at most ~2400 flakes in one footprint (density 5e7: 1538 of 1538 found, 2426 of 3142, 2283 of
+/// 6283), while the CPU walk finds them all. Not the walk's stack size (80 → 256 changes
+/// nothing), not llvmpipe's 65 535-iteration loop limit (nested loops change nothing).
+#[test]
+#[ignore = "fails on lavapipe: GPU counting truncates footprints of > ~2400 flakes"]
+fn gpu_count_matches_cpu_on_large_footprints() {
+    use facet_glint::flakes::{FlakeField, Footprint, flake_lambda};
+    use facet_glint::gpu::{GlintCounter, GlintQuery};
+    let Some(gpu) = gpu_for_tests("gpu_count_matches_cpu_on_large_footprints") else {
+        return;
+    };
+    let field = FlakeField {
+        density: 5e7,
+        seed: 0,
+    };
+    let cfg = facet_glint::glint_brdf::GlintConfig {
+        gamma: 0.05,
+        threshold: 1e30,
+        filtered: false,
+    };
+    let counter = GlintCounter::new(&gpu.device).unwrap();
+    for (ax, by) in [(0.01, 1e-3), (0.02, 1e-3), (0.04, 1e-3)] {
+        let fps: Vec<Footprint> = (0..4)
+            .map(|i| Footprint {
+                center: glam::DVec2::new(0.37 + 0.01 * i as f64, 0.61),
+                a: glam::DVec2::new(ax, 0.0),
+                b: glam::DVec2::new(0.0, by),
+            })
+            .collect();
+        let qs: Vec<GlintQuery> = fps
+            .iter()
+            .map(|fp| GlintQuery::new(fp, 1.0, (0, 7)))
+            .collect();
+        let gpu_counts = counter.count(&gpu, &field, &cfg, &qs).unwrap();
+        for (fp, g) in fps.iter().zip(gpu_counts) {
+            let cpu = field
+                .flakes_in(fp)
+                .iter()
+                .filter(|f| flake_lambda(f, (0, 7)) < 1.0)
+                .count();
+            println!("axes ({ax}, {by}): CPU {cpu} flakes, GPU {g}");
+            assert!((g - cpu as f64).abs() <= 2.0, "CPU {cpu}, GPU {g}");
+        }
+    }
 }
