@@ -8,16 +8,37 @@ override TEA_K3: u32;
 override TEA_DELTA: u32;
 override TEA_ROUNDS: u32;
 
+// One round on (v0, v1, sum).
+fn tea_round(s: vec3<u32>) -> vec3<u32> {
+    let sum = s.z + TEA_DELTA;
+    let v0 = s.x + (((s.y << 4u) + TEA_K0) ^ (s.y + sum) ^ ((s.y >> 5u) + TEA_K1));
+    let v1 = s.y + (((v0 << 4u) + TEA_K2) ^ (v0 + sum) ^ ((v0 >> 5u) + TEA_K3));
+    return vec3<u32>(v0, v1, sum);
+}
+
+// The rounds are written out rather than looped: llvmpipe (lavapipe) stops a loop after 65 535
+// iterations counted over the whole invocation, which a glint walk's thousands of hashes
+// exceeded (footprints of more than ~2400 flakes came back short). At most 16 rounds
+// (facet_glint::tea::ROUNDS is checked against that).
 fn tea(a: u32, b: u32) -> vec2<u32> {
-    var v0 = a;
-    var v1 = b;
-    var sum = 0u;
-    for (var r = 0u; r < TEA_ROUNDS; r++) {
-        sum += TEA_DELTA;
-        v0 += ((v1 << 4u) + TEA_K0) ^ (v1 + sum) ^ ((v1 >> 5u) + TEA_K1);
-        v1 += ((v0 << 4u) + TEA_K2) ^ (v0 + sum) ^ ((v0 >> 5u) + TEA_K3);
-    }
-    return vec2<u32>(v0, v1);
+    var s = vec3<u32>(a, b, 0u);
+    if (TEA_ROUNDS > 0u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 1u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 2u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 3u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 4u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 5u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 6u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 7u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 8u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 9u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 10u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 11u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 12u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 13u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 14u) { s = tea_round(s); }
+    if (TEA_ROUNDS > 15u) { s = tea_round(s); }
+    return s.xy;
 }
 
 // Uniform in [0, 1): the low word's top 23 bits as a mantissa in [1, 2), minus 1.

@@ -16,9 +16,11 @@ use glam::{DMat2, DVec2, DVec3};
 pub const LEAF_FLAKES: u64 = 8;
 /// Deepest level of the quadtree (2²⁰ cells per side).
 pub const MAX_DEPTH: u32 = 20;
-/// Binomial splits of up to this many flakes are exact inverse CDFs (½ⁿ stays a normal f32);
-/// larger ones use the normal approximation.
-pub const BINOMIAL_EXACT_MAX: u64 = 100;
+/// Binomial splits of up to this many flakes are exact inverse CDFs; larger ones use the
+/// continuity-corrected normal approximation. Kept small because the exact search is a loop, and
+/// llvmpipe (lavapipe) caps a loop's iterations per invocation at 65 535: at 100 a GPU walk over
+/// a footprint of more than ~3000 flakes came back short; at 24, ~5500.
+pub const BINOMIAL_EXACT_MAX: u64 = 24;
 
 /// A procedural flake field.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -8,6 +8,8 @@ pub const KEY: [u32; 4] = [0xA341_316C, 0xC801_3EA4, 0xAD90_777D, 0x7E95_761E];
 /// TEA's round constant δ.
 pub const DELTA: u32 = 0x9e37_79b9;
 pub const ROUNDS: u32 = 8;
+// shaders/glint/tea.inc.wgsl writes out at most 16 rounds.
+const _: () = assert!(ROUNDS <= 16);
 
 /// The override constants of `shaders/glint/tea.inc.wgsl`.
 pub fn pipeline_constants() -> [(&'static str, f64); 6] {
