@@ -1,0 +1,18 @@
+//! # facet-viewer: interactive roughness and stretch on a live path-traced preview
+//!
+//! [`app::ViewerApp`] is the UI state (material, edits, errors); [`preview`] owns the GPU work
+//! on a worker thread that shares eframe's device; [`plots`] draws the NDF slice, the Fresnel
+//! curves and the fit errors with egui's painter; [`panels`] lays the window out.
+
+pub mod app;
+pub mod material;
+pub mod panels;
+pub mod plots;
+pub mod preview;
+
+pub use app::ViewerApp;
+
+/// `assets/demo` of the workspace.
+pub fn demo_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/demo")
+}
