@@ -14,5 +14,6 @@ pub use app::ViewerApp;
 
 /// `assets/demo` of the workspace.
 pub fn demo_dir() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/demo")
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/demo");
+    dir.canonicalize().unwrap_or(dir)
 }

@@ -3,6 +3,7 @@
 use anyhow::{Context, Result, bail};
 use facet_viewer::ViewerApp;
 use facet_viewer::app::ScreenshotPlan;
+use facet_viewer::material::Shown;
 use facet_viewer::preview::Preview;
 use std::path::PathBuf;
 
@@ -11,7 +12,7 @@ const PREVIEW: (u32, u32) = (256, 256);
 
 fn main() -> Result<()> {
     let mut args = std::env::args().skip(1);
-    let (mut screenshot, mut frames, mut material) = (None, 16u32, None);
+    let (mut screenshot, mut frames, mut material, mut shown) = (None, 16u32, None, None);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--screenshot" => {
@@ -19,8 +20,24 @@ fn main() -> Result<()> {
             }
             "--frames" => frames = args.next().context("--frames N")?.parse()?,
             "--material" => material = Some(args.next().context("--material SPEC")?),
+            "--shown" => {
+                let name = args.next().context("--shown MODEL")?;
+                shown = Some(
+                    Shown::ALL
+                        .into_iter()
+                        .find(|s| {
+                            s.label().eq_ignore_ascii_case(&name)
+                                || format!("{s:?}").eq_ignore_ascii_case(&name)
+                        })
+                        .with_context(|| {
+                            format!("--shown {name}: measured, tabulated, ggx, beckmann or glint")
+                        })?,
+                );
+            }
             "-h" | "--help" => {
-                println!("facet-viewer [--material SPEC] [--screenshot PATH.png --frames N]");
+                println!(
+                    "facet-viewer [--material SPEC] [--shown MODEL] [--screenshot PATH.png --frames N]"
+                );
                 return Ok(());
             }
             other => bail!("unknown argument {other}"),
@@ -52,6 +69,11 @@ fn main() -> Result<()> {
             };
             if let Some(spec) = &material {
                 app.open(spec);
+            }
+            if let Some(s) = shown
+                && app.material.available(s)
+            {
+                app.material.shown = s;
             }
             match &cc.wgpu_render_state {
                 Some(rs) => {

@@ -7,7 +7,7 @@ use std::time::Instant;
 pub fn material_panel(app: &mut ViewerApp, ui: &mut egui::Ui) {
     egui::Panel::left("material")
         .resizable(true)
-        .default_size(300.0)
+        .default_size(340.0)
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| contents(app, ui));
         });
@@ -51,14 +51,12 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     let m = &mut app.material;
     let before = m.key();
     ui.label("Shown:");
-    ui.horizontal_wrapped(|ui| {
-        for s in Shown::ALL {
-            let enabled = m.available(s);
-            ui.add_enabled_ui(enabled, |ui| {
-                ui.radio_value(&mut m.shown, s, s.label());
-            });
-        }
-    });
+    for s in Shown::ALL {
+        let enabled = m.available(s);
+        ui.add_enabled_ui(enabled, |ui| {
+            ui.radio_value(&mut m.shown, s, s.label());
+        });
+    }
     if let Some((mut ax, mut ay, rot)) = m.alpha() {
         let rot_deg0 = rot.to_degrees();
         let mut rot_deg = rot_deg0;
