@@ -1,4 +1,9 @@
-//! `facet-viewer [--material SPEC] [--screenshot PATH --frames N]`
+//! `facet-viewer [--material SPEC] [--shown MODEL] [--screenshot PATH --frames N]`
+//!
+//! Opens the window on eframe's wgpu backend with the device the renderer needs (the
+//! adapter's own limits); the preview shares that device. Where wgpu finds no adapter or
+//! cannot start, the window opens on the glow (OpenGL) backend instead and says so, with the
+//! preview off: the material panel, plots, fitting and saving still work.
 
 use anyhow::{Context, Result, bail};
 use facet_viewer::ViewerApp;
@@ -10,19 +15,32 @@ use std::path::PathBuf;
 /// Preview resolution (the image is scaled to the panel).
 const PREVIEW: (u32, u32) = (256, 256);
 
-fn main() -> Result<()> {
+#[derive(Clone)]
+struct Args {
+    screenshot: Option<PathBuf>,
+    frames: u32,
+    material: Option<String>,
+    shown: Option<Shown>,
+}
+
+fn parse() -> Result<Option<Args>> {
+    let mut a = Args {
+        screenshot: None,
+        frames: 16,
+        material: None,
+        shown: None,
+    };
     let mut args = std::env::args().skip(1);
-    let (mut screenshot, mut frames, mut material, mut shown) = (None, 16u32, None, None);
-    while let Some(a) = args.next() {
-        match a.as_str() {
+    while let Some(arg) = args.next() {
+        match arg.as_str() {
             "--screenshot" => {
-                screenshot = Some(PathBuf::from(args.next().context("--screenshot PATH")?))
+                a.screenshot = Some(PathBuf::from(args.next().context("--screenshot PATH")?))
             }
-            "--frames" => frames = args.next().context("--frames N")?.parse()?,
-            "--material" => material = Some(args.next().context("--material SPEC")?),
+            "--frames" => a.frames = args.next().context("--frames N")?.parse()?,
+            "--material" => a.material = Some(args.next().context("--material SPEC")?),
             "--shown" => {
                 let name = args.next().context("--shown MODEL")?;
-                shown = Some(
+                a.shown = Some(
                     Shown::ALL
                         .into_iter()
                         .find(|s| {
@@ -38,17 +56,33 @@ fn main() -> Result<()> {
                 println!(
                     "facet-viewer [--material SPEC] [--shown MODEL] [--screenshot PATH.png --frames N]"
                 );
-                return Ok(());
+                return Ok(None);
             }
             other => bail!("unknown argument {other}"),
         }
     }
+    Ok(Some(a))
+}
+
+fn options(renderer: eframe::Renderer, gpu: &facet_gpu::GpuOptions) -> eframe::NativeOptions {
     let mut setup = egui_wgpu::WgpuSetupCreateNew::without_display_handle();
     // The renderer needs the adapter's own limits (storage buffers per stage, binding sizes).
     setup.device_descriptor = std::sync::Arc::new(facet_gpu::Gpu::device_descriptor);
-    setup.instance_descriptor.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
-    let options = eframe::NativeOptions {
-        renderer: eframe::Renderer::Wgpu,
+    setup.instance_descriptor.backends = gpu
+        .backends
+        .unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::GL);
+    if let Some(name) = gpu.adapter_name.clone() {
+        let name = name.to_ascii_lowercase();
+        setup.native_adapter_selector = Some(std::sync::Arc::new(move |adapters, _| {
+            adapters
+                .iter()
+                .find(|a| a.get_info().name.to_ascii_lowercase().contains(&name))
+                .cloned()
+                .ok_or_else(|| format!("no adapter matches FACET_ADAPTER={name}"))
+        }));
+    }
+    eframe::NativeOptions {
+        renderer,
         viewport: egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 800.0])
             .with_title("Facet viewer")
@@ -58,25 +92,43 @@ fn main() -> Result<()> {
             ..Default::default()
         },
         ..Default::default()
-    };
+    }
+}
+
+/// Runs the window; `no_gpu` says why the preview is off (glow backend).
+fn run_wgpu(args: Args, gpu: &facet_gpu::GpuOptions) -> Result<(), eframe::Error> {
+    run_with(args, options(eframe::Renderer::Wgpu, gpu), None)
+}
+
+fn run(
+    args: Args,
+    renderer: eframe::Renderer,
+    no_gpu: Option<String>,
+) -> Result<(), eframe::Error> {
+    run_with(args, options(renderer, &Default::default()), no_gpu)
+}
+
+fn run_with(
+    args: Args,
+    options: eframe::NativeOptions,
+    no_gpu: Option<String>,
+) -> Result<(), eframe::Error> {
     eframe::run_native(
         "Facet viewer",
         options,
         Box::new(move |cc| {
-            let mut app = match ViewerApp::with_default_material() {
-                Ok(a) => a,
-                Err(e) => return Err(format!("the default material: {e}").into()),
-            };
-            if let Some(spec) = &material {
+            let mut app = ViewerApp::with_default_material()
+                .map_err(|e| format!("the default material: {e}"))?;
+            if let Some(spec) = &args.material {
                 app.open(spec);
             }
-            if let Some(s) = shown
+            if let Some(s) = args.shown
                 && app.material.available(s)
             {
                 app.material.shown = s;
             }
-            match &cc.wgpu_render_state {
-                Some(rs) => {
+            match (&cc.wgpu_render_state, no_gpu) {
+                (Some(rs), _) => {
                     let gpu = facet_gpu::Gpu::from_parts(
                         rs.adapter.clone(),
                         rs.device.clone(),
@@ -94,14 +146,17 @@ fn main() -> Result<()> {
                         Err(e) => app.preview_error = Some(e),
                     }
                 }
-                None => {
-                    app.preview_error = Some("no GPU adapter (wgpu render state missing)".into())
+                (None, why) => {
+                    app.preview_error = Some(format!(
+                        "{}; the preview is off",
+                        why.unwrap_or_else(|| "no GPU adapter: wgpu did not start".into())
+                    ))
                 }
             }
-            if let Some(path) = screenshot {
+            if let Some(path) = &args.screenshot {
                 app.screenshot = Some(ScreenshotPlan {
-                    path,
-                    frames,
+                    path: path.clone(),
+                    frames: args.frames,
                     stage: 0,
                     started: std::time::Instant::now(),
                     saved: Default::default(),
@@ -110,5 +165,27 @@ fn main() -> Result<()> {
             Ok(Box::new(app))
         }),
     )
-    .map_err(|e| anyhow::anyhow!("the window: {e}"))
+}
+
+fn main() -> Result<()> {
+    let Some(args) = parse()? else {
+        return Ok(());
+    };
+    // FACET_BACKEND / FACET_ADAPTER as everywhere else; FACET_BACKEND=cpu means no GPU.
+    let gpu_options = match facet_gpu::GpuOptions::from_env() {
+        Ok(o) => o,
+        Err(e) => {
+            return run(args, eframe::Renderer::Glow, Some(e.to_string()))
+                .map_err(|e| anyhow::anyhow!("the window: {e}"));
+        }
+    };
+    match run_wgpu(args.clone(), &gpu_options) {
+        Ok(()) => Ok(()),
+        Err(e @ eframe::Error::Wgpu(_)) => {
+            eprintln!("wgpu: {e}; opening the window on OpenGL without the preview");
+            run(args, eframe::Renderer::Glow, Some(e.to_string()))
+                .map_err(|e| anyhow::anyhow!("the window: {e}"))
+        }
+        Err(e) => Err(anyhow::anyhow!("the window: {e}")),
+    }
 }

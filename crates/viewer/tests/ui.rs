@@ -151,3 +151,31 @@ fn saving_writes_a_fit_the_loader_reads_back_equal() {
     assert!((loaded.record.tabulated.stretch.alpha_x - 0.7).abs() < 1e-9);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn fitting_runs_in_the_background_and_replaces_the_material() {
+    let mut h = harness();
+    let gen0 = h.state().generation;
+    h.state_mut().open_text = "analytic:ggx?alpha=0.3&conductor=gold".into();
+    h.get_by_role_and_label(Role::Button, "Open").click();
+    h.run_steps(1);
+    assert!(h.state().fit_job.is_some(), "the fit runs on a thread");
+    let _ = h.get_by_label_contains("fitting analytic:ggx");
+    let t = std::time::Instant::now();
+    while h.state().fit_job.is_some() {
+        assert!(t.elapsed().as_secs() < 300, "the fit did not finish");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    h.run_steps(1);
+    let app = h.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let ggx = app.material.record.ggx.as_ref().unwrap();
+    assert!(
+        (ggx.alpha_x / 0.3 - 1.0).abs() < 0.05,
+        "fitted α {}",
+        ggx.alpha_x
+    );
+    assert!(app.generation > gen0);
+    assert_eq!(app.material.source, "analytic:ggx?alpha=0.3&conductor=gold");
+}

@@ -111,7 +111,8 @@ pub fn screenshot_step(app: &mut ViewerApp, ctx: &egui::Context) {
         }
         None => (0, 0, (0.0, 0.0, 0.0, None, app.preview_error.clone())),
     };
-    let timed_out = plan.started.elapsed().as_secs() > 240;
+    // Without a preview (no GPU) there is nothing to wait for.
+    let timed_out = plan.started.elapsed().as_secs() > 240 || app.preview.is_none();
     let current = gen_now == app.generation;
     match plan.stage {
         0 if (current && samples >= (plan.frames / 2).max(1)) || timed_out => {
