@@ -2,7 +2,7 @@
 //! live in [`crate::preview`]'s worker; this holds only its handle.
 
 use crate::material::{EditedMaterial, MaterialKey};
-use crate::preview::{Command, Orbit, Preview};
+use crate::preview::{Command, Orbit, Preview, PreviewScene};
 use facet_fit::fit::{FitConfig, fit_material};
 use facet_fit::material::FittedMaterial;
 use std::path::{Path, PathBuf};
@@ -132,7 +132,14 @@ impl ViewerApp {
             return;
         }
         self.error = None;
-        if Path::new(&spec).extension().is_some_and(|e| e == "json") {
+        let ext = Path::new(&spec)
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if matches!(ext.as_deref(), Some("gltf" | "glb")) {
+            self.open_scene(Path::new(&spec));
+            return;
+        }
+        if ext.as_deref() == Some("json") {
             match FittedMaterial::load(Path::new(&spec)) {
                 Ok(fit) => {
                     self.set_material(EditedMaterial::new(fit, spec.clone()));
@@ -170,6 +177,34 @@ impl ViewerApp {
             stage,
             rx,
         });
+    }
+
+    /// The preview scene for a glTF file (else the sphere) with the current material.
+    pub fn preview_scene(&self, gltf: Option<&Path>) -> Result<PreviewScene, String> {
+        let material = self.material.render_material()?;
+        match gltf {
+            Some(p) => PreviewScene::gltf(p, material),
+            None => Ok(PreviewScene::sphere(material)),
+        }
+    }
+
+    /// Loads a glTF scene into the preview; its first Facet material takes the edits.
+    pub fn open_scene(&mut self, path: &Path) {
+        match self.preview_scene(Some(path)) {
+            Ok(ps) => {
+                self.orbit = ps.orbit;
+                self.status = format!(
+                    "scene {}: material {:?} is edited",
+                    path.display(),
+                    ps.scene.materials[ps.edited].name
+                );
+                match &self.preview {
+                    Some(p) => p.send(Command::Scene(Box::new(ps))),
+                    None => self.status += " (no preview without a GPU)",
+                }
+            }
+            Err(e) => self.error = Some(format!("cannot open {}: {e}", path.display())),
+        }
     }
 
     fn set_material(&mut self, m: EditedMaterial) {

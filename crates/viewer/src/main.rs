@@ -1,4 +1,4 @@
-//! `facet-viewer [--material SPEC] [--shown MODEL] [--screenshot PATH --frames N]`
+//! `facet-viewer [--material SPEC] [--shown MODEL] [--scene PATH.gltf] [--screenshot PATH --frames N]`
 //!
 //! Opens the window on eframe's wgpu backend with the device the renderer needs (the
 //! adapter's own limits); the preview shares that device. Where wgpu finds no adapter or
@@ -21,6 +21,7 @@ struct Args {
     frames: u32,
     material: Option<String>,
     shown: Option<Shown>,
+    scene: Option<PathBuf>,
 }
 
 fn parse() -> Result<Option<Args>> {
@@ -29,6 +30,7 @@ fn parse() -> Result<Option<Args>> {
         frames: 16,
         material: None,
         shown: None,
+        scene: None,
     };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
@@ -38,6 +40,7 @@ fn parse() -> Result<Option<Args>> {
             }
             "--frames" => a.frames = args.next().context("--frames N")?.parse()?,
             "--material" => a.material = Some(args.next().context("--material SPEC")?),
+            "--scene" => a.scene = Some(PathBuf::from(args.next().context("--scene PATH.gltf")?)),
             "--shown" => {
                 let name = args.next().context("--shown MODEL")?;
                 a.shown = Some(
@@ -54,7 +57,7 @@ fn parse() -> Result<Option<Args>> {
             }
             "-h" | "--help" => {
                 println!(
-                    "facet-viewer [--material SPEC] [--shown MODEL] [--screenshot PATH.png --frames N]"
+                    "facet-viewer [--material SPEC] [--shown MODEL] [--scene PATH.gltf] [--screenshot PATH.png --frames N]"
                 );
                 return Ok(None);
             }
@@ -134,10 +137,18 @@ fn run_with(
                         rs.device.clone(),
                         rs.queue.clone(),
                     );
-                    match app.material.render_material() {
-                        Ok(m) => {
+                    let scene = match app.preview_scene(args.scene.as_deref()) {
+                        Err(e) if args.scene.is_some() => {
+                            app.error = Some(format!("the scene: {e}"));
+                            app.preview_scene(None)
+                        }
+                        r => r,
+                    };
+                    match scene {
+                        Ok(scene) => {
                             let ctx = cc.egui_ctx.clone();
-                            app.preview = Some(Preview::start(gpu, m, PREVIEW, move || {
+                            app.orbit = scene.orbit;
+                            app.preview = Some(Preview::start(gpu, scene, PREVIEW, move || {
                                 ctx.request_repaint()
                             }));
                             // The worker starts on this material: generation 0 is it.

@@ -17,30 +17,50 @@ use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
-/// Index of the sphere's material in the preview scene.
+/// Index of the sphere's material in the sphere scene.
 pub const SPHERE: usize = 1;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
 
-/// An orbit camera around the origin.
+/// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orbit {
+    pub target: Vec3,
     pub yaw: f32,
     pub pitch: f32,
     pub distance: f32,
+    /// Vertical field of view, radians.
+    pub yfov: f32,
 }
 
 impl Default for Orbit {
     fn default() -> Self {
         Orbit {
+            target: Vec3::ZERO,
             yaw: 0.0,
             pitch: 0.25,
             distance: 4.5,
+            yfov: 35f32.to_radians(),
         }
     }
 }
 
 impl Orbit {
+    /// The orbit through a scene's camera, around the centre of the scene's bounds.
+    pub fn from_camera(camera: &Camera, bounds: (Vec3, Vec3)) -> Self {
+        let target = 0.5 * (bounds.0 + bounds.1);
+        let offset = camera.position - target;
+        let distance = offset.length().max(1e-3);
+        let d = offset / distance;
+        Orbit {
+            target,
+            yaw: d.x.atan2(d.z),
+            pitch: d.y.clamp(-1.0, 1.0).asin(),
+            distance,
+            yfov: camera.yfov,
+        }
+    }
+
     pub fn camera(&self) -> Camera {
         let pitch = self.pitch.clamp(-0.2, 1.4);
         let dir = Vec3::new(
@@ -48,15 +68,59 @@ impl Orbit {
             pitch.sin(),
             pitch.cos() * self.yaw.cos(),
         );
-        let position = dir * self.distance.clamp(1.5, 20.0);
+        let position = self.target + dir * self.distance;
         let forward = -dir;
         let up = (Vec3::Y - forward * forward.dot(Vec3::Y)).normalize();
         Camera {
             position,
             forward,
             up,
-            yfov: 35f32.to_radians(),
+            yfov: self.yfov,
         }
+    }
+}
+
+/// A scene for the preview: the scene, which material the edits go to, where the orbit starts.
+#[derive(Clone, Debug)]
+pub struct PreviewScene {
+    pub scene: Scene,
+    /// Index of the edited material.
+    pub edited: usize,
+    pub orbit: Orbit,
+}
+
+impl PreviewScene {
+    /// A unit sphere (the edited material) on a grey plane.
+    pub fn sphere(material: Material) -> Self {
+        PreviewScene {
+            scene: preview_scene(material),
+            edited: SPHERE,
+            orbit: Orbit::default(),
+        }
+    }
+
+    /// A glTF scene whose first Facet material (else its first material) takes the edits.
+    pub fn gltf(path: &std::path::Path, material: Material) -> Result<Self, String> {
+        let mut scene =
+            facet_render::scene::load_gltf(path, &Default::default()).map_err(|e| e.to_string())?;
+        let edited = scene
+            .materials
+            .iter()
+            .position(|m| m.facet.is_some())
+            .unwrap_or(0);
+        if scene.materials.is_empty() {
+            return Err(format!("{}: the scene has no materials", path.display()));
+        }
+        scene.materials[edited] = Material {
+            name: scene.materials[edited].name.clone(),
+            ..material
+        };
+        let orbit = Orbit::from_camera(&scene.camera, scene.bounds());
+        Ok(PreviewScene {
+            scene,
+            edited,
+            orbit,
+        })
     }
 }
 
@@ -69,6 +133,8 @@ pub enum Command {
         sent: Instant,
     },
     Camera(Orbit),
+    /// Another scene (resources and pipelines are rebuilt).
+    Scene(Box<PreviewScene>),
     Quit,
 }
 
@@ -148,10 +214,10 @@ pub fn preview_environment() -> Environment {
 }
 
 impl Preview {
-    /// Starts the worker on `gpu` (eframe's device) with the first sphere material.
+    /// Starts the worker on `gpu` (eframe's device) with a scene.
     pub fn start(
         gpu: Gpu,
-        material: Material,
+        scene: PreviewScene,
         size: (u32, u32),
         repaint: impl Fn() + Send + 'static,
     ) -> Self {
@@ -165,7 +231,7 @@ impl Preview {
         let thread = std::thread::Builder::new()
             .name("facet-preview".into())
             .spawn(move || {
-                if let Err(e) = worker(gpu, material, size, rx, &sh, &repaint) {
+                if let Err(e) = worker(gpu, scene, size, rx, &sh, &repaint) {
                     sh.lock().unwrap().error = Some(e);
                     repaint();
                 }
@@ -197,16 +263,20 @@ fn build(gpu: &Gpu, scene: &Scene, env: &Environment) -> Result<Built, String> {
 
 fn worker(
     gpu: Gpu,
-    material: Material,
+    preview: PreviewScene,
     (width, height): (u32, u32),
     rx: Receiver<Command>,
     shared: &Mutex<Shared>,
     repaint: &dyn Fn(),
 ) -> Result<(), String> {
     let env = preview_environment();
-    let mut scene = preview_scene(material);
+    let PreviewScene {
+        mut scene,
+        mut edited,
+        orbit,
+    } = preview;
+    let mut orbit = orbit;
     let mut built = build(&gpu, &scene, &env)?;
-    let mut orbit = Orbit::default();
     let mut camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
     let n = (width * height) as usize;
     let mut sum = vec![[0f32; 3]; n];
@@ -243,6 +313,23 @@ fn worker(
         for c in cmds {
             match c {
                 Command::Quit => return Ok(()),
+                Command::Scene(p) => {
+                    shared.lock().unwrap().rebuilding = true;
+                    repaint();
+                    let b = build(&gpu, &p.scene, &env);
+                    let mut s = shared.lock().unwrap();
+                    s.rebuilding = false;
+                    match b {
+                        Ok(b) => {
+                            built = b;
+                            scene = p.scene;
+                            edited = p.edited;
+                            orbit = p.orbit;
+                            restart = true;
+                        }
+                        Err(e) => s.error = Some(format!("preview scene: {e}")),
+                    }
+                }
                 Command::Camera(o) => {
                     orbit = o;
                     restart = true;
@@ -255,10 +342,11 @@ fn worker(
             }
         }
         if let Some((g, material, sent)) = new_material {
-            scene.materials[SPHERE] = *material;
+            let name = scene.materials[edited].name.clone();
+            scene.materials[edited] = Material { name, ..*material };
             let in_place = built
                 .res
-                .update_material(&gpu.queue, &scene, SPHERE)
+                .update_material(&gpu.queue, &scene, edited)
                 .is_ok();
             if !in_place {
                 shared.lock().unwrap().rebuilding = true;

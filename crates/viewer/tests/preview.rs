@@ -2,7 +2,7 @@
 //! in place, no pipeline rebuild), and the timings are printed (run with --nocapture).
 
 use facet_viewer::ViewerApp;
-use facet_viewer::preview::{Command, Preview};
+use facet_viewer::preview::{Command, Preview, PreviewScene};
 use std::time::{Duration, Instant};
 
 fn wait(p: &Preview, what: &str, ok: impl Fn(&facet_viewer::preview::Shared) -> bool) {
@@ -31,7 +31,7 @@ fn preview_accumulates_and_restarts_on_an_edit() {
     let mut app = ViewerApp::with_default_material().unwrap();
     let p = Preview::start(
         gpu,
-        app.material.render_material().unwrap(),
+        PreviewScene::sphere(app.material.render_material().unwrap()),
         (256, 256),
         || {},
     );

@@ -15,7 +15,8 @@ pub fn material_panel(app: &mut ViewerApp, ui: &mut egui::Ui) {
 
 fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     ui.heading("Material");
-    let hint = ui.label("MERL file, fit JSON, nbrdf:NAME or analytic:SPEC (or drop a file):");
+    let hint = ui
+        .label("MERL file, fit JSON, nbrdf:NAME, analytic:SPEC, or a glTF scene (or drop a file):");
     ui.horizontal(|ui| {
         let r = ui
             .add(egui::TextEdit::singleline(&mut app.open_text).desired_width(200.0))
