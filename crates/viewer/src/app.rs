@@ -51,6 +51,8 @@ pub struct ViewerApp {
     pub texture: Option<egui::TextureHandle>,
     /// The preview frame the texture shows.
     pub shown_frame: u64,
+    /// The exposure the texture was tone mapped with.
+    pub shown_exposure: f32,
     /// Where the preview image was drawn last (points).
     pub preview_rect: Option<egui::Rect>,
     pub nbrdf: PathBuf,
@@ -92,6 +94,7 @@ impl ViewerApp {
             preview_error: None,
             texture: None,
             shown_frame: 0,
+            shown_exposure: 0.0,
             preview_rect: None,
             nbrdf: nbrdf_path(),
             screenshot: None,

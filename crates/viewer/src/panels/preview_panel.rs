@@ -23,7 +23,8 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     if let Some(e) = &s.error {
         ui.colored_label(egui::Color32::from_rgb(230, 80, 60), format!("Error: {e}"));
     }
-    if s.frame != app.shown_frame && !s.mean.is_empty() {
+    // A new frame, or the same one under another exposure (accumulation may have stopped).
+    if (s.frame != app.shown_frame || app.exposure != app.shown_exposure) && !s.mean.is_empty() {
         let pixels = tone_map(&s.mean, app.exposure);
         let image = egui::ColorImage::new([s.width as usize, s.height as usize], pixels);
         match &mut app.texture {
@@ -37,6 +38,7 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
             }
         }
         app.shown_frame = s.frame;
+        app.shown_exposure = app.exposure;
     }
     let current = s.generation == app.generation;
     ui.label(format!(
