@@ -56,6 +56,8 @@ pub struct ViewerApp {
     /// Where the preview image was drawn last (points).
     pub preview_rect: Option<egui::Rect>,
     pub nbrdf: PathBuf,
+    /// The neural proxies' names, read when the list is first opened.
+    pub proxy_names: Option<Result<Vec<String>, String>>,
     pub screenshot: Option<ScreenshotPlan>,
 }
 
@@ -97,6 +99,7 @@ impl ViewerApp {
             shown_exposure: 0.0,
             preview_rect: None,
             nbrdf: nbrdf_path(),
+            proxy_names: None,
             screenshot: None,
         }
     }
@@ -208,6 +211,16 @@ impl ViewerApp {
             }
             Err(e) => self.error = Some(format!("cannot open {}: {e}", path.display())),
         }
+    }
+
+    /// The neural proxies' names (the network file is read once).
+    pub fn proxies(&mut self) -> &Result<Vec<String>, String> {
+        let path = self.nbrdf.clone();
+        self.proxy_names.get_or_insert_with(|| {
+            facet_fit::nbrdf::NbrdfLibrary::open(&path)
+                .map(|lib| lib.names().map(str::to_owned).collect())
+                .map_err(|e| e.to_string())
+        })
     }
 
     fn set_material(&mut self, m: EditedMaterial) {

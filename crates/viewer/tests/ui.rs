@@ -179,3 +179,25 @@ fn fitting_runs_in_the_background_and_replaces_the_material() {
     assert!(app.generation > gen0);
     assert_eq!(app.material.source, "analytic:ggx?alpha=0.3&conductor=gold");
 }
+
+#[test]
+fn neural_proxies_are_listed_and_fitted_by_name() {
+    let mut h = harness();
+    match h.state_mut().proxies().clone() {
+        Ok(names) => {
+            assert!(names.len() >= 100, "{} proxies", names.len());
+            let spec = format!("nbrdf:{}", names[0]);
+            h.state_mut().open(&spec);
+            let t = std::time::Instant::now();
+            while h.state().fit_job.is_some() {
+                assert!(t.elapsed().as_secs() < 300, "the fit did not finish");
+                std::thread::sleep(std::time::Duration::from_millis(50));
+                h.run_steps(1);
+            }
+            assert!(h.state().error.is_none(), "{:?}", h.state().error);
+            assert_eq!(h.state().material.source, spec);
+            println!("fitted {spec} in {:.1} s", t.elapsed().as_secs_f64());
+        }
+        Err(e) => eprintln!("SKIPPED neural_proxies_are_listed_and_fitted_by_name: {e}"),
+    }
+}

@@ -27,6 +27,26 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
             app.open(&spec);
         }
     });
+    let mut chosen = None;
+    egui::ComboBox::from_label("neural proxy")
+        .selected_text("choose...")
+        .height(300.0)
+        .show_ui(ui, |ui| match app.proxies() {
+            Ok(names) => {
+                for name in names {
+                    if ui.selectable_label(false, name).clicked() {
+                        chosen = Some(format!("nbrdf:{name}"));
+                    }
+                }
+            }
+            Err(e) => {
+                ui.label(format!("no proxies: {e}"));
+            }
+        });
+    if let Some(spec) = chosen {
+        app.open_text = spec.clone();
+        app.open(&spec);
+    }
     if let Some(job) = &app.fit_job {
         ui.horizontal(|ui| {
             ui.spinner();
