@@ -170,6 +170,8 @@ pub struct Shared {
 pub struct Preview {
     tx: Sender<Command>,
     pub shared: Arc<Mutex<Shared>>,
+    /// The device's uncaptured errors (wgpu would panic on them): shown in the window.
+    pub gpu_error: Arc<Mutex<Option<String>>>,
     thread: Option<std::thread::JoinHandle<()>>,
 }
 
@@ -227,6 +229,13 @@ impl Preview {
             rebuilding: true,
             ..Default::default()
         }));
+        let gpu_error = Arc::new(Mutex::new(None));
+        let slot = gpu_error.clone();
+        // Its own lock: wgpu calls the handler inside whichever call failed.
+        gpu.device
+            .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+                *slot.lock().unwrap() = Some(e.to_string());
+            }));
         let sh = shared.clone();
         let thread = std::thread::Builder::new()
             .name("facet-preview".into())
@@ -240,6 +249,7 @@ impl Preview {
         Preview {
             tx,
             shared,
+            gpu_error,
             thread: Some(thread),
         }
     }

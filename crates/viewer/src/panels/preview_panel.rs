@@ -20,6 +20,16 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
         return;
     };
     let s = shared.lock().unwrap().clone();
+    if let Some(e) = app
+        .preview
+        .as_ref()
+        .and_then(|p| p.gpu_error.lock().unwrap().clone())
+    {
+        ui.colored_label(
+            egui::Color32::from_rgb(230, 80, 60),
+            format!("GPU error: {e}"),
+        );
+    }
     if let Some(e) = &s.error {
         ui.colored_label(egui::Color32::from_rgb(230, 80, 60), format!("Error: {e}"));
     }
