@@ -201,3 +201,31 @@ fn neural_proxies_are_listed_and_fitted_by_name() {
         Err(e) => eprintln!("SKIPPED neural_proxies_are_listed_and_fitted_by_name: {e}"),
     }
 }
+
+#[test]
+fn a_gltf_scene_opens_and_a_bad_one_is_an_error() {
+    let mut h = harness();
+    let demo = facet_viewer::demo_dir().join("demo.gltf");
+    h.state_mut().open(&demo.display().to_string());
+    h.run_steps(1);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    assert!(
+        h.state().status.contains("is edited"),
+        "{}",
+        h.state().status
+    );
+    let bad = std::env::temp_dir().join(format!("facet-viewer-bad-{}.gltf", std::process::id()));
+    std::fs::write(&bad, "{ not gltf").unwrap();
+    let before = h.state().material.record.clone();
+    h.state_mut().open(&bad.display().to_string());
+    h.run_steps(1);
+    assert!(
+        h.state()
+            .error
+            .as_deref()
+            .unwrap_or("")
+            .contains("cannot open")
+    );
+    assert_eq!(h.state().material.record, before);
+    let _ = std::fs::remove_file(&bad);
+}
