@@ -146,6 +146,40 @@ impl Gpu {
         })
     }
 
+    /// Wraps a device made elsewhere (eframe's `egui_wgpu::RenderState`) so the renderer and
+    /// the UI share one device and queue. Device loss is reported through [`Gpu::check_lost`];
+    /// the device's own lost callback is taken over for that.
+    pub fn from_parts(adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let info = adapter.get_info();
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let lost = Arc::new(Mutex::new(None));
+        let flag = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            *flag.lock().unwrap() = Some(format!("{reason:?}: {message}"));
+        });
+        Gpu {
+            adapter,
+            device,
+            queue,
+            info,
+            timestamps,
+            lost,
+        }
+    }
+
+    /// The device descriptor [`Gpu::new`] asks an adapter for: its own limits and timestamp
+    /// queries where it has them. For code that creates the device itself (eframe).
+    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+        wgpu::DeviceDescriptor {
+            label: Some("facet"),
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+            required_limits: adapter.limits(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        }
+    }
+
     /// "name (backend, type)", as written into fit records.
     pub fn describe(&self) -> String {
         format!(

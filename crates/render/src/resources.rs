@@ -69,6 +69,8 @@ pub struct SceneResources {
     pub env_color: [f32; 4],
     pub scene_radius: f32,
     pub built: Built,
+    /// The materials as uploaded (for [`SceneResources::update_material`]).
+    pub material_data: Vec<GpuMaterial>,
 }
 
 /// Settings of the resources that are not in the scene file.
@@ -461,6 +463,7 @@ impl SceneResources {
             vertices: buffer::storage(d, "vertices", &vertices),
             triangles: buffer::storage(d, "triangles", &triangles),
             materials: buffer::storage(d, "materials", &materials),
+            material_data: materials.clone(),
             textures: buffer::storage(
                 d,
                 "textures",
@@ -494,6 +497,95 @@ impl SceneResources {
             buffer::check_binding(d, what, bytes)?;
         }
         Ok(res)
+    }
+}
+
+impl SceneResources {
+    /// Rewrites material `index` in place from `scene.materials[index]`: its α, rotation,
+    /// Fresnel table and diffuse albedo, at the offsets it already has. Edits that change
+    /// the material's class, its NDF kind, its tables or its glint pyramids (another fit,
+    /// glints on or off, a glint material's α or γ) return `Err`: those need new resources.
+    pub fn update_material(
+        &mut self,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        index: usize,
+    ) -> Result<(), RenderError> {
+        let rebuild = |why: &str| Err(RenderError::Scene(format!("material {index}: {why}")));
+        let (Some(m), Some(old)) = (scene.materials.get(index), self.material_data.get(index))
+        else {
+            return rebuild("no such material");
+        };
+        let Some(f) = &m.facet else {
+            return rebuild("not a fitted material");
+        };
+        if f.glint.is_some() || old.kind == MaterialKind::Glint as u32 {
+            return rebuild("glint materials are rebuilt");
+        }
+        let choice = match f.model {
+            FacetModel::Tabulated => facet_fit::material::ModelChoice::Tabulated,
+            FacetModel::Ggx => facet_fit::material::ModelChoice::Ggx,
+            FacetModel::Beckmann => facet_fit::material::ModelChoice::Beckmann,
+        };
+        let Some(brdf) = f.fit.model(choice) else {
+            return rebuild("the fit has no such model");
+        };
+        let mut g = *old;
+        match &brdf.ndf {
+            Ndf::Analytic(a) => {
+                let kind = match a.kind {
+                    NdfKind::Ggx => 0,
+                    NdfKind::Beckmann => 1,
+                };
+                if old.kind != MaterialKind::Analytic as u32 || old.ndf_kind != kind {
+                    return rebuild("the NDF class changed");
+                }
+                g.alpha_x = a.alpha_x as f32;
+                g.alpha_y = a.alpha_y as f32;
+                g.rotation = a.rotation as f32;
+                g.roughness = (a.alpha_x * a.alpha_y).sqrt() as f32;
+            }
+            Ndf::Tabulated(tab) => {
+                if old.kind != MaterialKind::Tabulated as u32 {
+                    return rebuild("the NDF class changed");
+                }
+                let cone_alpha = f
+                    .fit
+                    .record
+                    .ggx
+                    .as_ref()
+                    .map_or(0.3, |p| (p.alpha_x * p.alpha_y).sqrt() as f32);
+                g.alpha_x = tab.stretch.alpha_x as f32;
+                g.alpha_y = tab.stretch.alpha_y as f32;
+                g.rotation = tab.stretch.rotation as f32;
+                g.roughness =
+                    cone_alpha * (tab.stretch.alpha_x * tab.stretch.alpha_y).sqrt() as f32;
+            }
+        }
+        g.diffuse = [
+            brdf.diffuse[0] as f32,
+            brdf.diffuse[1] as f32,
+            brdf.diffuse[2] as f32,
+            0.0,
+        ];
+        let fres: Vec<f32> = (0..FRESNEL_NODES)
+            .flat_map(|j| {
+                let theta_d = j as f64 / (FRESNEL_NODES - 1) as f64 * std::f64::consts::FRAC_PI_2;
+                rgb(brdf.fresnel.eval(theta_d.cos()))
+            })
+            .collect();
+        queue.write_buffer(
+            &self.tables,
+            4 * g.fresnel_offset as u64,
+            bytemuck::cast_slice(&fres),
+        );
+        queue.write_buffer(
+            &self.materials,
+            (index * std::mem::size_of::<GpuMaterial>()) as u64,
+            bytemuck::bytes_of(&g),
+        );
+        self.material_data[index] = g;
+        Ok(())
     }
 }
 

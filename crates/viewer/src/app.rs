@@ -1,0 +1,335 @@
+//! The UI state: the edited material, the open/save fields, errors, the fit job. GPU objects
+//! live in [`crate::preview`]'s worker; this holds only its handle.
+
+use crate::material::{EditedMaterial, MaterialKey};
+use crate::preview::{Command, Orbit, Preview, PreviewScene};
+use facet_fit::fit::{FitConfig, fit_material};
+use facet_fit::material::FittedMaterial;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::Receiver;
+use std::time::Instant;
+
+/// A fit running on a background thread.
+pub struct FitJob {
+    pub label: String,
+    pub started: Instant,
+    pub stage: std::sync::Arc<std::sync::Mutex<String>>,
+    rx: Receiver<Result<FittedMaterial, String>>,
+}
+
+/// What a screenshot run (`--screenshot PATH --frames N`) does.
+#[derive(Clone, Debug)]
+pub struct ScreenshotPlan {
+    pub path: PathBuf,
+    /// Preview frames to accumulate before the shot.
+    pub frames: u32,
+    /// Stage: 0 waiting for frames/2, 1 nudged αx and waiting, 2 shot requested, 3 saved.
+    pub stage: u32,
+    pub started: Instant,
+    pub saved: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+pub struct ViewerApp {
+    pub material: EditedMaterial,
+    /// Bumped whenever the material the renderer sees changes (the preview restarts).
+    pub generation: u64,
+    /// The key of the material last sent to the renderer.
+    pub sent_key: Option<MaterialKey>,
+    /// When the last edit happened (for the edit-to-frame latency).
+    pub edited_at: Option<Instant>,
+    pub exposure: f32,
+    pub orbit: Orbit,
+    /// The open field: a path, `nbrdf:NAME` or `analytic:SPEC`.
+    pub open_text: String,
+    pub save_text: String,
+    pub error: Option<String>,
+    pub status: String,
+    pub fit_job: Option<FitJob>,
+    /// The live preview; `None` without a GPU (then `preview_error` says why).
+    pub preview: Option<Preview>,
+    pub preview_error: Option<String>,
+    pub texture: Option<egui::TextureHandle>,
+    /// The preview frame the texture shows.
+    pub shown_frame: u64,
+    /// The exposure the texture was tone mapped with.
+    pub shown_exposure: f32,
+    /// Where the preview image was drawn last (points).
+    pub preview_rect: Option<egui::Rect>,
+    pub nbrdf: PathBuf,
+    /// The neural proxies' names, read when the list is first opened.
+    pub proxy_names: Option<Result<Vec<String>, String>>,
+    pub screenshot: Option<ScreenshotPlan>,
+}
+
+/// The network file for `nbrdf:` inputs (as `facet fit` finds it).
+pub fn nbrdf_path() -> PathBuf {
+    if let Some(p) = std::env::var_os("FACET_NBRDF") {
+        return p.into();
+    }
+    for local in [
+        Path::new("../shared/data/nbrdf/merl100.json").to_owned(),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/nbrdf/merl100.json"),
+    ] {
+        if local.exists() {
+            return local;
+        }
+    }
+    facet_fit::nbrdf::NbrdfLibrary::default_path()
+}
+
+impl ViewerApp {
+    /// The app on a material, without a preview (tests, no GPU).
+    pub fn new(material: EditedMaterial) -> Self {
+        ViewerApp {
+            save_text: "edited_fit.json".into(),
+            open_text: material.source.clone(),
+            material,
+            generation: 0,
+            sent_key: None,
+            edited_at: None,
+            exposure: 0.0,
+            orbit: Orbit::default(),
+            error: None,
+            status: String::new(),
+            fit_job: None,
+            preview: None,
+            preview_error: None,
+            texture: None,
+            shown_frame: 0,
+            shown_exposure: 0.0,
+            preview_rect: None,
+            nbrdf: nbrdf_path(),
+            proxy_names: None,
+            screenshot: None,
+        }
+    }
+
+    /// The app on the demo's default fit.
+    pub fn with_default_material() -> Result<Self, String> {
+        let path = crate::demo_dir().join("default_fit.json");
+        let fit = FittedMaterial::load(&path).map_err(|e| e.to_string())?;
+        Ok(Self::new(EditedMaterial::new(
+            fit,
+            path.display().to_string(),
+        )))
+    }
+
+    /// Samples accumulated for the current material (0 without a preview, or right after a
+    /// change).
+    pub fn samples(&self) -> u32 {
+        match &self.preview {
+            Some(p) => {
+                let s = p.shared.lock().unwrap();
+                if s.generation == self.generation {
+                    s.samples
+                } else {
+                    0
+                }
+            }
+            None => 0,
+        }
+    }
+
+    /// Opens a fit JSON directly, or fits a MERL file / `nbrdf:NAME` / `analytic:SPEC` on a
+    /// background thread. A failure leaves the current material as it is.
+    pub fn open(&mut self, spec: &str) {
+        let spec = spec.trim().to_string();
+        if spec.is_empty() {
+            return;
+        }
+        self.error = None;
+        let ext = Path::new(&spec)
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        if matches!(ext.as_deref(), Some("gltf" | "glb")) {
+            self.open_scene(Path::new(&spec));
+            return;
+        }
+        if ext.as_deref() == Some("json") {
+            match FittedMaterial::load(Path::new(&spec)) {
+                Ok(fit) => {
+                    self.set_material(EditedMaterial::new(fit, spec.clone()));
+                    self.status = format!("opened {spec}");
+                }
+                Err(e) => self.error = Some(format!("cannot open {spec}: {e}")),
+            }
+            return;
+        }
+        if !spec.starts_with("nbrdf:")
+            && !spec.starts_with("analytic:")
+            && let Err(e) = std::fs::metadata(&spec)
+        {
+            self.error = Some(format!("cannot open {spec}: {e}"));
+            return;
+        }
+        let (tx, rx) = std::sync::mpsc::channel();
+        let stage = std::sync::Arc::new(std::sync::Mutex::new("opening".to_string()));
+        let st = stage.clone();
+        let nbrdf = self.nbrdf.clone();
+        let label = spec.clone();
+        std::thread::spawn(move || {
+            let r = (|| {
+                let mut lib = None;
+                let src = facet_fit::source::open_source(&spec, &nbrdf, &mut lib)
+                    .map_err(|e| e.to_string())?;
+                *st.lock().unwrap() = "extracting the NDF and fitting".into();
+                fit_material(&*src, &spec, &FitConfig::isotropic()).map_err(|e| e.to_string())
+            })();
+            let _ = tx.send(r);
+        });
+        self.fit_job = Some(FitJob {
+            label,
+            started: Instant::now(),
+            stage,
+            rx,
+        });
+    }
+
+    /// The preview scene for a glTF file (else the sphere) with the current material.
+    pub fn preview_scene(&self, gltf: Option<&Path>) -> Result<PreviewScene, String> {
+        let material = self.material.render_material()?;
+        match gltf {
+            Some(p) => PreviewScene::gltf(p, material),
+            None => Ok(PreviewScene::sphere(material)),
+        }
+    }
+
+    /// Loads a glTF scene into the preview; its first Facet material takes the edits.
+    pub fn open_scene(&mut self, path: &Path) {
+        match self.preview_scene(Some(path)) {
+            Ok(ps) => {
+                self.orbit = ps.orbit;
+                self.status = format!(
+                    "scene {}: material {:?} is edited",
+                    path.display(),
+                    ps.scene.materials[ps.edited].name
+                );
+                match &self.preview {
+                    Some(p) => p.send(Command::Scene(Box::new(ps))),
+                    None => self.status += " (no preview without a GPU)",
+                }
+            }
+            Err(e) => self.error = Some(format!("cannot open {}: {e}", path.display())),
+        }
+    }
+
+    /// The neural proxies' names (the network file is read once).
+    pub fn proxies(&mut self) -> &Result<Vec<String>, String> {
+        let path = self.nbrdf.clone();
+        self.proxy_names.get_or_insert_with(|| {
+            facet_fit::nbrdf::NbrdfLibrary::open(&path)
+                .map(|lib| lib.names().map(str::to_owned).collect())
+                .map_err(|e| e.to_string())
+        })
+    }
+
+    fn set_material(&mut self, m: EditedMaterial) {
+        self.material = m;
+        self.open_text = self.material.source.clone();
+    }
+
+    /// Polls the fit job; true while one runs.
+    pub fn poll_fit(&mut self) -> bool {
+        let Some(job) = &self.fit_job else {
+            return false;
+        };
+        match job.rx.try_recv() {
+            Ok(Ok(fit)) => {
+                let label = job.label.clone();
+                let secs = job.started.elapsed().as_secs_f64();
+                self.fit_job = None;
+                self.set_material(EditedMaterial::new(fit, label.clone()));
+                self.status = format!("fitted {label} in {secs:.1} s");
+                false
+            }
+            Ok(Err(e)) => {
+                self.error = Some(format!("cannot open {}: {e}", job.label));
+                self.fit_job = None;
+                false
+            }
+            Err(std::sync::mpsc::TryRecvError::Empty) => true,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => {
+                self.error = Some(format!("the fit of {} stopped", job.label));
+                self.fit_job = None;
+                false
+            }
+        }
+    }
+
+    /// Writes the edited material as a fit JSON that `facet render` reads.
+    pub fn save(&mut self, path: &Path) {
+        let r = FittedMaterial::from_record(self.material.edited_record())
+            .map_err(|e| e.to_string())
+            .and_then(|m| m.save(path).map_err(|e| e.to_string()));
+        match r {
+            Ok(()) => {
+                self.status = format!("saved {}", path.display());
+                self.error = None;
+            }
+            Err(e) => self.error = Some(format!("cannot save {}: {e}", path.display())),
+        }
+    }
+
+    /// Sends the material to the renderer if it changed since the last call; true if it did.
+    pub fn sync_material(&mut self) -> bool {
+        let key = self.material.key();
+        if self.sent_key.as_ref() == Some(&key) {
+            return false;
+        }
+        match self.material.render_material() {
+            Ok(m) => {
+                self.generation += 1;
+                self.sent_key = Some(key);
+                let sent = self.edited_at.take().unwrap_or_else(Instant::now);
+                if let Some(p) = &self.preview {
+                    p.send(Command::Material {
+                        generation: self.generation,
+                        material: Box::new(m),
+                        sent,
+                    });
+                }
+                true
+            }
+            Err(e) => {
+                self.error = Some(format!("invalid material: {e}"));
+                self.sent_key = Some(key);
+                false
+            }
+        }
+    }
+
+    /// Files dropped on the window are opened.
+    pub fn handle_drops(&mut self, ctx: &egui::Context) {
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_owned())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
+        for p in dropped {
+            self.open(&p.display().to_string());
+        }
+    }
+
+    /// The whole UI inside `ui` (the eframe app and the tests call this).
+    pub fn show(&mut self, ui: &mut egui::Ui) {
+        let ctx = ui.ctx().clone();
+        self.handle_drops(&ctx);
+        if self.poll_fit() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(100));
+        }
+        crate::panels::material_panel(self, ui);
+        crate::panels::plots_panel(self, ui);
+        crate::panels::preview_panel(self, ui);
+        self.sync_material();
+    }
+}
+
+impl eframe::App for ViewerApp {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.show(ui);
+        crate::panels::screenshot_step(self, ui.ctx());
+    }
+}

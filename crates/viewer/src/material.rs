@@ -1,0 +1,234 @@
+//! The edited material: a fit record, the model shown, and the edits applied on top of it.
+
+use facet_fit::material::{FitRecord, FittedMaterial};
+use facet_render::scene::{FacetMaterial, FacetModel, GlintParams, Material};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// What the preview shows on the sphere.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shown {
+    /// The measured data's own NDF: the tabulated fit as extracted, without edits.
+    Measured,
+    /// The tabulated fit with the edited stretch.
+    Tabulated,
+    Ggx,
+    Beckmann,
+    /// The GGX model with glints.
+    Glint,
+}
+
+impl Shown {
+    pub const ALL: [Shown; 5] = [
+        Shown::Measured,
+        Shown::Tabulated,
+        Shown::Ggx,
+        Shown::Beckmann,
+        Shown::Glint,
+    ];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Shown::Measured => "measured data",
+            Shown::Tabulated => "tabulated fit",
+            Shown::Ggx => "GGX",
+            Shown::Beckmann => "Beckmann",
+            Shown::Glint => "glint",
+        }
+    }
+}
+
+/// Glint settings of the edit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlintEdit {
+    pub density: f32,
+    pub gamma_deg: f32,
+    pub threshold: f32,
+}
+
+impl Default for GlintEdit {
+    fn default() -> Self {
+        GlintEdit {
+            density: 2.0e5,
+            gamma_deg: 1.0,
+            threshold: 64.0,
+        }
+    }
+}
+
+/// The loaded fit and the edits on it. `record` holds the edited α and rotation of every
+/// model; `tint` multiplies every Fresnel table when the record is written out.
+#[derive(Clone, Debug)]
+pub struct EditedMaterial {
+    /// The fit as loaded or fitted (the "data's fit" of the plots).
+    pub base: Arc<FittedMaterial>,
+    /// Where it came from (file path or source spec).
+    pub source: String,
+    /// The record with edited α and rotation.
+    pub record: FitRecord,
+    pub shown: Shown,
+    pub tint: [f64; 3],
+    pub glint: GlintEdit,
+    /// αx and αy move together (their ratio kept).
+    pub lock: bool,
+}
+
+impl EditedMaterial {
+    pub fn new(base: FittedMaterial, source: String) -> Self {
+        let record = base.record.clone();
+        let shown = if record.ggx.is_some() {
+            Shown::Ggx
+        } else {
+            Shown::Tabulated
+        };
+        EditedMaterial {
+            base: Arc::new(base),
+            source,
+            record,
+            shown,
+            tint: [1.0; 3],
+            glint: GlintEdit::default(),
+            lock: true,
+        }
+    }
+
+    /// The model the shown choice renders with.
+    pub fn model(&self) -> FacetModel {
+        match self.shown {
+            Shown::Measured | Shown::Tabulated => FacetModel::Tabulated,
+            Shown::Ggx | Shown::Glint => FacetModel::Ggx,
+            Shown::Beckmann => FacetModel::Beckmann,
+        }
+    }
+
+    /// Whether the shown model exists in the fit (GGX/Beckmann may be absent).
+    pub fn available(&self, shown: Shown) -> bool {
+        match shown {
+            Shown::Measured | Shown::Tabulated => true,
+            Shown::Ggx | Shown::Glint => self.record.ggx.is_some(),
+            Shown::Beckmann => self.record.beckmann.is_some(),
+        }
+    }
+
+    /// (αx, αy, rotation) of the shown model: the tabulated stretch or the analytic α.
+    pub fn alpha(&self) -> Option<(f64, f64, f64)> {
+        let r = &self.record;
+        match self.shown {
+            Shown::Measured => None,
+            Shown::Tabulated => {
+                let s = r.tabulated.stretch;
+                Some((s.alpha_x, s.alpha_y, s.rotation))
+            }
+            Shown::Ggx | Shown::Glint => r.ggx.as_ref().map(|p| (p.alpha_x, p.alpha_y, p.rotation)),
+            Shown::Beckmann => r
+                .beckmann
+                .as_ref()
+                .map(|p| (p.alpha_x, p.alpha_y, p.rotation)),
+        }
+    }
+
+    /// Sets (αx, αy, rotation) of the shown model; α clamped to [1e-3, 4].
+    pub fn set_alpha(&mut self, ax: f64, ay: f64, rotation: f64) {
+        let (ax, ay) = (ax.clamp(1e-3, 4.0), ay.clamp(1e-3, 4.0));
+        let r = &mut self.record;
+        match self.shown {
+            Shown::Measured => {}
+            Shown::Tabulated => {
+                r.tabulated.stretch.alpha_x = ax;
+                r.tabulated.stretch.alpha_y = ay;
+                r.tabulated.stretch.rotation = rotation;
+            }
+            Shown::Ggx | Shown::Glint | Shown::Beckmann => {
+                let p = if self.shown == Shown::Beckmann {
+                    r.beckmann.as_mut()
+                } else {
+                    r.ggx.as_mut()
+                };
+                if let Some(p) = p {
+                    p.alpha_x = ax;
+                    p.alpha_y = ay;
+                    p.rotation = rotation;
+                }
+            }
+        }
+    }
+
+    /// The edited record as saved: edited α, Fresnel tables times the tint.
+    pub fn edited_record(&self) -> FitRecord {
+        let mut r = self.record.clone();
+        let tint = |t: &mut facet_fit::fresnel::FresnelTable| {
+            for v in &mut t.rgb {
+                for (x, k) in v.iter_mut().zip(self.tint) {
+                    *x *= k;
+                }
+            }
+        };
+        if self.tint != [1.0; 3] {
+            tint(&mut r.fresnel);
+            if let Some(p) = r.ggx.as_mut() {
+                tint(&mut p.fresnel);
+            }
+            if let Some(p) = r.beckmann.as_mut() {
+                tint(&mut p.fresnel);
+            }
+        }
+        r
+    }
+
+    /// The fitted material the renderer gets (the unedited base for "measured data").
+    pub fn fitted(&self) -> Result<Arc<FittedMaterial>, String> {
+        if self.shown == Shown::Measured {
+            return Ok(self.base.clone());
+        }
+        FittedMaterial::from_record(self.edited_record()).map(Arc::new)
+    }
+
+    /// The scene material of the sphere.
+    pub fn render_material(&self) -> Result<Material, String> {
+        let fit = self.fitted()?;
+        let glint = (self.shown == Shown::Glint).then_some(GlintParams {
+            density: self.glint.density,
+            gamma_deg: self.glint.gamma_deg,
+            threshold: self.glint.threshold,
+        });
+        Ok(Material {
+            name: "facet".into(),
+            facet: Some(FacetMaterial {
+                source: PathBuf::from(&self.source),
+                fit,
+                model: self.model(),
+                glint,
+            }),
+            ..Material::default()
+        })
+    }
+
+    /// What the renderer's material depends on, for change detection (cheap to compare).
+    pub fn key(&self) -> MaterialKey {
+        let p = |p: &Option<facet_fit::material::ParamRecord>| {
+            p.as_ref().map(|p| [p.alpha_x, p.alpha_y, p.rotation])
+        };
+        let s = self.record.tabulated.stretch;
+        MaterialKey {
+            base: Arc::as_ptr(&self.base) as usize,
+            shown: self.shown,
+            stretch: [s.alpha_x, s.alpha_y, s.rotation],
+            ggx: p(&self.record.ggx),
+            beckmann: p(&self.record.beckmann),
+            tint: self.tint,
+            glint: (self.shown == Shown::Glint).then_some(self.glint),
+        }
+    }
+}
+
+/// See [`EditedMaterial::key`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialKey {
+    pub base: usize,
+    pub shown: Shown,
+    pub stretch: [f64; 3],
+    pub ggx: Option<[f64; 3]>,
+    pub beckmann: Option<[f64; 3]>,
+    pub tint: [f64; 3],
+    pub glint: Option<GlintEdit>,
+}

@@ -1,0 +1,165 @@
+//! The material panel: open, model choice, sliders, save.
+
+use crate::app::ViewerApp;
+use crate::material::Shown;
+use std::time::Instant;
+
+pub fn material_panel(app: &mut ViewerApp, ui: &mut egui::Ui) {
+    egui::Panel::left("material")
+        .resizable(true)
+        .default_size(340.0)
+        .show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| contents(app, ui));
+        });
+}
+
+fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
+    ui.heading("Material");
+    let hint = ui
+        .label("MERL file, fit JSON, nbrdf:NAME, analytic:SPEC, or a glTF scene (or drop a file):");
+    ui.horizontal(|ui| {
+        let r = ui
+            .add(egui::TextEdit::singleline(&mut app.open_text).desired_width(200.0))
+            .labelled_by(hint.id);
+        let enter = r.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        if ui.button("Open").clicked() || enter {
+            let spec = app.open_text.clone();
+            app.open(&spec);
+        }
+    });
+    let mut chosen = None;
+    egui::ComboBox::from_label("neural proxy")
+        .selected_text("choose...")
+        .height(300.0)
+        .show_ui(ui, |ui| match app.proxies() {
+            Ok(names) => {
+                for name in names {
+                    if ui.selectable_label(false, name).clicked() {
+                        chosen = Some(format!("nbrdf:{name}"));
+                    }
+                }
+            }
+            Err(e) => {
+                ui.label(format!("no proxies: {e}"));
+            }
+        });
+    if let Some(spec) = chosen {
+        app.open_text = spec.clone();
+        app.open(&spec);
+    }
+    if let Some(job) = &app.fit_job {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(format!(
+                "fitting {}: {} ({:.0} s)",
+                job.label,
+                job.stage.lock().unwrap(),
+                job.started.elapsed().as_secs_f64()
+            ));
+        });
+    }
+    if let Some(e) = app.error.clone() {
+        ui.horizontal(|ui| {
+            ui.colored_label(egui::Color32::from_rgb(230, 80, 60), format!("Error: {e}"));
+            if ui.small_button("dismiss").clicked() {
+                app.error = None;
+            }
+        });
+    }
+    ui.label(format!("Source: {}", app.material.source));
+    ui.separator();
+
+    let m = &mut app.material;
+    let before = m.key();
+    ui.label("Shown:");
+    for s in Shown::ALL {
+        let enabled = m.available(s);
+        ui.add_enabled_ui(enabled, |ui| {
+            ui.radio_value(&mut m.shown, s, s.label());
+        });
+    }
+    if let Some((mut ax, mut ay, rot)) = m.alpha() {
+        let rot_deg0 = rot.to_degrees();
+        let mut rot_deg = rot_deg0;
+        let what = if m.shown == Shown::Tabulated {
+            "stretch of the tabulated NDF"
+        } else {
+            "α of the model"
+        };
+        ui.label(what);
+        let old = (ax, ay);
+        ui.add(
+            egui::Slider::new(&mut ax, 0.01..=2.0)
+                .logarithmic(true)
+                .text("αx"),
+        );
+        ui.add(
+            egui::Slider::new(&mut ay, 0.01..=2.0)
+                .logarithmic(true)
+                .text("αy"),
+        );
+        ui.checkbox(&mut m.lock, "lock (isotropic scaling)");
+        if m.lock {
+            if ax != old.0 && old.0 > 0.0 {
+                ay = old.1 * ax / old.0;
+            } else if ay != old.1 && old.1 > 0.0 {
+                ax = old.0 * ay / old.1;
+            }
+        }
+        ui.add(egui::Slider::new(&mut rot_deg, -90.0..=90.0).text("rotation °"));
+        if (ax, ay) != old || rot_deg != rot_deg0 {
+            let rot = if rot_deg != rot_deg0 {
+                rot_deg.to_radians()
+            } else {
+                rot
+            };
+            m.set_alpha(ax, ay, rot);
+        }
+    } else {
+        ui.label("The measured data are shown as extracted (no edits).");
+    }
+    ui.label("Fresnel tint:");
+    let tint0 = m.tint.map(|v| v as f32);
+    let mut tint = tint0;
+    ui.horizontal(|ui| {
+        ui.color_edit_button_rgb(&mut tint);
+        if ui.small_button("reset").clicked() {
+            tint = [1.0; 3];
+        }
+    });
+    if tint != tint0 {
+        m.tint = tint.map(|v| v as f64);
+    }
+    if m.shown == Shown::Glint {
+        ui.label("Glints:");
+        ui.add(
+            egui::Slider::new(&mut m.glint.density, 1e3..=1e7)
+                .logarithmic(true)
+                .text("density"),
+        );
+        ui.add(egui::Slider::new(&mut m.glint.gamma_deg, 0.25..=5.0).text("γ °"));
+        ui.add(
+            egui::Slider::new(&mut m.glint.threshold, 1.0..=1e4)
+                .logarithmic(true)
+                .text("threshold"),
+        );
+    }
+    if m.key() != before {
+        app.edited_at = Some(Instant::now());
+    }
+    ui.separator();
+    ui.add(egui::Slider::new(&mut app.exposure, -6.0..=6.0).text("exposure"));
+    ui.separator();
+    let hint = ui.label("Save the edited material as a fit JSON:");
+    ui.horizontal(|ui| {
+        ui.add(egui::TextEdit::singleline(&mut app.save_text).desired_width(180.0))
+            .labelled_by(hint.id);
+        if ui.button("Save fit JSON").clicked() {
+            let p = std::path::PathBuf::from(app.save_text.trim());
+            app.save(&p);
+        }
+    });
+    if !app.status.is_empty() {
+        ui.label(app.status.as_str());
+    }
+}

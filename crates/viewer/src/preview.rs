@@ -1,0 +1,455 @@
+//! The progressive preview: a path-traced sphere on a plane under the demo sky, rendered on a
+//! worker thread that shares eframe's device and queue.
+//!
+//! Why a thread: `Integrator::render` submits and then waits for the GPU. On lavapipe one
+//! sample per pixel of a 256² image takes tens of milliseconds, and rebuilding the pipelines
+//! after a change of material class takes about half a second; done inside `App::ui` either
+//! would freeze the window. The worker renders one sample per pixel per batch, adds it to a
+//! CPU accumulation buffer, publishes the mean, asks for a repaint, and reads the UI's
+//! commands between batches, so a slider move restarts accumulation within one batch.
+
+use facet_gpu::Gpu;
+use facet_render::camera::CameraFrame;
+use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
+use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};
+use glam::{Vec3, Vec4};
+use std::sync::mpsc::{Receiver, Sender, TryRecvError};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// Index of the sphere's material in the sphere scene.
+pub const SPHERE: usize = 1;
+/// Accumulation stops here (the GPU rests until the next change).
+pub const MAX_SAMPLES: u32 = 1024;
+
+/// An orbit camera around `target`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbit {
+    pub target: Vec3,
+    pub yaw: f32,
+    pub pitch: f32,
+    pub distance: f32,
+    /// Vertical field of view, radians.
+    pub yfov: f32,
+}
+
+impl Default for Orbit {
+    fn default() -> Self {
+        Orbit {
+            target: Vec3::ZERO,
+            yaw: 0.0,
+            pitch: 0.25,
+            distance: 4.5,
+            yfov: 35f32.to_radians(),
+        }
+    }
+}
+
+impl Orbit {
+    /// The orbit through a scene's camera, around the centre of the scene's bounds.
+    pub fn from_camera(camera: &Camera, bounds: (Vec3, Vec3)) -> Self {
+        let target = 0.5 * (bounds.0 + bounds.1);
+        let offset = camera.position - target;
+        let distance = offset.length().max(1e-3);
+        let d = offset / distance;
+        Orbit {
+            target,
+            yaw: d.x.atan2(d.z),
+            pitch: d.y.clamp(-1.0, 1.0).asin(),
+            distance,
+            yfov: camera.yfov,
+        }
+    }
+
+    pub fn camera(&self) -> Camera {
+        let pitch = self.pitch.clamp(-0.2, 1.4);
+        let dir = Vec3::new(
+            pitch.cos() * self.yaw.sin(),
+            pitch.sin(),
+            pitch.cos() * self.yaw.cos(),
+        );
+        let position = self.target + dir * self.distance;
+        let forward = -dir;
+        let up = (Vec3::Y - forward * forward.dot(Vec3::Y)).normalize();
+        Camera {
+            position,
+            forward,
+            up,
+            yfov: self.yfov,
+        }
+    }
+}
+
+/// A scene for the preview: the scene, which material the edits go to, where the orbit starts.
+#[derive(Clone, Debug)]
+pub struct PreviewScene {
+    pub scene: Scene,
+    /// Index of the edited material.
+    pub edited: usize,
+    pub orbit: Orbit,
+}
+
+impl PreviewScene {
+    /// A unit sphere (the edited material) on a grey plane.
+    pub fn sphere(material: Material) -> Self {
+        PreviewScene {
+            scene: preview_scene(material),
+            edited: SPHERE,
+            orbit: Orbit::default(),
+        }
+    }
+
+    /// A glTF scene whose first Facet material (else its first material) takes the edits.
+    pub fn gltf(path: &std::path::Path, material: Material) -> Result<Self, String> {
+        let mut scene =
+            facet_render::scene::load_gltf(path, &Default::default()).map_err(|e| e.to_string())?;
+        let edited = scene
+            .materials
+            .iter()
+            .position(|m| m.facet.is_some())
+            .unwrap_or(0);
+        if scene.materials.is_empty() {
+            return Err(format!("{}: the scene has no materials", path.display()));
+        }
+        scene.materials[edited] = Material {
+            name: scene.materials[edited].name.clone(),
+            ..material
+        };
+        let orbit = Orbit::from_camera(&scene.camera, scene.bounds());
+        Ok(PreviewScene {
+            scene,
+            edited,
+            orbit,
+        })
+    }
+}
+
+/// What the UI sends.
+pub enum Command {
+    /// A new sphere material; `sent` is when the edit happened (latency is measured from it).
+    Material {
+        generation: u64,
+        material: Box<Material>,
+        sent: Instant,
+    },
+    Camera(Orbit),
+    /// Another scene (resources and pipelines are rebuilt).
+    Scene(Box<PreviewScene>),
+    Quit,
+}
+
+/// What the worker publishes.
+#[derive(Clone, Debug, Default)]
+pub struct Shared {
+    /// The material generation the accumulated image shows.
+    pub generation: u64,
+    pub width: u32,
+    pub height: u32,
+    /// Mean linear RGB so far.
+    pub mean: Vec<[f32; 3]>,
+    pub samples: u32,
+    /// Bumped on every published frame.
+    pub frame: u64,
+    /// Wall time of the last batch (render + readback + accumulation), ms.
+    pub frame_ms: f64,
+    /// Samples per pixel per second over the current accumulation.
+    pub spp_per_s: f64,
+    /// Pixel samples per second over the current accumulation.
+    pub samples_per_s: f64,
+    /// From the last material edit to its first published frame, ms.
+    pub latency_ms: Option<f64>,
+    /// Whether the last material change needed new resources (pipelines) rather than an
+    /// in-place buffer write.
+    pub last_rebuilt: bool,
+    pub rebuilding: bool,
+    pub error: Option<String>,
+    pub adapter: String,
+}
+
+/// The UI's handle on the worker.
+pub struct Preview {
+    tx: Sender<Command>,
+    pub shared: Arc<Mutex<Shared>>,
+    /// The device's uncaptured errors (wgpu would panic on them): shown in the window.
+    pub gpu_error: Arc<Mutex<Option<String>>>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for Preview {
+    fn drop(&mut self) {
+        let _ = self.tx.send(Command::Quit);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// The preview scene: a unit sphere (material [`SPHERE`]) on a grey plane.
+pub fn preview_scene(sphere: Material) -> Scene {
+    let mut scene = Scene::default();
+    scene.materials.push(Material {
+        name: "floor".into(),
+        base_color: Vec4::new(0.45, 0.45, 0.45, 1.0),
+        roughness: 0.8,
+        metallic: 0.0,
+        ..Material::default()
+    });
+    scene.materials.push(sphere);
+    scene.add_quad(
+        Vec3::new(-8.0, -1.0, 8.0),
+        Vec3::new(16.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -16.0),
+        4.0,
+        0,
+    );
+    scene.add_uv_sphere(Vec3::ZERO, 1.0, 96, 48, SPHERE as u32);
+    scene.camera = Orbit::default().camera();
+    scene
+}
+
+/// The demo sky, or a constant grey when it cannot be read.
+pub fn preview_environment() -> Environment {
+    match EnvironmentMap::load(&crate::demo_dir().join("sky.exr")) {
+        Ok((map, _)) => Environment::Map(Arc::new(map)),
+        Err(_) => Environment::Constant(Vec3::splat(0.8)),
+    }
+}
+
+impl Preview {
+    /// Starts the worker on `gpu` (eframe's device) with a scene.
+    pub fn start(
+        gpu: Gpu,
+        scene: PreviewScene,
+        size: (u32, u32),
+        repaint: impl Fn() + Send + 'static,
+    ) -> Self {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let shared = Arc::new(Mutex::new(Shared {
+            adapter: gpu.describe(),
+            rebuilding: true,
+            ..Default::default()
+        }));
+        let gpu_error = Arc::new(Mutex::new(None));
+        let slot = gpu_error.clone();
+        // Its own lock: wgpu calls the handler inside whichever call failed.
+        gpu.device
+            .on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+                *slot.lock().unwrap() = Some(e.to_string());
+            }));
+        let sh = shared.clone();
+        let thread = std::thread::Builder::new()
+            .name("facet-preview".into())
+            .spawn(move || {
+                if let Err(e) = worker(gpu, scene, size, rx, &sh, &repaint) {
+                    sh.lock().unwrap().error = Some(e);
+                    repaint();
+                }
+            })
+            .expect("spawn the preview thread");
+        Preview {
+            tx,
+            shared,
+            gpu_error,
+            thread: Some(thread),
+        }
+    }
+
+    pub fn send(&self, cmd: Command) {
+        let _ = self.tx.send(cmd);
+    }
+}
+
+struct Built {
+    res: SceneResources,
+    integrator: Integrator,
+}
+
+fn build(gpu: &Gpu, scene: &Scene, env: &Environment) -> Result<Built, String> {
+    let res = SceneResources::new(gpu, scene, Some(env), ResourceConfig::standard())
+        .map_err(|e| e.to_string())?;
+    let integrator = Integrator::new(&gpu.device, &res).map_err(|e| e.to_string())?;
+    Ok(Built { res, integrator })
+}
+
+fn worker(
+    gpu: Gpu,
+    preview: PreviewScene,
+    (width, height): (u32, u32),
+    rx: Receiver<Command>,
+    shared: &Mutex<Shared>,
+    repaint: &dyn Fn(),
+) -> Result<(), String> {
+    let env = preview_environment();
+    let PreviewScene {
+        mut scene,
+        mut edited,
+        orbit,
+    } = preview;
+    let mut orbit = orbit;
+    let mut built = build(&gpu, &scene, &env)?;
+    let mut camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
+    let n = (width * height) as usize;
+    let mut sum = vec![[0f32; 3]; n];
+    let mut samples = 0u32;
+    let mut generation = 0u64;
+    let mut pending_latency: Option<Instant> = None;
+    let mut started = Instant::now();
+    let mut frame = 0u64;
+    let mut seed = 0u32;
+    {
+        let mut s = shared.lock().unwrap();
+        s.rebuilding = false;
+        s.width = width;
+        s.height = height;
+    }
+    loop {
+        // Commands: block only when there is nothing left to render.
+        let mut cmds = Vec::new();
+        if samples >= MAX_SAMPLES {
+            match rx.recv() {
+                Ok(c) => cmds.push(c),
+                Err(_) => return Ok(()),
+            }
+        }
+        loop {
+            match rx.try_recv() {
+                Ok(c) => cmds.push(c),
+                Err(TryRecvError::Empty) => break,
+                Err(TryRecvError::Disconnected) => return Ok(()),
+            }
+        }
+        let mut restart = false;
+        let mut new_material = None;
+        for c in cmds {
+            match c {
+                Command::Quit => return Ok(()),
+                Command::Scene(p) => {
+                    shared.lock().unwrap().rebuilding = true;
+                    repaint();
+                    let b = build(&gpu, &p.scene, &env);
+                    let mut s = shared.lock().unwrap();
+                    s.rebuilding = false;
+                    match b {
+                        Ok(b) => {
+                            built = b;
+                            scene = p.scene;
+                            edited = p.edited;
+                            orbit = p.orbit;
+                            restart = true;
+                        }
+                        Err(e) => s.error = Some(format!("preview scene: {e}")),
+                    }
+                }
+                Command::Camera(o) => {
+                    orbit = o;
+                    restart = true;
+                }
+                Command::Material {
+                    generation: g,
+                    material,
+                    sent,
+                } => new_material = Some((g, material, sent)),
+            }
+        }
+        if let Some((g, material, sent)) = new_material {
+            let name = scene.materials[edited].name.clone();
+            scene.materials[edited] = Material { name, ..*material };
+            let in_place = built
+                .res
+                .update_material(&gpu.queue, &scene, edited)
+                .is_ok();
+            if !in_place {
+                shared.lock().unwrap().rebuilding = true;
+                repaint();
+                let b = build(&gpu, &scene, &env);
+                let mut s = shared.lock().unwrap();
+                s.rebuilding = false;
+                match b {
+                    Ok(b) => built = b,
+                    Err(e) => {
+                        s.error = Some(format!("preview: {e}"));
+                        drop(s);
+                        repaint();
+                        continue;
+                    }
+                }
+            }
+            shared.lock().unwrap().last_rebuilt = !in_place;
+            generation = g;
+            pending_latency = Some(sent);
+            restart = true;
+        }
+        if restart {
+            camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
+            sum.iter_mut().for_each(|p| *p = [0.0; 3]);
+            samples = 0;
+            started = Instant::now();
+        }
+        if samples >= MAX_SAMPLES {
+            continue;
+        }
+        let t = Instant::now();
+        let cfg = RenderConfig {
+            width,
+            height,
+            spp: 1,
+            spp_per_pass: 1,
+            wavefront: width * height,
+            seed,
+            ..RenderConfig::preview()
+        };
+        seed = seed.wrapping_add(1);
+        let (image, _) = built
+            .integrator
+            .render(&gpu, &built.res, &camera, &cfg, &mut |_| {})
+            .map_err(|e| format!("preview render: {e}"))?;
+        gpu.check_lost().map_err(|e| e.to_string())?;
+        for (s, p) in sum.iter_mut().zip(&image.pixels) {
+            for (a, v) in s.iter_mut().zip(p) {
+                if v.is_finite() {
+                    *a += v;
+                }
+            }
+        }
+        samples += 1;
+        frame += 1;
+        let inv = 1.0 / samples as f32;
+        let mean: Vec<[f32; 3]> = sum.iter().map(|s| s.map(|v| v * inv)).collect();
+        let frame_ms = t.elapsed().as_secs_f64() * 1e3;
+        let secs = started.elapsed().as_secs_f64().max(1e-9);
+        {
+            let mut s = shared.lock().unwrap();
+            s.generation = generation;
+            s.mean = mean;
+            s.samples = samples;
+            s.frame = frame;
+            s.frame_ms = frame_ms;
+            s.spp_per_s = samples as f64 / secs;
+            s.samples_per_s = samples as f64 * n as f64 / secs;
+            if let Some(sent) = pending_latency.take() {
+                s.latency_ms = Some(sent.elapsed().as_secs_f64() * 1e3);
+            }
+        }
+        repaint();
+    }
+}
+
+/// The README's tone mapping: v = 1 − exp(−2^exposure · L), then sRGB.
+pub fn tone_map(mean: &[[f32; 3]], exposure: f32) -> Vec<egui::Color32> {
+    let k = 2f32.powf(exposure);
+    let srgb = |v: f32| {
+        let v = v.clamp(0.0, 1.0);
+        let s = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0 + 0.5) as u8
+    };
+    mean.iter()
+        .map(|p| {
+            let m = p.map(|l| srgb(1.0 - (-k * l.max(0.0)).exp()));
+            egui::Color32::from_rgb(m[0], m[1], m[2])
+        })
+        .collect()
+}
