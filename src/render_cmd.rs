@@ -190,12 +190,19 @@ pub struct Timings {
     pub built: facet_render::Built,
 }
 
-/// Renders a job and writes both outputs.
-pub fn render_job(job: &Job, out: &Path, exposure: f32) -> Result<Timings> {
-    let gpu = facet_gpu::Gpu::new().context("the renderer needs a GPU adapter")?;
+/// The renderer's adapter (FACET_BACKEND / FACET_ADAPTER choose it), with a hint when none.
+pub fn open_gpu() -> Result<facet_gpu::Gpu> {
+    facet_gpu::Gpu::new().context(
+        "the renderer needs a GPU adapter (any wgpu adapter works; on Linux without a GPU, \
+         `apt-get install mesa-vulkan-drivers libvulkan1` gives the lavapipe software adapter)",
+    )
+}
+
+/// Renders a job on `gpu` and writes both outputs.
+pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) -> Result<Timings> {
     println!("adapter: {}", gpu.describe());
     let t = std::time::Instant::now();
-    let res = SceneResources::new(&gpu, &job.scene, job.environment.as_ref(), job.resources)?;
+    let res = SceneResources::new(gpu, &job.scene, job.environment.as_ref(), job.resources)?;
     let resources = t.elapsed().as_secs_f64() * 1e3;
     let t = std::time::Instant::now();
     let integrator = Integrator::new(&gpu.device, &res)?;
@@ -206,7 +213,7 @@ pub fn render_job(job: &Job, out: &Path, exposure: f32) -> Result<Timings> {
         ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed} (eta {eta})")
             .expect("static template"),
     );
-    let (image, stats) = integrator.render(&gpu, &res, &camera, &job.config, &mut |f| {
+    let (image, stats) = integrator.render(gpu, &res, &camera, &job.config, &mut |f| {
         bar.set_position((f * 1000.0) as u64)
     })?;
     bar.finish_and_clear();
@@ -248,7 +255,8 @@ pub fn print_timings(t: &Timings, triangles: usize) {
 
 pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let job = prepare(args)?;
-    let timings = render_job(&job, &args.out, args.exposure)?;
+    let gpu = open_gpu()?;
+    let timings = render_job(&gpu, &job, &args.out, args.exposure)?;
     print_timings(&timings, job.scene.indices.len());
     Ok(ExitCode::SUCCESS)
 }
