@@ -4,6 +4,9 @@ use std::path::PathBuf;
 
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
+    /// A file that is not a regular file, too large for its kind, or unreadable.
+    #[error(transparent)]
+    Input(#[from] crate::input::InputError),
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,

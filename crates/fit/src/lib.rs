@@ -39,6 +39,7 @@ pub mod fresnel;
 pub mod geometry;
 pub mod gpu;
 pub mod grid;
+pub mod input;
 pub mod material;
 pub mod merl;
 pub mod microfacet;

@@ -147,7 +147,7 @@ impl FittedMaterial {
             path: path.to_owned(),
             problem,
         };
-        let text = std::fs::read_to_string(path).map_err(|e| FitError::io(path, e))?;
+        let text = crate::input::read_to_string(path, crate::input::Cap::FIT_JSON)?;
         let record: FitRecord = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
         Self::from_record(record).map_err(bad)
     }

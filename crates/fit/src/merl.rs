@@ -75,11 +75,7 @@ impl MerlTable {
             path: path.to_owned(),
             problem,
         };
-        let meta = std::fs::metadata(path).map_err(|e| FitError::io(path, e))?;
-        if meta.is_dir() {
-            return Err(bad("is a directory".into()));
-        }
-        let len = meta.len();
+        let (mut file, len) = crate::input::open(path, crate::input::Cap::MERL)?;
         if len == 0 {
             return Err(bad("the file is empty".into()));
         }
@@ -88,7 +84,6 @@ impl MerlTable {
                 "truncated header: {len} bytes, a header needs 12"
             )));
         }
-        let mut file = std::fs::File::open(path).map_err(|e| FitError::io(path, e))?;
         let mut header = [0u8; 12];
         file.read_exact(&mut header)
             .map_err(|e| FitError::io(path, e))?;

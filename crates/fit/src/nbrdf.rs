@@ -124,10 +124,7 @@ impl NbrdfLibrary {
             path: path.to_owned(),
             problem,
         };
-        if path.is_dir() {
-            return Err(bad("is a directory".into()));
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| FitError::io(path, e))?;
+        let text = crate::input::read_to_string(path, crate::input::Cap::NBRDF)?;
         let entries: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text)
             .map_err(|e| bad(format!("not a JSON object of networks: {e}")))?;
         if entries.is_empty() {

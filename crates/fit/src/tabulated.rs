@@ -58,8 +58,21 @@ impl NdfTables {
                 self.nu, self.ng, self.nphi
             ));
         }
-        if self.d.len() != self.nu * self.nphi || self.g1.len() != self.ng * self.nphi {
-            return Err("table lengths do not match nu · nphi and ng · nphi".into());
+        // Sizes from a file: a product that overflows matches no table.
+        let (d_len, g1_len) = (
+            self.nu.checked_mul(self.nphi),
+            self.ng.checked_mul(self.nphi),
+        );
+        if d_len != Some(self.d.len()) || g1_len != Some(self.g1.len()) {
+            return Err(format!(
+                "table lengths d = {}, g1 = {} do not match nu · nphi = {} · {} and ng · nphi = {} · {}",
+                self.d.len(),
+                self.g1.len(),
+                self.nu,
+                self.nphi,
+                self.ng,
+                self.nphi
+            ));
         }
         if self
             .d
