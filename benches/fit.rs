@@ -101,11 +101,7 @@ fn anisotropic(c: &mut Criterion) {
 }
 
 fn proxy(c: &mut Criterion) {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/nbrdf/merl100.json");
-    let Ok(lib) = NbrdfLibrary::open(&path) else {
-        eprintln!("skipping the proxy benchmark: {} not found", path.display());
-        return;
-    };
+    let lib = NbrdfLibrary::embedded();
     let src = lib.get("gold-metallic-paint").unwrap();
     let mut g = c.benchmark_group("proxy");
     g.sample_size(10);

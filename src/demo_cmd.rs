@@ -10,15 +10,19 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser, Clone, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct DemoArgs {
     /// Output folder.
     #[arg(long, default_value = "out")]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 480)]
+    /// Image width, 1 to 16384.
+    #[arg(long, default_value_t = 480, value_parser = crate::args::side)]
     pub width: u32,
-    #[arg(long, default_value_t = 270)]
+    /// Image height, 1 to 16384.
+    #[arg(long, default_value_t = 270, value_parser = crate::args::side)]
     pub height: u32,
-    #[arg(long, default_value_t = 16)]
+    /// Samples per pixel, 1 to 2^20.
+    #[arg(long, default_value_t = 16, value_parser = crate::args::spp)]
     pub spp: u32,
 }
 

@@ -1,5 +1,6 @@
 //! `facet dpf`: one DPF query from the tables, or the nine levels written as EXR slices.
 
+use crate::fit_cmd::BackendArg;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use facet_fit::extract::{ExtractConfig, extract_isotropic};
@@ -12,23 +13,28 @@ use std::process::ExitCode;
 use std::sync::Arc;
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct DpfArgs {
     /// The NDF: `analytic:beckmann?alpha=0.1`, a fit .json (its tabulated NDF), or any input of
     /// `facet fit` (its NDF is extracted first).
     #[arg(long)]
     ndf: String,
-    /// Cone half-angle γ in degrees.
-    #[arg(long)]
+    /// Cone half-angle γ in degrees, (0, 90].
+    #[arg(long, value_parser = crate::args::degrees)]
     gamma: Option<f64>,
-    /// Polar angle of ωo in degrees.
-    #[arg(long)]
+    /// Polar angle of ωo in degrees, [0, 90].
+    #[arg(long, value_parser = crate::args::degrees)]
     theta_o: Option<f64>,
-    /// Polar angle of ωi in degrees.
-    #[arg(long)]
+    /// Polar angle of ωi in degrees, [0, 90].
+    #[arg(long, value_parser = crate::args::degrees)]
     theta_i: Option<f64>,
-    /// φo − φi in degrees; 180 is the mirror configuration.
-    #[arg(long)]
+    /// φo − φi in degrees, -360 to 360; 180 is the mirror configuration.
+    #[arg(long, value_parser = crate::args::degrees)]
     dphi: Option<f64>,
+    /// Where the tables are built: auto (any adapter, else the CPU), gpu, or cpu (no adapter is
+    /// touched).
+    #[arg(long, value_enum, default_value = "auto")]
+    backend: BackendArg,
     /// Print the query's result as JSON.
     #[arg(long)]
     json: bool,
@@ -39,14 +45,14 @@ pub struct DpfArgs {
     /// Table cells: preview (12×12×24) or standard (32×32×64).
     #[arg(long, default_value = "standard")]
     resolution: String,
-    /// Neural proxy file for `nbrdf:` inputs.
+    /// Neural proxy file for `nbrdf:` inputs (default: `$FACET_NBRDF`, else the embedded ones).
     #[arg(long)]
     nbrdf: Option<PathBuf>,
 }
 
 fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
     let mut library = None;
-    let path = crate::fit_cmd::nbrdf_path(nbrdf);
+    let path = facet_fit::nbrdf::NbrdfLibrary::override_path(nbrdf.as_deref());
     if let Some(rest) = spec.strip_prefix("analytic:") {
         return Ok(facet_fit::analytic::parse_analytic(rest)?.ndf);
     }
@@ -54,7 +60,7 @@ fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
         let fit = facet_fit::material::FittedMaterial::load(Path::new(spec))?;
         return Ok(fit.tabulated.ndf.clone());
     }
-    let src = open_source(spec, &path, &mut library)?;
+    let src = open_source(spec, path.as_deref(), &mut library)?;
     let ex = extract_isotropic(src.as_ref(), &ExtractConfig::isotropic())?;
     let model = MicrofacetBrdf {
         name: spec.into(),
@@ -65,16 +71,29 @@ fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
     Ok(model.ndf)
 }
 
-/// Builds the listed levels on the GPU when there is one, else on the CPU.
-fn build(ndf: &Ndf, cfg: DpfConfig, which: &[usize]) -> (DpfPyramid, String) {
-    match Gpu::new() {
-        Ok(gpu) => match facet_glint::gpu::build_levels(&gpu, ndf, cfg, which) {
-            Ok(g) => return (g.pyramid, gpu.describe()),
-            Err(e) => eprintln!("notice: GPU build failed ({e}); building on the CPU"),
-        },
-        Err(e) => eprintln!("notice: {e}; building on the CPU"),
+/// Builds the listed levels on the GPU (`auto`: when there is one, else on the CPU).
+fn build(
+    ndf: &Ndf,
+    cfg: DpfConfig,
+    which: &[usize],
+    backend: BackendArg,
+) -> Result<(DpfPyramid, String)> {
+    if backend != BackendArg::Cpu {
+        match Gpu::new() {
+            Ok(gpu) => match facet_glint::gpu::build_levels(&gpu, ndf, cfg, which) {
+                Ok(g) => return Ok((g.pyramid, gpu.describe())),
+                Err(e) if backend == BackendArg::Auto => {
+                    eprintln!("notice: GPU build failed ({e}); building on the CPU")
+                }
+                Err(e) => return Err(e).context("--backend gpu"),
+            },
+            Err(e) if backend == BackendArg::Auto => {
+                eprintln!("notice: {e}; building on the CPU")
+            }
+            Err(e) => return Err(e).context("--backend gpu"),
+        }
     }
-    (DpfPyramid::build_levels(ndf, cfg, which), "cpu".into())
+    Ok((DpfPyramid::build_levels(ndf, cfg, which), "cpu".into()))
 }
 
 pub fn run(args: &DpfArgs) -> Result<ExitCode> {
@@ -86,7 +105,7 @@ pub fn run(args: &DpfArgs) -> Result<ExitCode> {
     let ndf = ndf_of(&args.ndf, &args.nbrdf).with_context(|| format!("--ndf {}", args.ndf))?;
     if let Some(dir) = &args.write {
         let t = std::time::Instant::now();
-        let (pyramid, backend) = build(&ndf, cfg, &[0, 1, 2, 3, 4, 5, 6, 7, 8]);
+        let (pyramid, backend) = build(&ndf, cfg, &[0, 1, 2, 3, 4, 5, 6, 7, 8], args.backend)?;
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for table in pyramid.levels.iter().flatten() {
             let path = dir.join(format!(
@@ -122,7 +141,7 @@ pub fn run(args: &DpfArgs) -> Result<ExitCode> {
         bail!("angles out of range: θo, θi in [0, 90], γ in (0, 90], Δφ finite");
     }
     let (levels, _) = DpfPyramid::levels_for(g.to_radians());
-    let (pyramid, backend) = build(&ndf, cfg, &levels);
+    let (pyramid, backend) = build(&ndf, cfg, &levels, args.backend)?;
     let p_table = pyramid.lookup(
         to.to_radians(),
         ti.to_radians(),

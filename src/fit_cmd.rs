@@ -5,6 +5,7 @@ use clap::{Args, ValueEnum};
 use facet_fit::extract::Stopping;
 use facet_fit::fit::{Backend, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
+use facet_fit::input::same_file;
 use facet_fit::material::FittedMaterial;
 use facet_fit::merl::{MerlBrdf, MerlTable};
 use facet_fit::nbrdf::NbrdfLibrary;
@@ -18,6 +19,9 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+/// Most (θ, φ) directions of an anisotropic extraction.
+const MAX_ANISO_DIRECTIONS: usize = 65536;
+
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ModelArg {
     All,
@@ -28,7 +32,8 @@ pub enum ModelArg {
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {
-    /// The GPU when a hardware adapter exists, else the CPU (with a notice).
+    /// A GPU adapter when there is one, else the CPU, with a notice (`facet fit` leaves a
+    /// software adapter such as lavapipe alone: the f64 CPU path is faster).
     Auto,
     /// WGSL compute passes (f32); fails when there is no adapter.
     Gpu,
@@ -80,6 +85,7 @@ pub enum QuadratureArg {
 }
 
 #[derive(Args)]
+#[command(allow_negative_numbers = true)]
 pub struct FitArgs {
     /// MERL .binary file, `nbrdf:NAME`, `analytic:ggx?alpha=0.2&f0=0.04`, or a fit .json.
     #[arg(required = true)]
@@ -90,17 +96,19 @@ pub struct FitArgs {
     /// Extract on a (θ, φ) grid and fit αx, αy and rotation.
     #[arg(long)]
     aniso: bool,
-    /// Polar quadrature nodes N (default 90; 64 with --aniso).
-    #[arg(long)]
+    /// Polar quadrature nodes N, 2 to 4096 (default 90; 64 with --aniso, where N × the
+    /// azimuthal nodes is at most 65536).
+    #[arg(long, value_parser = crate::args::resolution)]
     resolution: Option<usize>,
-    /// Azimuthal nodes with --aniso.
-    #[arg(long, default_value_t = 64)]
+    /// Azimuthal nodes with --aniso, 1 to 1024.
+    #[arg(long, default_value_t = 64, value_parser = crate::args::phi_resolution)]
     phi_resolution: usize,
-    /// Run exactly M power iterations (the paper: 4) instead of iterating to convergence.
-    #[arg(long)]
+    /// Run exactly M power iterations, 1 to 10000 (the paper: 4), instead of iterating to
+    /// convergence.
+    #[arg(long, value_parser = crate::args::iterations)]
     iterations: Option<usize>,
-    /// Convergence tolerance: L1 change of the normalised NDF per iteration.
-    #[arg(long, default_value_t = 1e-9)]
+    /// Convergence tolerance: L1 change of the normalised NDF per iteration, 1e-15 to 1.
+    #[arg(long, default_value_t = 1e-9, value_parser = crate::args::tolerance)]
     tolerance: f64,
     #[arg(long, value_enum, default_value = "gauss-legendre-sqrt")]
     quadrature: QuadratureArg,
@@ -109,7 +117,8 @@ pub struct FitArgs {
     /// Output folder for <name>.json and the tables.
     #[arg(long, default_value = "out")]
     out: PathBuf,
-    /// Neural proxy file for `nbrdf:` inputs.
+    /// Neural proxy file for `nbrdf:` inputs (default: `$FACET_NBRDF`, else the MERL-100
+    /// proxies embedded in Facet).
     #[arg(long)]
     nbrdf: Option<PathBuf>,
 }
@@ -122,22 +131,21 @@ impl FitArgs {
             FitConfig::isotropic()
         };
         if let Some(n) = self.resolution {
-            if !(2..=4096).contains(&n) {
-                bail!("--resolution {n}: use 2 to 4096 nodes");
-            }
             cfg.extract.resolution = n;
         }
         if self.aniso {
-            if !(1..=4096).contains(&self.phi_resolution) {
+            cfg.extract.phi_resolution = self.phi_resolution;
+            // The kernel is (N·Nφ)² per iteration: 65536 directions is minutes already.
+            let dirs = cfg.extract.resolution * cfg.extract.phi_resolution;
+            if dirs > MAX_ANISO_DIRECTIONS {
                 bail!(
-                    "--phi-resolution {}: use 1 to 4096 nodes",
-                    self.phi_resolution
+                    "--resolution {} × --phi-resolution {} = {dirs} directions; --aniso takes at most {MAX_ANISO_DIRECTIONS}",
+                    cfg.extract.resolution,
+                    cfg.extract.phi_resolution
                 );
             }
-            cfg.extract.phi_resolution = self.phi_resolution;
         }
         cfg.extract.stopping = match self.iterations {
-            Some(0) => bail!("--iterations must be at least 1"),
             Some(m) => Stopping::Fixed(m),
             None => Stopping::Converge {
                 tolerance: self.tolerance,
@@ -171,22 +179,6 @@ impl FitArgs {
     }
 }
 
-/// The neural proxy file: `--nbrdf`, else `FACET_NBRDF`, else the shared data beside the checkout.
-pub fn nbrdf_path(arg: &Option<PathBuf>) -> PathBuf {
-    if let Some(p) = arg {
-        return p.clone();
-    }
-    if let Some(p) = std::env::var_os("FACET_NBRDF") {
-        return p.into();
-    }
-    let local = Path::new("../shared/data/nbrdf/merl100.json");
-    if local.exists() {
-        local.to_owned()
-    } else {
-        NbrdfLibrary::default_path()
-    }
-}
-
 pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let cfg = args.config()?;
     let gpu = open_gpu(args.backend)?;
@@ -194,7 +186,15 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating the output folder {}", args.out.display()))?;
-    let nbrdf = nbrdf_path(&args.nbrdf);
+    let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
+    // Every file this run reads: no output may replace one of them.
+    let read: Vec<PathBuf> = args
+        .inputs
+        .iter()
+        .filter(|i| !i.starts_with("nbrdf:") && !i.starts_with("analytic:"))
+        .map(PathBuf::from)
+        .chain(nbrdf.clone())
+        .collect();
     let mut library = None;
     let bar = (args.inputs.len() > 1).then(|| {
         let bar = ProgressBar::new(args.inputs.len() as u64);
@@ -217,9 +217,10 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
             &cfg,
             backend,
             &args.out,
-            &nbrdf,
+            nbrdf.as_deref(),
             &mut library,
             &mut names,
+            &read,
         ) {
             Ok(fit) => rows.push(fit),
             Err(e) => {
@@ -259,9 +260,10 @@ fn fit_one(
     cfg: &FitConfig,
     backend: Backend,
     out: &Path,
-    nbrdf: &Path,
+    nbrdf: Option<&Path>,
     library: &mut Option<NbrdfLibrary>,
     names: &mut HashSet<String>,
+    read: &[PathBuf],
 ) -> Result<FittedMaterial> {
     let t = Instant::now();
     let src = open_source(input, nbrdf, library)?;
@@ -272,8 +274,9 @@ fn fit_one(
     }
     fit.record.timings_ms.load = load_ms;
     fit.record.timings_ms.total += load_ms;
-    // Two inputs with one name get -2, -3, ... rather than overwriting each other.
-    let base = fit.record.name.clone();
+    // The name comes from data: a safe file stem. Two inputs with one name get -2, -3, ...
+    // rather than overwriting each other.
+    let base = facet_fit::input::safe_file_stem(&fit.record.name);
     let mut name = base.clone();
     for k in 2.. {
         if names.insert(name.clone()) {
@@ -282,19 +285,19 @@ fn fit_one(
         name = format!("{base}-{k}");
     }
     let json = out.join(format!("{name}.json"));
-    if Path::new(input).exists() && same_file(Path::new(input), &json) {
-        bail!(
-            "{input}: the output {} would overwrite the input; choose another --out",
-            json.display()
-        );
+    let csv = out.join(format!("{name}.tables.csv"));
+    for o in [&json, &csv] {
+        if let Some(i) = read.iter().find(|i| same_file(i, o)) {
+            bail!(
+                "{input}: the output {} would replace the input {}; choose another --out",
+                o.display(),
+                i.display()
+            );
+        }
     }
     fit.save(&json)?;
-    write_tables(&fit, &out.join(format!("{name}.tables.csv")))?;
+    write_tables(&fit, &csv)?;
     Ok(fit)
-}
-
-fn same_file(a: &Path, b: &Path) -> bool {
-    matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }
 
 /// θ (degrees), D, P = D cos⁴θ and G1 of the tabulated NDF at φ = 0, and F(θd) per channel.

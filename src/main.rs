@@ -1,5 +1,6 @@
 //! `facet`: measured materials to microfacet models.
 
+mod args;
 mod demo_cmd;
 mod dpf_cmd;
 mod fit_cmd;

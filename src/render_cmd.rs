@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use facet_fit::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
@@ -12,6 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Args, Clone, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct RenderArgs {
     /// The scene: a glTF 2.0 file (.gltf or .glb).
     pub scene: PathBuf,
@@ -24,23 +26,25 @@ pub struct RenderArgs {
     /// Output image; the PNG and the EXR are both written, with this stem.
     #[arg(long, default_value = "out/render.png")]
     pub out: PathBuf,
-    #[arg(long, default_value_t = 960)]
+    /// Image width, 1 to 16384 (width × height × spp at most 2^40).
+    #[arg(long, default_value_t = 960, value_parser = crate::args::side)]
     pub width: u32,
-    #[arg(long, default_value_t = 540)]
+    /// Image height, 1 to 16384.
+    #[arg(long, default_value_t = 540, value_parser = crate::args::side)]
     pub height: u32,
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 32)]
+    /// Samples per pixel, 1 to 2^20.
+    #[arg(long, default_value_t = 32, value_parser = crate::args::spp)]
     pub spp: u32,
-    /// Bounces after the camera ray.
-    #[arg(long, default_value_t = 5)]
+    /// Bounces after the camera ray, 0 to 64.
+    #[arg(long, default_value_t = 5, value_parser = crate::args::depth)]
     pub max_depth: u32,
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = crate::args::seed)]
     pub seed: u32,
-    /// Stop after the pass during which this many seconds have passed.
-    #[arg(long, value_name = "SECONDS")]
+    /// Stop after the pass during which this many seconds have passed (positive).
+    #[arg(long, value_name = "SECONDS", value_parser = crate::args::seconds)]
     pub time_limit: Option<f64>,
-    /// PNG exposure in stops (the EXR is always linear).
-    #[arg(long, default_value_t = 0.0)]
+    /// PNG exposure in stops, -64 to 64 (the EXR is always linear).
+    #[arg(long, default_value_t = 0.0, value_parser = crate::args::stops)]
     pub exposure: f32,
     /// Camera by index or name (default: the first perspective camera).
     #[arg(long)]
@@ -48,8 +52,8 @@ pub struct RenderArgs {
     /// Attach a fit JSON to the glTF material NAME (repeatable): NAME=FILE.
     #[arg(long = "material", value_name = "NAME=FILE")]
     pub materials: Vec<String>,
-    /// Paths in flight at once.
-    #[arg(long, default_value_t = 1 << 20)]
+    /// Paths in flight at once, 64 to 2^24.
+    #[arg(long, default_value_t = 1 << 20, value_parser = crate::args::wavefront)]
     pub wavefront: u32,
     /// BVH build preset.
     #[arg(long, value_enum, default_value_t = PresetArg::Medium)]
@@ -113,6 +117,15 @@ pub struct Job {
 }
 
 pub fn prepare(args: &RenderArgs) -> Result<Job> {
+    let samples = args.width as u64 * args.height as u64 * args.spp as u64;
+    if samples > crate::args::MAX_SAMPLES {
+        bail!(
+            "--width {} × --height {} × --spp {} = {samples} samples; a render takes at most 2^40",
+            args.width,
+            args.height,
+            args.spp
+        );
+    }
     let mut materials = Vec::new();
     for m in &args.materials {
         let (name, file) = m
@@ -120,21 +133,27 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
             .with_context(|| format!("--material {m:?}: expected NAME=FILE"))?;
         materials.push((name.to_owned(), PathBuf::from(file)));
     }
-    let inputs: Vec<&Path> = std::iter::once(args.scene.as_path())
-        .chain(args.env.as_deref())
-        .chain(materials.iter().map(|(_, f)| f.as_path()))
-        .collect();
-    let (png, exr) = outputs(&args.out);
-    for o in [&png, &exr] {
-        if inputs.iter().any(|i| same_file(i, o)) {
-            bail!("{}: the output would overwrite an input", o.display());
-        }
-    }
     let options = LoadOptions {
         camera: args.camera.clone(),
         materials,
     };
     let scene = load_gltf(&args.scene, &options)?;
+    // Every file the scene read (its buffers, textures and fits), the scene and the
+    // environment: no output may replace one of them.
+    let inputs: Vec<&Path> = std::iter::once(args.scene.as_path())
+        .chain(args.env.as_deref())
+        .chain(scene.inputs.iter().map(PathBuf::as_path))
+        .collect();
+    let (png, exr) = outputs(&args.out);
+    for o in [&png, &exr] {
+        if let Some(i) = inputs.iter().find(|i| same_file(i, o)) {
+            bail!(
+                "{}: the output would replace the input {}; choose another --out",
+                o.display(),
+                i.display()
+            );
+        }
+    }
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -172,13 +191,6 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         config,
         resources,
     })
-}
-
-fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
 }
 
 /// Timings of one render, ms.

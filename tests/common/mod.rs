@@ -12,14 +12,14 @@ pub fn merl_from_spec(spec: &str) -> MerlBrdf {
     MerlBrdf::from_table(spec, MerlTable::sample(&model)).unwrap()
 }
 
-/// The shared neural proxies beside the checkout.
+/// The neural proxies' file inside the repository (the one facet-fit embeds).
 pub fn nbrdf_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data/nbrdf/merl100.json")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("crates/fit/data/nbrdf/merl100.json")
 }
 
+/// The embedded MERL-100 proxies.
 pub fn nbrdf() -> NbrdfLibrary {
-    NbrdfLibrary::open(&nbrdf_path())
-        .expect("../shared/data/nbrdf/merl100.json is part of the workspace set-up")
+    NbrdfLibrary::embedded()
 }
 
 /// A scratch folder under target/ for one test.

@@ -126,8 +126,15 @@ fn backscatter_slice(src: &dyn Brdf, dirs: &[(f64, f64)]) -> Result<Vec<f64>, Fi
         name: src.name().to_owned(),
         problem,
     };
-    if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
-        return Err(fail(format!("the backscattering slice holds {v}")));
+    if let Some(v) = values
+        .iter()
+        .flatten()
+        .find(|v| !(v.abs() <= crate::brdf::MAX_FR))
+    {
+        return Err(fail(format!(
+            "the backscattering slice holds f_r = {v:e}, outside ±{:e}",
+            crate::brdf::MAX_FR
+        )));
     }
     // Missing directions take the value of their nearest valid neighbour in the list.
     let filled =

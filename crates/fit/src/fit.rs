@@ -138,6 +138,21 @@ fn fit_with(
             problem: "no valid sample on the MERL grid".into(),
         });
     }
+    let max = crate::brdf::MAX_FR as f32;
+    if let Some(s) = set
+        .samples
+        .iter()
+        .find(|s| s.x.iter().any(|x| !(x.abs() <= max)))
+    {
+        let (i, j) = (s.i, s.j);
+        return Err(FitError::Extraction {
+            name: src.name().into(),
+            problem: format!(
+                "f_r cos θi = {:?} at θh bin {i}, θd bin {j} is outside ±{max:e}",
+                s.x
+            ),
+        });
+    }
     // The GPU averages Fresnel over isotropic sample sets, uploaded once for all models.
     let uploaded = match gpu {
         Some(g) if set.rotations.len() == 1 => Some((

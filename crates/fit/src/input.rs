@@ -157,7 +157,11 @@ pub fn read(path: &Path, cap: Cap) -> Result<Vec<u8>, InputError> {
     if bytes.len() as u64 > cap.bytes {
         return Err(InputError::new(
             path,
-            format!("grew past the {} MiB a {} may hold", cap.bytes / MIB, cap.kind),
+            format!(
+                "grew past the {} MiB a {} may hold",
+                cap.bytes / MIB,
+                cap.kind
+            ),
         ));
     }
     Ok(bytes)
@@ -188,6 +192,11 @@ pub fn canonical(path: &Path) -> Option<PathBuf> {
         _ => PathBuf::from("."),
     };
     Some(canonical(&parent)?.join(name))
+}
+
+/// Whether two paths name one file, by canonical path (either may not exist yet).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    matches!((canonical(a), canonical(b)), (Some(x), Some(y)) if x == y)
 }
 
 /// A name taken from data (a record's `name`, an nbrdf key) as a safe file stem: no separators,

@@ -106,6 +106,8 @@ pub struct FittedMaterial {
 impl FittedMaterial {
     pub fn from_record(record: FitRecord) -> Result<Self, String> {
         record.fresnel.validate()?;
+        let st = record.tabulated.stretch;
+        check_alpha("tabulated.stretch", st.alpha_x, st.alpha_y, st.rotation)?;
         let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)?;
         let tabulated = MicrofacetBrdf {
             name: format!("{}-tabulated", record.name),
@@ -117,9 +119,12 @@ impl FittedMaterial {
             |kind: NdfKind, p: &Option<ParamRecord>| -> Result<Option<MicrofacetBrdf>, String> {
                 let Some(p) = p else { return Ok(None) };
                 p.fresnel.validate()?;
-                if !(p.alpha_x > 0.0 && p.alpha_y > 0.0 && p.rotation.is_finite()) {
-                    return Err(format!("{} α must be positive", kind.name()));
-                }
+                check_alpha(
+                    &format!("{}.alpha", kind.name()),
+                    p.alpha_x,
+                    p.alpha_y,
+                    p.rotation,
+                )?;
                 Ok(Some(MicrofacetBrdf {
                     name: format!("{}-{}", record.name, kind.name()),
                     ndf: Ndf::Analytic(AnalyticNdf {
@@ -143,12 +148,19 @@ impl FittedMaterial {
     }
 
     pub fn load(path: &Path) -> Result<Self, FitError> {
+        Self::parse(
+            path,
+            &crate::input::read_to_string(path, crate::input::Cap::FIT_JSON)?,
+        )
+    }
+
+    /// A fit from the text of its JSON; `path` names it in errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, FitError> {
         let bad = |problem: String| FitError::Material {
             path: path.to_owned(),
             problem,
         };
-        let text = crate::input::read_to_string(path, crate::input::Cap::FIT_JSON)?;
-        let record: FitRecord = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        let record: FitRecord = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
         Self::from_record(record).map_err(bad)
     }
 
@@ -184,6 +196,20 @@ impl FittedMaterial {
             ..self.tabulated.clone()
         }
     }
+}
+
+/// α in [`ALPHA_RANGE`](crate::analytic::ALPHA_RANGE) and a finite rotation, or an error naming
+/// the field and the values.
+fn check_alpha(field: &str, alpha_x: f64, alpha_y: f64, rotation: f64) -> Result<(), String> {
+    let range = crate::analytic::ALPHA_RANGE;
+    if range.contains(&alpha_x) && range.contains(&alpha_y) && rotation.is_finite() {
+        return Ok(());
+    }
+    Err(format!(
+        "{field}: α = ({alpha_x}, {alpha_y}), rotation {rotation} (α must lie in [{:e}, {}], the rotation be finite)",
+        range.start(),
+        range.end()
+    ))
 }
 
 /// A fitted material is a BRDF source: its tabulated model.

@@ -13,7 +13,7 @@ use crate::geometry::{HalfDiff, from_half_diff, to_half_diff};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
-use std::io::{Read, Write};
+use std::io::Write;
 use std::path::Path;
 
 pub const THETA_H_RES: usize = 90;
@@ -24,6 +24,9 @@ pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
 /// f_r = stored value × SCALE[channel].
 pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 const HEADER_BYTES: u64 = 12;
+/// The largest stored value read as a measurement (f_r ≈ 7·10⁸ sr⁻¹, past any mirror-like
+/// MERL material): larger ones would overflow the extraction's sums.
+pub const MAX_STORED: f64 = 1e12;
 
 /// Flat index of bin (θh, θd, φd).
 pub const fn index(i: usize, j: usize, k: usize) -> usize {
@@ -71,11 +74,16 @@ impl std::fmt::Debug for MerlTable {
 impl MerlTable {
     /// Reads and validates a MERL `.binary` file.
     pub fn read(path: &Path) -> Result<Self, FitError> {
+        Self::parse(path, &crate::input::read(path, crate::input::Cap::MERL)?)
+    }
+
+    /// Validates the bytes of a MERL file; `path` names it in errors.
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, FitError> {
         let bad = |problem: String| FitError::Merl {
             path: path.to_owned(),
             problem,
         };
-        let (mut file, len) = crate::input::open(path, crate::input::Cap::MERL)?;
+        let len = bytes.len() as u64;
         if len == 0 {
             return Err(bad("the file is empty".into()));
         }
@@ -84,11 +92,8 @@ impl MerlTable {
                 "truncated header: {len} bytes, a header needs 12"
             )));
         }
-        let mut header = [0u8; 12];
-        file.read_exact(&mut header)
-            .map_err(|e| FitError::io(path, e))?;
         let dims: [i32; 3] = std::array::from_fn(|d| {
-            i32::from_le_bytes(header[4 * d..4 * d + 4].try_into().unwrap())
+            i32::from_le_bytes(bytes[4 * d..4 * d + 4].try_into().unwrap())
         });
         if dims.iter().any(|&d| d <= 0) {
             return Err(bad(format!(
@@ -120,14 +125,12 @@ impl MerlTable {
                 dims[0], dims[1], dims[2]
             )));
         }
-        let mut raw = vec![0f64; 3 * SAMPLES];
-        file.read_exact(bytemuck::cast_slice_mut(&mut raw))
-            .map_err(|e| FitError::io(path, e))?;
-        if cfg!(target_endian = "big") {
-            raw.iter_mut()
-                .for_each(|v| *v = f64::from_bits(u64::from_le(v.to_bits())));
-        }
-        if let Some(at) = raw.iter().position(|v| !v.is_finite()) {
+        let raw: Vec<f64> = bytes[HEADER_BYTES as usize..]
+            .chunks_exact(8)
+            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+            .collect();
+        // Missing samples are negative, whatever their size; a valid one is at most MAX_STORED.
+        if let Some(at) = raw.iter().position(|v| !(*v <= MAX_STORED)) {
             let (c, s) = (at / SAMPLES, at % SAMPLES);
             let (i, j, k) = (
                 s / (PHI_D_RES * THETA_D_RES),
@@ -137,8 +140,12 @@ impl MerlTable {
             return Err(bad(format!(
                 "sample {s} of channel {} (θh bin {i}, θd bin {j}, φd bin {k}) is {}",
                 ["red", "green", "blue"][c],
-                raw[at]
-            )));
+                raw[at],
+            ) + &if raw[at].is_finite() {
+                format!(", above the {MAX_STORED:e} a measured value can be")
+            } else {
+                String::new()
+            }));
         }
         Ok(MerlTable { raw })
     }

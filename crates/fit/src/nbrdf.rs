@@ -107,6 +107,11 @@ impl Brdf for NeuralBrdf {
     }
 }
 
+/// The MERL-100 networks shipped inside the crate.
+const EMBEDDED: &str = include_str!("../data/nbrdf/merl100.json");
+/// How the embedded file is named in messages.
+pub const EMBEDDED_LABEL: &str = "merl100.json (embedded in facet-fit)";
+
 /// The file of networks, `name -> weights`.
 pub struct NbrdfLibrary {
     path: PathBuf,
@@ -114,18 +119,42 @@ pub struct NbrdfLibrary {
 }
 
 impl NbrdfLibrary {
-    /// `../shared/data/nbrdf/merl100.json` as seen from the workspace root.
-    pub fn default_path() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/nbrdf/merl100.json")
+    /// The neural proxies of the 100 MERL materials, embedded in the library
+    /// (`crates/fit/data/nbrdf/`, MIT licence, see its README). Parsed on each call: keep it.
+    pub fn embedded() -> Self {
+        Self::parse(Path::new(EMBEDDED_LABEL), EMBEDDED)
+            .expect("the embedded MERL-100 file is valid JSON of networks")
+    }
+
+    /// The file to read instead of the embedded one: `arg` (`--nbrdf`), else `$FACET_NBRDF`;
+    /// `None` means [`NbrdfLibrary::embedded`].
+    pub fn override_path(arg: Option<&Path>) -> Option<PathBuf> {
+        arg.map(Path::to_owned)
+            .or_else(|| std::env::var_os("FACET_NBRDF").map(PathBuf::from))
+    }
+
+    /// `path` when given, else the embedded library.
+    pub fn open_or_embedded(path: Option<&Path>) -> Result<Self, FitError> {
+        match path {
+            Some(p) => Self::open(p),
+            None => Ok(Self::embedded()),
+        }
     }
 
     pub fn open(path: &Path) -> Result<Self, FitError> {
+        Self::parse(
+            path,
+            &crate::input::read_to_string(path, crate::input::Cap::NBRDF)?,
+        )
+    }
+
+    /// A library from the text of its JSON; `path` names it in errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, FitError> {
         let bad = |problem: String| FitError::Nbrdf {
             path: path.to_owned(),
             problem,
         };
-        let text = crate::input::read_to_string(path, crate::input::Cap::NBRDF)?;
-        let entries: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text)
+        let entries: BTreeMap<String, serde_json::Value> = serde_json::from_str(text)
             .map_err(|e| bad(format!("not a JSON object of networks: {e}")))?;
         if entries.is_empty() {
             return Err(bad("holds no material".into()));

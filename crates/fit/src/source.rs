@@ -9,15 +9,16 @@ use crate::nbrdf::NbrdfLibrary;
 use std::path::Path;
 
 /// An input: `nbrdf:NAME`, `analytic:SPEC`, a fit `.json` (its tabulated model) or a MERL file.
-/// `nbrdf` is the network file used for `nbrdf:` inputs, opened on first use.
+/// `nbrdf` is the network file used for `nbrdf:` inputs (`None`: the embedded MERL-100
+/// proxies), opened on first use.
 pub fn open_source(
     input: &str,
-    nbrdf: &Path,
+    nbrdf: Option<&Path>,
     library: &mut Option<NbrdfLibrary>,
 ) -> Result<Box<dyn Brdf>, FitError> {
     if let Some(name) = input.strip_prefix("nbrdf:") {
         if library.is_none() {
-            *library = Some(NbrdfLibrary::open(nbrdf)?);
+            *library = Some(NbrdfLibrary::open_or_embedded(nbrdf)?);
         }
         return Ok(Box::new(library.as_ref().unwrap().get(name)?));
     }

@@ -55,26 +55,11 @@ pub struct ViewerApp {
     pub shown_exposure: f32,
     /// Where the preview image was drawn last (points).
     pub preview_rect: Option<egui::Rect>,
-    pub nbrdf: PathBuf,
+    /// The network file for `nbrdf:` inputs (`FACET_NBRDF`), `None`: the embedded proxies.
+    pub nbrdf: Option<PathBuf>,
     /// The neural proxies' names, read when the list is first opened.
     pub proxy_names: Option<Result<Vec<String>, String>>,
     pub screenshot: Option<ScreenshotPlan>,
-}
-
-/// The network file for `nbrdf:` inputs (as `facet fit` finds it).
-pub fn nbrdf_path() -> PathBuf {
-    if let Some(p) = std::env::var_os("FACET_NBRDF") {
-        return p.into();
-    }
-    for local in [
-        Path::new("../shared/data/nbrdf/merl100.json").to_owned(),
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/nbrdf/merl100.json"),
-    ] {
-        if local.exists() {
-            return local;
-        }
-    }
-    facet_fit::nbrdf::NbrdfLibrary::default_path()
 }
 
 impl ViewerApp {
@@ -98,7 +83,7 @@ impl ViewerApp {
             shown_frame: 0,
             shown_exposure: 0.0,
             preview_rect: None,
-            nbrdf: nbrdf_path(),
+            nbrdf: facet_fit::nbrdf::NbrdfLibrary::override_path(None),
             proxy_names: None,
             screenshot: None,
         }
@@ -170,7 +155,7 @@ impl ViewerApp {
         std::thread::spawn(move || {
             let r = (|| {
                 let mut lib = None;
-                let src = facet_fit::source::open_source(&spec, &nbrdf, &mut lib)
+                let src = facet_fit::source::open_source(&spec, nbrdf.as_deref(), &mut lib)
                     .map_err(|e| e.to_string())?;
                 *st.lock().unwrap() = "extracting the NDF and fitting".into();
                 fit_material(&*src, &spec, &FitConfig::isotropic()).map_err(|e| e.to_string())
@@ -217,7 +202,7 @@ impl ViewerApp {
     pub fn proxies(&mut self) -> &Result<Vec<String>, String> {
         let path = self.nbrdf.clone();
         self.proxy_names.get_or_insert_with(|| {
-            facet_fit::nbrdf::NbrdfLibrary::open(&path)
+            facet_fit::nbrdf::NbrdfLibrary::open_or_embedded(path.as_deref())
                 .map(|lib| lib.names().map(str::to_owned).collect())
                 .map_err(|e| e.to_string())
         })

@@ -40,6 +40,9 @@ pub struct Scene {
     pub camera: Camera,
     /// Messages about things skipped or defaulted (a missing texture, a dropped triangle).
     pub warnings: Vec<String>,
+    /// Every file read besides the scene file itself (buffers, textures, fits named by
+    /// materials), so that no output of a run replaces one of them.
+    pub inputs: Vec<PathBuf>,
 }
 
 /// A pinhole camera.
