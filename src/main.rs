@@ -32,6 +32,8 @@ enum Command {
 }
 
 fn main() -> std::process::ExitCode {
+    // SAFETY: first thing in main, before any thread exists.
+    unsafe { facet_gpu::ensure_runtime_dir() };
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Fit(args)) => fit_cmd::run(&args),

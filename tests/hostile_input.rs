@@ -222,9 +222,9 @@ fn values_that_would_break_the_extraction_are_refused_up_front() {
         err.contains("huge-values.binary") && err.contains("1e308") && err.contains("above"),
         "{err}"
     );
-    // A source that returns f_r past MAX_FR is refused by the extraction with the value.
+    // A source whose f_r cos θi passes MAX_X on the MERL grid is refused with the value.
     let mut t = MerlTable::sample(&parse_analytic("ggx?alpha=0.3").unwrap());
-    (0..facet_fit::merl::SAMPLES).for_each(|s| t.scale_sample(s, [1e11; 3]));
+    (0..facet_fit::merl::SAMPLES).for_each(|s| t.scale_sample(s, [1e13; 3]));
     let err = facet_fit::fit::fit_material(
         &MerlBrdf::from_table("bright", t).unwrap(),
         "t",

@@ -7,11 +7,6 @@ use std::borrow::Cow;
 /// Linear Rec.709 RGB.
 pub type Rgb = [f64; 3];
 
-/// The largest f_r (sr⁻¹) a source may return and still be fitted: a GGX mirror of α = 10⁻⁴
-/// peaks at 1/(π α²) ≈ 3·10⁷; beyond 10⁹ the extraction's f64 sums and the f32 metric lose
-/// their meaning, so such values are refused with the value named.
-pub const MAX_FR: f64 = 1e9;
-
 /// A BRDF: measured, neural, analytic or fitted.
 ///
 /// `eval` returns f_r without the cosine, or `None` where the source has no sample (a

@@ -126,15 +126,9 @@ fn backscatter_slice(src: &dyn Brdf, dirs: &[(f64, f64)]) -> Result<Vec<f64>, Fi
         name: src.name().to_owned(),
         problem,
     };
-    if let Some(v) = values
-        .iter()
-        .flatten()
-        .find(|v| !(v.abs() <= crate::brdf::MAX_FR))
-    {
-        return Err(fail(format!(
-            "the backscattering slice holds f_r = {v:e}, outside ±{:e}",
-            crate::brdf::MAX_FR
-        )));
+    // f(o, o) grows as 1/cos²θo towards grazing: only non-finite values are refused here.
+    if let Some(v) = values.iter().flatten().find(|v| !v.is_finite()) {
+        return Err(fail(format!("the backscattering slice holds {v}")));
     }
     // Missing directions take the value of their nearest valid neighbour in the list.
     let filled =

@@ -138,7 +138,7 @@ fn fit_with(
             problem: "no valid sample on the MERL grid".into(),
         });
     }
-    let max = crate::brdf::MAX_FR as f32;
+    let max = crate::grid::MAX_X;
     if let Some(s) = set
         .samples
         .iter()

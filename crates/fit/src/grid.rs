@@ -61,6 +61,11 @@ fn above_horizon(g: &BinGeometry) -> bool {
     g.inv_cos_i > 0.0 && g.inv_cos_o > 0.0
 }
 
+/// The largest x = f_r cos θi a source may give on the MERL grid: a GGX mirror of α = 10⁻⁴ at
+/// its peak stays below 10⁹; beyond 10¹² the f32 sums over 1.5·10⁶ samples of the Fresnel
+/// average and the metric would overflow, so such values are refused with the value named.
+pub const MAX_X: f32 = 1e12;
+
 /// One valid sample: a MERL bin seen at azimuth rotation `rot`, with the source's value.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct GridSample {

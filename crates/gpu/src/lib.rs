@@ -15,8 +15,10 @@ pub mod buffer;
 pub mod context;
 pub mod dispatch;
 pub mod error;
+pub mod runtime_dir;
 pub mod shader;
 pub mod timer;
 
 pub use context::{Gpu, GpuOptions, gpu_for_tests};
 pub use error::GpuError;
+pub use runtime_dir::ensure_runtime_dir;

@@ -179,6 +179,8 @@ fn run_with(
 }
 
 fn main() -> Result<()> {
+    // SAFETY: first thing in main, before any thread exists.
+    unsafe { facet_gpu::ensure_runtime_dir() };
     let Some(args) = parse()? else {
         return Ok(());
     };
