@@ -82,11 +82,9 @@ pub fn wavefront(s: &str) -> Result<u32, String> {
 
 /// Seconds: positive, finite, at most a week.
 pub fn seconds(s: &str) -> Result<f64, String> {
-    let v = real(s, 0.0..=604_800.0)?;
-    if v > 0.0 {
-        Ok(v)
-    } else {
-        Err("give a positive number of seconds".into())
+    match real(s, f64::MIN..=f64::MAX)? {
+        v if v > 0.0 && v <= 604_800.0 => Ok(v),
+        _ => Err("give a positive number of seconds, at most 604800 (a week)".into()),
     }
 }
 

@@ -233,7 +233,7 @@ fn render_bad_inputs_name_the_file() {
                 "--out".into(),
                 demo.replace("demo.gltf", "sky.png"),
             ],
-            "overwrite".into(),
+            "would replace the input".into(),
         ),
     ];
     for (args, needle) in cases {

@@ -210,10 +210,21 @@ fn bad_merl_files_get_clear_errors() {
     let mut inf = bytes.clone();
     inf[at..at + 8].copy_from_slice(&f64::INFINITY.to_le_bytes());
     expect_merl_error(&write("inf.binary", &inf), "inf");
-    expect_merl_error(&dir, "is a directory");
-    match MerlTable::read(&dir.join("does-not-exist.binary")) {
-        Err(e @ FitError::Io { .. }) => assert!(e.to_string().contains("does-not-exist.binary")),
-        other => panic!("expected an I/O error, got {other:?}"),
+    // Not a file at all: refused by the input layer, before the MERL reader.
+    for (path, needle) in [
+        (dir.clone(), "is a directory"),
+        (dir.join("does-not-exist.binary"), "no such file"),
+    ] {
+        match MerlTable::read(&path) {
+            Err(e @ FitError::Input(_)) => {
+                let msg = e.to_string();
+                assert!(
+                    msg.contains(&path.display().to_string()) && msg.contains(needle),
+                    "{msg}"
+                );
+            }
+            other => panic!("expected an input error, got {other:?}"),
+        }
     }
     // All samples missing: the reader accepts the file, the source says what is wrong.
     let mut empty = spec_table("ggx?alpha=0.2");
@@ -226,7 +237,7 @@ fn bad_merl_files_get_clear_errors() {
 fn bad_specs_and_proxies_get_clear_errors() {
     for (spec, needle) in [
         ("phong?alpha=0.2", "unknown model"),
-        ("ggx?alpha=-1", "positive"),
+        ("ggx?alpha=-1", "α must lie in"),
         ("ggx?alpha=abc", "not a finite number"),
         ("ggx?f0=0.04", "give alpha"),
         ("ggx?alpha=0.2&eta=1,1,1", "both eta and k"),

@@ -58,31 +58,33 @@ pub fn parse_analytic(spec: &str) -> Result<MicrofacetBrdf, FitError> {
             }));
         }
         seen.push(key);
+        // `x` is one component of the value `v`; an error names the whole value.
+        let num_of = |x: &str, v: &str, range: &std::ops::RangeInclusive<f64>, what: &str| {
+            let x = x
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(format!("`{key}={v}`: not a finite number")))?;
+            if range.contains(&x) {
+                Ok(x)
+            } else {
+                Err(bad(format!("`{key}={v}`: {what}")))
+            }
+        };
         let num =
-            |v: &str, range: std::ops::RangeInclusive<f64>, what: &str| -> Result<f64, FitError> {
-                let x = v
-                    .parse::<f64>()
-                    .ok()
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| bad(format!("`{key}={v}`: not a finite number")))?;
-                if range.contains(&x) {
-                    Ok(x)
-                } else {
-                    Err(bad(format!("`{key}={v}`: {what}")))
-                }
-            };
-        let rgb =
-            |v: &str, range: std::ops::RangeInclusive<f64>, what: &str| -> Result<Rgb, FitError> {
-                let parts: Vec<f64> = v
-                    .split(',')
-                    .map(|x| num(x, range.clone(), what))
-                    .collect::<Result<_, _>>()?;
-                match parts[..] {
-                    [x] => Ok([x; 3]),
-                    [r, g, b] => Ok([r, g, b]),
-                    _ => Err(bad(format!("`{key}={v}`: give one value or r,g,b"))),
-                }
-            };
+            |v: &str, range: std::ops::RangeInclusive<f64>, what: &str| num_of(v, v, &range, what);
+        let rgb = |v: &str, range: std::ops::RangeInclusive<f64>, what: &str| {
+            let parts: Vec<f64> = v
+                .split(',')
+                .map(|x| num_of(x, v, &range, what))
+                .collect::<Result<_, _>>()?;
+            match parts[..] {
+                [x] => Ok([x; 3]),
+                [r, g, b] => Ok([r, g, b]),
+                _ => Err(bad(format!("`{key}={v}`: give one value or r,g,b"))),
+            }
+        };
         let alpha_range = || {
             format!(
                 "α must lie in [{:e}, {}]",

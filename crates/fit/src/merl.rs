@@ -138,7 +138,7 @@ impl MerlTable {
                 s % PHI_D_RES,
             );
             return Err(bad(format!(
-                "sample {s} of channel {} (θh bin {i}, θd bin {j}, φd bin {k}) is {}",
+                "sample {s} of channel {} (θh bin {i}, θd bin {j}, φd bin {k}) is {:e}",
                 ["red", "green", "blue"][c],
                 raw[at],
             ) + &if raw[at].is_finite() {
