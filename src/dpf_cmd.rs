@@ -106,7 +106,7 @@ pub fn run(args: &DpfArgs) -> Result<ExitCode> {
     if let Some(dir) = &args.write {
         let t = std::time::Instant::now();
         let (pyramid, backend) = build(&ndf, cfg, &[0, 1, 2, 3, 4, 5, 6, 7, 8], args.backend)?;
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        crate::output::folder(dir, "--write")?;
         for table in pyramid.levels.iter().flatten() {
             let path = dir.join(format!(
                 "dpf-gamma{:02}.exr",

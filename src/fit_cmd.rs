@@ -184,8 +184,7 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let gpu = open_gpu(args.backend)?;
     let fitter = fitter(&gpu, args.backend)?;
     let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating the output folder {}", args.out.display()))?;
+    crate::output::folder(&args.out, "--out")?;
     let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
     // Every file this run reads: no output may replace one of them.
     let read: Vec<PathBuf> = args
@@ -328,6 +327,9 @@ fn write_tables(fit: &FittedMaterial, path: &Path) -> Result<()> {
 }
 
 fn print_summary(rows: &[FittedMaterial]) {
+    if rows.is_empty() {
+        return;
+    }
     let mut out = std::io::stdout().lock();
     let _ = writeln!(
         out,
@@ -413,7 +415,7 @@ pub fn fit_default(out: &Path) -> Result<(FittedMaterial, std::path::PathBuf)> {
         backend,
     )?;
     fit.record.timings_ms.load = load_ms;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    crate::output::folder(out, "--out")?;
     let json = out.join("default-gold-ggx.json");
     fit.save(&json)?;
     write_tables(&fit, &out.join("default-gold-ggx.tables.csv"))?;

@@ -4,6 +4,7 @@ mod args;
 mod demo_cmd;
 mod dpf_cmd;
 mod fit_cmd;
+mod output;
 mod render_cmd;
 
 use clap::{Parser, Subcommand};

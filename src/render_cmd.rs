@@ -145,6 +145,10 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         .chain(scene.inputs.iter().map(PathBuf::as_path))
         .collect();
     let (png, exr) = outputs(&args.out);
+    // The folder is made (or refused) now, not after the render.
+    if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
+        crate::output::folder(dir, "--out")?;
+    }
     for o in [&png, &exr] {
         if let Some(i) = inputs.iter().find(|i| same_file(i, o)) {
             bail!(

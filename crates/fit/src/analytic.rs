@@ -12,7 +12,6 @@
 /// above 10 the lobe is flatter than Lambertian and nothing is left to fit.
 pub const ALPHA_RANGE: std::ops::RangeInclusive<f64> = 1e-4..=10.0;
 
-use crate::brdf::Rgb;
 use crate::error::FitError;
 use crate::fresnel::Fresnel;
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
