@@ -186,14 +186,17 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
     crate::output::folder(&args.out, "--out")?;
     let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
-    // Every file this run reads: no output may replace one of them.
-    let read: Vec<PathBuf> = args
-        .inputs
-        .iter()
-        .filter(|i| !i.starts_with("nbrdf:") && !i.starts_with("analytic:"))
-        .map(PathBuf::from)
-        .chain(nbrdf.clone())
-        .collect();
+    let mut outputs = Outputs {
+        dir: &args.out,
+        read: args
+            .inputs
+            .iter()
+            .filter(|i| !i.starts_with("nbrdf:") && !i.starts_with("analytic:"))
+            .map(PathBuf::from)
+            .chain(nbrdf.clone())
+            .collect(),
+        names: HashSet::new(),
+    };
     let mut library = None;
     let bar = (args.inputs.len() > 1).then(|| {
         let bar = ProgressBar::new(args.inputs.len() as u64);
@@ -205,7 +208,6 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     });
     let mut rows = Vec::new();
     let mut failures = 0;
-    let mut names = HashSet::new();
     let started = Instant::now();
     for input in &args.inputs {
         if let Some(bar) = &bar {
@@ -215,11 +217,9 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
             input,
             &cfg,
             backend,
-            &args.out,
             nbrdf.as_deref(),
             &mut library,
-            &mut names,
-            &read,
+            &mut outputs,
         ) {
             Ok(fit) => rows.push(fit),
             Err(e) => {
@@ -254,15 +254,49 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     })
 }
 
+/// Where the fits of one run go: `dir/<name>.json` and `.tables.csv`, each name once, never
+/// over a file the run reads.
+struct Outputs<'a> {
+    dir: &'a Path,
+    /// Every file this run reads.
+    read: Vec<PathBuf>,
+    names: HashSet<String>,
+}
+
+impl Outputs<'_> {
+    /// The JSON and CSV paths for a fit named `name` (from data: made a safe file stem; a
+    /// second fit of one name gets -2, -3, ...), refused when one would replace an input.
+    fn claim(&mut self, name: &str) -> Result<(PathBuf, PathBuf)> {
+        let base = facet_fit::input::safe_file_stem(name);
+        let mut name = base.clone();
+        for k in 2.. {
+            if self.names.insert(name.clone()) {
+                break;
+            }
+            name = format!("{base}-{k}");
+        }
+        let json = self.dir.join(format!("{name}.json"));
+        let csv = self.dir.join(format!("{name}.tables.csv"));
+        for o in [&json, &csv] {
+            if let Some(i) = self.read.iter().find(|i| same_file(i, o)) {
+                bail!(
+                    "the output {} would replace the input {}; choose another --out",
+                    o.display(),
+                    i.display()
+                );
+            }
+        }
+        Ok((json, csv))
+    }
+}
+
 fn fit_one(
     input: &str,
     cfg: &FitConfig,
     backend: Backend,
-    out: &Path,
     nbrdf: Option<&Path>,
     library: &mut Option<NbrdfLibrary>,
-    names: &mut HashSet<String>,
-    read: &[PathBuf],
+    outputs: &mut Outputs,
 ) -> Result<FittedMaterial> {
     let t = Instant::now();
     let src = open_source(input, nbrdf, library)?;
@@ -273,27 +307,9 @@ fn fit_one(
     }
     fit.record.timings_ms.load = load_ms;
     fit.record.timings_ms.total += load_ms;
-    // The name comes from data: a safe file stem. Two inputs with one name get -2, -3, ...
-    // rather than overwriting each other.
-    let base = facet_fit::input::safe_file_stem(&fit.record.name);
-    let mut name = base.clone();
-    for k in 2.. {
-        if names.insert(name.clone()) {
-            break;
-        }
-        name = format!("{base}-{k}");
-    }
-    let json = out.join(format!("{name}.json"));
-    let csv = out.join(format!("{name}.tables.csv"));
-    for o in [&json, &csv] {
-        if let Some(i) = read.iter().find(|i| same_file(i, o)) {
-            bail!(
-                "{input}: the output {} would replace the input {}; choose another --out",
-                o.display(),
-                i.display()
-            );
-        }
-    }
+    let (json, csv) = outputs
+        .claim(&fit.record.name)
+        .with_context(|| input.to_owned())?;
     fit.save(&json)?;
     write_tables(&fit, &csv)?;
     Ok(fit)
