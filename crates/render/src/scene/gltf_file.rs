@@ -21,6 +21,7 @@ use super::gltf_material::MaterialLoader;
 use super::mesh::{RawPrimitive, clean_primitive};
 use super::{Camera, Light, Material, Scene};
 use crate::error::RenderError;
+use facet_fit::input::{self, Cap};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::khr_lights_punctual::Kind;
 use std::path::{Path, PathBuf};
@@ -41,9 +42,22 @@ pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
 /// Loads a glTF 2.0 file into a world-space [`Scene`]. Bad input is a [`RenderError::Input`]
 /// naming the file; a scene without any renderable triangle is a [`RenderError::Scene`].
+/// The file is read through [`facet_fit::input`] (a regular file of at most
+/// [`Cap::GLTF`](facet_fit::input::Cap::GLTF) bytes), then [`load_gltf_bytes`].
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderError> {
+    let bytes = input::read(path, Cap::GLTF)?;
+    load_gltf_bytes(path, &bytes, options)
+}
+
+/// [`load_gltf`] of a glTF JSON or `.glb` already in memory: `path` names it in messages and
+/// is where relative URIs (buffers, images, fits) are resolved from.
+pub fn load_gltf_bytes(
+    path: &Path,
+    bytes: &[u8],
+    options: &LoadOptions,
+) -> Result<Scene, RenderError> {
     let gltf::Gltf { document, blob } =
-        gltf::Gltf::open(path).map_err(|e| RenderError::input(path, describe(e)))?;
+        gltf::Gltf::from_slice(bytes).map_err(|e| RenderError::input(path, describe(e)))?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = gltf::import_buffers(&document, Some(base), blob)
         .map_err(|e| RenderError::input(path, format!("loading buffers: {}", describe(e))))?;

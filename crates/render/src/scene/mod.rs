@@ -16,7 +16,7 @@ pub mod mesh;
 pub mod shapes;
 
 pub use environment::{Environment, EnvironmentMap};
-pub use gltf_file::{LoadOptions, load_gltf};
+pub use gltf_file::{LoadOptions, load_gltf, load_gltf_bytes};
 
 /// A whole scene in world space.
 #[derive(Clone, Debug, Default)]
