@@ -13,6 +13,7 @@
 //! dω = 2π² sin θ du dv the solid-angle density is `p_xy · w · h / (2π² sin θ)`.
 
 use crate::error::RenderError;
+use crate::scene::gltf_file::guard;
 use facet_fit::input::{self, Cap};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -123,32 +124,21 @@ impl EnvironmentMap {
         let not_exr = |e: exr::error::Error| {
             RenderError::input(path, format!("not a readable RGB OpenEXR image: {e}"))
         };
-        let caught = |payload: Box<dyn std::any::Any + Send>| {
-            RenderError::input(
-                path,
-                format!(
-                    "internal error while reading the OpenEXR image: {}; please report it",
-                    crate::scene::gltf_file::panic_message(payload.as_ref())
-                ),
-            )
-        };
-        let meta = std::panic::catch_unwind(|| {
+        let meta = guard(path, "the OpenEXR image", || {
             exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
-        })
-        .map_err(caught)?
-        .map_err(not_exr)?;
+                .map_err(not_exr)
+        })?;
         for (i, header) in meta.headers.iter().enumerate() {
             let display = header.shared_attributes.display_window.size;
             for (window, size) in [
                 ("data window", header.layer_size),
                 ("display window", display),
             ] {
-                check_env_size(size.0 as u64, size.1 as u64).map_err(|m| {
-                    RenderError::input(path, format!("layer {i}'s {window}: {m}"))
-                })?;
+                check_env_size(size.0 as u64, size.1 as u64)
+                    .map_err(|m| RenderError::input(path, format!("layer {i}'s {window}: {m}")))?;
             }
         }
-        let image = std::panic::catch_unwind(|| {
+        let image = guard(path, "the OpenEXR image", || {
             use exr::prelude::{ReadChannels as _, ReadLayers as _};
             exr::prelude::read()
                 .no_deep_data()
@@ -162,9 +152,8 @@ impl EnvironmentMap {
                 .first_valid_layer()
                 .all_attributes()
                 .from_buffered(std::io::Cursor::new(bytes))
-        })
-        .map_err(caught)?
-        .map_err(not_exr)?;
+                .map_err(not_exr)
+        })?;
         let size = image.layer_data.size;
         let (_, mut texels) = image.layer_data.channel_data.pixels;
         let mut bad = 0usize;

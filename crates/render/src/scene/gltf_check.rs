@@ -187,7 +187,9 @@ pub fn check_accessor(
         return Err("count is 0 (it must be at least 1)".into());
     }
     if count > cap {
-        return Err(format!("count {count} is more than Facet reads ({cap})"));
+        return Err(format!(
+            "count {count} is more than the {cap} Facet reads from one accessor"
+        ));
     }
     let comp = component_size(ct);
     let element = comp * components(ty);
@@ -217,8 +219,7 @@ pub fn check_accessor(
                 "sparse.count {n} is not between 1 and the accessor's count {count}"
             ));
         }
-        let Checked::Valid(json::accessor::IndexComponentType(ict)) =
-            sparse.indices.component_type
+        let Checked::Valid(json::accessor::IndexComponentType(ict)) = sparse.indices.component_type
         else {
             return Err("sparse.indices.componentType is not an index type".into());
         };
@@ -308,7 +309,11 @@ fn check_range(
             s
         }
     };
-    let align = if r.vertex { r.component.max(4) } else { r.component };
+    let align = if r.vertex {
+        r.component.max(4)
+    } else {
+        r.component
+    };
     if !r.offset.is_multiple_of(align) {
         return Err(format!(
             "byteOffset {} is not a multiple of {align}",
@@ -386,7 +391,10 @@ pub fn check_camera(c: &json::camera::Camera) -> Result<CameraKind, String> {
             if let Some(zfar) = p.zfar
                 && !(finite(zfar) && zfar > p.znear)
             {
-                return Err(format!("perspective.zfar {zfar} is not > znear {}", p.znear));
+                return Err(format!(
+                    "perspective.zfar {zfar} is not > znear {}",
+                    p.znear
+                ));
             }
             if let Some(r) = p.aspect_ratio
                 && !(finite(r) && r > 0.0)

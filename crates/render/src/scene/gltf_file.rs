@@ -66,14 +66,21 @@ pub fn load_gltf_bytes(
     bytes: &[u8],
     options: &LoadOptions,
 ) -> Result<Scene, RenderError> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        load_document(path, bytes, options)
-    }))
-    .unwrap_or_else(|payload| {
+    guard(path, "the glTF", || load_document(path, bytes, options))
+}
+
+/// Runs `f`, turning a panic inside it into a [`RenderError::Input`] naming `path`:
+/// "internal error while reading {what}: {panic message}; please report it".
+pub(crate) fn guard<T>(
+    path: &Path,
+    what: &str,
+    f: impl FnOnce() -> Result<T, RenderError>,
+) -> Result<T, RenderError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
         Err(RenderError::input(
             path,
             format!(
-                "internal error while reading the glTF: {}; please report it",
+                "internal error while reading {what}: {}; please report it",
                 panic_message(payload.as_ref())
             ),
         ))
@@ -81,7 +88,7 @@ pub fn load_gltf_bytes(
 }
 
 /// The message of a caught panic.
-pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     if let Some(s) = payload.downcast_ref::<&str>() {
         (*s).to_owned()
     } else if let Some(s) = payload.downcast_ref::<String>() {
@@ -302,7 +309,10 @@ fn add_mesh(
             (Attribute::Position, Some(position_accessor)),
             (Attribute::Normal, prim.get(&gltf::Semantic::Normals)),
             (Attribute::Tangent, prim.get(&gltf::Semantic::Tangents)),
-            (Attribute::TexCoord0, prim.get(&gltf::Semantic::TexCoords(0))),
+            (
+                Attribute::TexCoord0,
+                prim.get(&gltf::Semantic::TexCoords(0)),
+            ),
             (Attribute::Indices, prim.indices()),
         ];
         let n_positions = root
@@ -618,5 +628,33 @@ pub fn framing_camera((lo, hi): (Vec3, Vec3)) -> Camera {
         forward,
         up,
         yfov: DEFAULT_YFOV,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_panic_becomes_an_error_naming_the_file() {
+        let e = guard(Path::new("s.gltf"), "the glTF", || -> Result<(), _> {
+            panic!("index out of bounds: the len is 3 but the index is 7")
+        })
+        .unwrap_err()
+        .to_string();
+        assert_eq!(
+            e,
+            "s.gltf: internal error while reading the glTF: index out of bounds: the len is 3 but the index is 7; please report it"
+        );
+        let n = 7;
+        let e = guard(
+            Path::new("e.exr"),
+            "the OpenEXR image",
+            || -> Result<(), _> { panic!("formatted {n}") },
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("e.exr") && e.contains("formatted 7"), "{e}");
+        assert_eq!(guard(Path::new("x"), "x", || Ok(3)).unwrap(), 3);
     }
 }
