@@ -107,8 +107,7 @@ fn over_the_device_limits_is_an_error_naming_the_input() {
         let e = too_large(
             integrator
                 .render(&gpu, &res, &camera, &config, &mut |_| {})
-                .err()
-                .expect("a film over the binding limit"),
+                .expect_err("a film over the binding limit"),
         );
         let size = format!("--width × --height = {width} × {height}");
         assert!(e.contains("the film") && e.contains(&size), "{e}");
@@ -124,8 +123,7 @@ fn over_the_device_limits_is_an_error_naming_the_input() {
     let e = too_large(
         integrator
             .render(&gpu, &res, &camera, &config, &mut |_| {})
-            .err()
-            .expect("8 × 16384 × 16 bytes of path state"),
+            .expect_err("8 × 16384 × 16 bytes of path state"),
     );
     assert!(
         e.contains("the path state") && e.contains("--wavefront"),
