@@ -751,6 +751,14 @@ fn an_exr_header_of_100000_by_100000_is_refused_quickly() {
         .unwrap_err()
         .to_string();
     has_all(&e, &["huge.exr", "16384 × 16384", "67108864"]);
+    // Within both limits (4096²) but far more chunks than the tiny file holds: refused before
+    // the 200 MB pixel buffer is made.
+    patch_box2i(&mut bytes, "dataWindow", [0, 0, 4095, 4095]);
+    patch_box2i(&mut bytes, "displayWindow", [0, 0, 4095, 4095]);
+    let e = EnvironmentMap::from_exr_bytes(&path, &bytes)
+        .unwrap_err()
+        .to_string();
+    has_all(&e, &["huge.exr", "chunks"]);
     // Garbage after a valid magic number: an error, not a panic.
     let e = EnvironmentMap::from_exr_bytes(&path, &bytes[..40])
         .unwrap_err()

@@ -114,8 +114,8 @@ impl EnvironmentMap {
     /// [`Self::load`] of an OpenEXR file already in memory (`path` names it in messages).
     ///
     /// The header is read first, alone: a layer wider or taller than [`MAX_ENV_SIDE`] or with
-    /// more than [`MAX_ENV_PIXELS`] pixels (data or display window) is refused before any pixel
-    /// buffer exists. A panic of the decoder on a malformed file is caught and reported as an
+    /// more than [`MAX_ENV_PIXELS`] pixels (data or display window), or more chunks than the
+    /// file has room for in its offset tables, is refused before any pixel buffer exists. A panic of the decoder on a malformed file is caught and reported as an
     /// error naming the file.
     pub fn from_exr_bytes(
         path: &Path,
@@ -137,6 +137,18 @@ impl EnvironmentMap {
                 check_env_size(size.0 as u64, size.1 as u64)
                     .map_err(|m| RenderError::input(path, format!("layer {i}'s {window}: {m}")))?;
             }
+        }
+        // Each chunk has an 8-byte entry in the offset table, which the decoder allocates from
+        // the header (a 1 × 1 tiling of a large map would be millions of entries in a tiny file).
+        let chunks: u64 = meta.headers.iter().map(|h| h.chunk_count as u64).sum();
+        if chunks.saturating_mul(8) > bytes.len() as u64 {
+            return Err(RenderError::input(
+                path,
+                format!(
+                    "the header declares {chunks} chunks, more than the file's {} bytes can hold",
+                    bytes.len()
+                ),
+            ));
         }
         let image = guard(path, "the OpenEXR image", || {
             use exr::prelude::{ReadChannels as _, ReadLayers as _};
