@@ -16,6 +16,19 @@
 //! Lights: KHR_lights_punctual on nodes, `intensity × color` (candela for point and spot, lux
 //! for directional), direction = the node's −Z. `range` is ignored: the renderer uses the
 //! physical inverse-square falloff everywhere, which is what glTF prescribes inside the range.
+//!
+//! Hostile input is an error naming the file and the field at fault, or (for what only costs a
+//! texture, a light or an unused camera) a warning; never a panic, a hang or a huge allocation:
+//! - files are read through [`facet_fit::input`]: regular files only (no FIFO, device,
+//!   directory), each under its [`Cap`];
+//! - buffers are loaded here (`gltf_buffers`): the GLB chunk, `data:` URIs, relative
+//!   files; absolute paths and schemes refused ([`super::uri`]); their bytes cover byteLength;
+//! - a GLB header is checked before the `gltf` crate reads it;
+//! - every accessor read, every camera and every light is checked first ([`super::gltf_check`]);
+//! - a scene holds at most [`MAX_VERTICES`] vertices and [`MAX_TRIANGLES`] triangles, counting a
+//!   mesh once per node it is placed on;
+//! - textures: see [`super::gltf_material`];
+//! - whatever still panics inside the `gltf` crate is caught ([`load_gltf_bytes`]).
 
 use super::gltf_buffers::Buffers;
 use super::gltf_check::{
