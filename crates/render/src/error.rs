@@ -13,6 +13,20 @@ pub enum RenderError {
     /// A scene that loaded but cannot be rendered (no triangles, a bad camera).
     #[error("{0}")]
     Scene(String),
+    /// A GPU resource sized by input (the scene, a fit, the environment map, the render size)
+    /// over a limit of the device ([`crate::limits`]), refused before it is created.
+    #[error(
+        "{what}: {} is more than this adapter's {limit_name} ({limit}); the size comes from {set_by}",
+        amount(*needed, unit)
+    )]
+    TooLarge {
+        what: String,
+        needed: u64,
+        unit: &'static str,
+        limit_name: &'static str,
+        limit: u64,
+        set_by: String,
+    },
     #[error(transparent)]
     Gpu(#[from] facet_gpu::GpuError),
 }
@@ -23,5 +37,23 @@ impl RenderError {
             path: path.into(),
             message: message.to_string(),
         }
+    }
+}
+
+impl From<facet_fit::input::InputError> for RenderError {
+    fn from(e: facet_fit::input::InputError) -> Self {
+        RenderError::Input {
+            path: e.path,
+            message: e.problem,
+        }
+    }
+}
+
+/// `needed unit`, or "over u64::MAX unit" for a size that saturated.
+fn amount(needed: u64, unit: &str) -> String {
+    if needed == u64::MAX {
+        format!("over {needed} {unit}")
+    } else {
+        format!("{needed} {unit}")
     }
 }

@@ -12,6 +12,7 @@ use crate::camera::CameraFrame;
 use crate::error::RenderError;
 use crate::film::Image;
 use crate::gpu_types::{GpuFrame, PATH_REGIONS};
+use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::resources::SceneResources;
 use crate::stages::{Layouts, Stage, queue_args};
@@ -197,13 +198,22 @@ impl Integrator {
         let wavefront = (config.wavefront.max(64) as u64).min(pixels).min(1 << 24) as u32;
         let w = wavefront as u64;
         let nq = self.n_queues as u64;
-        for (what, bytes) in [
-            ("path state", PATH_REGIONS * w * 16),
-            ("queues", nq * w * 4),
-            ("film", pixels * 16),
-        ] {
-            buffer::check_binding(d, what, bytes)?;
-        }
+        let render_size = format!(
+            "the render size (--width × --height = {} × {})",
+            config.width, config.height
+        );
+        let slots = format!(
+            "--wavefront and --width × --height ({wavefront} paths in flight for {} × {} pixels)",
+            config.width, config.height
+        );
+        let film_bytes = product(&[pixels, 16]);
+        DeviceLimits::of(d).check(&[
+            Planned::storage("the path state", product(&[PATH_REGIONS, w, 16]), &slots),
+            Planned::storage("the path info", product(&[w, 16]), &slots),
+            Planned::storage("the queues", product(&[nq, w, 4]), &slots),
+            Planned::storage("the film", film_bytes, &render_size),
+            Planned::buffer("the film read-back", film_bytes, &render_size),
+        ])?;
         let t0 = Instant::now();
         let (frame_buf, paths, info, counters, sizes, args, queues, film) = gpu.scoped(|| {
             (

@@ -27,6 +27,7 @@ pub mod error;
 pub mod film;
 pub mod gpu_types;
 pub mod integrator;
+pub mod limits;
 pub mod procedural;
 pub mod queues;
 pub mod resources;

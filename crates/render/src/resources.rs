@@ -8,6 +8,7 @@
 use crate::bvh::{Bvh, BvhConfig, GpuBvh};
 use crate::error::RenderError;
 use crate::gpu_types::{GpuLight, GpuMaterial, LightKind, MaterialKind, NONE};
+use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::scene::{Environment, FacetModel, Light, Scene};
 use facet_fit::microfacet::{Ndf, NdfKind};
@@ -101,15 +102,41 @@ fn lum(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
-/// The `tables` buffer under construction: f32 words at offsets.
+/// The `tables` buffer under construction: f32 words at offsets, and how many words each input
+/// (a fit file, the environment map, the scene's lights) put there.
 #[derive(Default)]
-struct Tables(Vec<f32>);
+struct Tables {
+    words: Vec<f32>,
+    sources: Vec<(String, u64)>,
+}
 
 impl Tables {
-    fn push(&mut self, values: impl IntoIterator<Item = f32>) -> u32 {
-        let at = self.0.len() as u32;
-        self.0.extend(values);
+    fn push(&mut self, source: &str, values: impl IntoIterator<Item = f32>) -> u32 {
+        let at = self.words.len() as u32;
+        self.words.extend(values);
+        let added = self.words.len() as u64 - u64::from(at);
+        match self.sources.iter_mut().find(|(s, _)| s == source) {
+            Some((_, n)) => *n += added,
+            None => self.sources.push((source.to_owned(), added)),
+        }
         at
+    }
+
+    /// What filled the tables, largest first: "the environment map sky.exr (12582912 bytes), …".
+    fn described(&self) -> String {
+        let mut by_size = self.sources.clone();
+        by_size.sort_by_key(|(_, n)| std::cmp::Reverse(*n));
+        let parts: Vec<String> = by_size
+            .iter()
+            .take(4)
+            .map(|(s, n)| format!("{s} ({} bytes)", 4 * n))
+            .collect();
+        let more = by_size.len().saturating_sub(parts.len());
+        if more > 0 {
+            format!("{} and {more} more", parts.join(", "))
+        } else {
+            parts.join(", ")
+        }
     }
 }
 
@@ -122,6 +149,7 @@ impl SceneResources {
     ) -> Result<Self, RenderError> {
         validate(scene)?;
         let d = &gpu.device;
+        let limits = DeviceLimits::of(d);
         let mut built = Built::default();
         let mut tables = Tables::default();
 
@@ -129,6 +157,24 @@ impl SceneResources {
         let bvh = Bvh::build(&scene.positions, &scene.indices, config.bvh);
         built.bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
         built.bvh_nodes = bvh.cwbvh.nodes.len();
+        let bvh_set_by = format!("the scene ({} triangles)", scene.indices.len());
+        limits.check(&[
+            Planned::storage(
+                "the BVH nodes",
+                product(&[bvh.cwbvh.nodes.len() as u64, 80]),
+                &bvh_set_by,
+            ),
+            Planned::storage(
+                "the BVH primitives",
+                product(&[bvh.cwbvh.primitive_indices.len() as u64, 4]),
+                &bvh_set_by,
+            ),
+            Planned::storage(
+                "the BVH triangles",
+                product(&[bvh.cwbvh.primitive_indices.len() as u64, 48]),
+                &bvh_set_by,
+            ),
+        ])?;
         let gpu_bvh = GpuBvh::upload(d, &bvh)?;
 
         // Vertices: four regions of n vectors (position, normal, tangent, uv).
@@ -186,7 +232,8 @@ impl SceneResources {
                         rgb(brdf.fresnel.eval(theta_d.cos()))
                     })
                     .collect();
-                g.fresnel_offset = tables.push(fres);
+                let fit_source = format!("the fit {} of material `{}`", f.source.display(), m.name);
+                g.fresnel_offset = tables.push(&fit_source, fres);
                 g.fresnel_count = FRESNEL_NODES as u32;
                 g.diffuse = [
                     brdf.diffuse[0] as f32,
@@ -218,11 +265,11 @@ impl SceneResources {
                         let tt = tab.tables();
                         let (cdf, cell_pdf) = tab.sampling_tables();
                         let header = [tt.nu as f32, tt.nphi as f32, tt.ng as f32, 0.0];
-                        g.tab_offset = tables.push(header);
-                        tables.push(tt.d.iter().map(|v| *v as f32));
-                        tables.push(tt.g1.iter().map(|v| *v as f32));
-                        tables.push(cdf.iter().map(|v| *v as f32));
-                        tables.push(cell_pdf.iter().map(|v| *v as f32));
+                        g.tab_offset = tables.push(&fit_source, header);
+                        tables.push(&fit_source, tt.d.iter().map(|v| *v as f32));
+                        tables.push(&fit_source, tt.g1.iter().map(|v| *v as f32));
+                        tables.push(&fit_source, cdf.iter().map(|v| *v as f32));
+                        tables.push(&fit_source, cell_pdf.iter().map(|v| *v as f32));
                         g.kind = MaterialKind::Tabulated as u32;
                         g.alpha_x = tab.stretch.alpha_x as f32;
                         g.alpha_y = tab.stretch.alpha_y as f32;
@@ -282,6 +329,18 @@ impl SceneResources {
             };
             let ([k0, k1], w) = facet_glint::dpf::DpfPyramid::levels_for(cfg.gamma);
             let which: Vec<usize> = if w > 0.0 { vec![k0, k1] } else { vec![k0] };
+            let (nt, np) = (config.dpf.n_theta as u64, config.dpf.n_dphi as u64);
+            let dpf_set_by =
+                format!("the DPF resolution (ResourceConfig::dpf: n_theta {nt}, n_dphi {np})");
+            let side = |x: u64| u32::try_from(x).unwrap_or(u32::MAX);
+            limits.check(&[
+                Planned::texture_3d(
+                    "a DPF level texture",
+                    [side(np), side(nt), side(nt)],
+                    &dpf_set_by,
+                ),
+                Planned::storage("a DPF level buffer", product(&[nt, nt, np, 4]), &dpf_set_by),
+            ])?;
             let dpf = facet_glint::gpu::build_levels(gpu, &Ndf::Analytic(ndf), config.dpf, &which)?;
             let (params, t0, t1): (GlintEvalParams, _, _) =
                 facet_glint::gpu::eval_params(&cfg, &ndf, &dpf)?;
@@ -423,9 +482,18 @@ impl SceneResources {
             Some(Environment::Map(map)) => {
                 env_kind = 2;
                 env_size = (map.width, map.height);
-                let texels = tables.push(map.texels.iter().flat_map(|t| t.to_array()));
-                let marginal = tables.push(map.marginal_cdf.iter().copied());
-                let conditional = tables.push(map.conditional_cdf.iter().copied());
+                let source = format!("the environment map {}", map.path.display());
+                // Checked before the copy into the tables: the map is the largest input.
+                let words =
+                    3 * map.texels.len() + map.marginal_cdf.len() + map.conditional_cdf.len();
+                limits.check(&[Planned::storage(
+                    "the scene tables",
+                    4 * (tables.words.len() + words) as u64,
+                    format!("{source} ({}×{})", map.width, map.height),
+                )])?;
+                let texels = tables.push(&source, map.texels.iter().flat_map(|t| t.to_array()));
+                let marginal = tables.push(&source, map.marginal_cdf.iter().copied());
+                let conditional = tables.push(&source, map.conditional_cdf.iter().copied());
                 env_offsets = (texels, marginal, conditional);
                 built.environment_map = true;
                 let avg = map.texels.iter().map(|t| lum(*t)).sum::<f32>()
@@ -450,14 +518,64 @@ impl SceneResources {
         if let Some(last) = cdf.last_mut() {
             *last = 1.0;
         }
-        let light_cdf = tables.push(cdf);
+        let light_cdf = tables.push("the scene's lights", cdf);
         built.lights = lights.len();
         if lights.is_empty() {
             lights.push(GpuLight::default());
         }
-        if tables.0.is_empty() {
-            tables.0.push(0.0);
+        if tables.words.is_empty() {
+            tables.words.push(0.0);
         }
+        let size_of = |n: usize, each: usize| product(&[n as u64, each as u64]);
+        let n_tri = scene.indices.len();
+        let largest = scene
+            .textures
+            .iter()
+            .max_by_key(|t| u64::from(t.width) * u64::from(t.height))
+            .map_or(String::new(), |t| {
+                format!("; the largest, {}, is {}×{}", t.name, t.width, t.height)
+            });
+        limits.check(&[
+            Planned::storage(
+                "the vertex buffer",
+                size_of(vertices.len(), 16),
+                format!("the scene ({n} vertices)"),
+            ),
+            Planned::storage(
+                "the triangle buffer",
+                size_of(triangles.len(), 16),
+                format!("the scene ({n_tri} triangles)"),
+            ),
+            Planned::storage(
+                "the material buffer",
+                size_of(materials.len(), std::mem::size_of::<GpuMaterial>()),
+                format!("the scene ({} materials)", materials.len()),
+            ),
+            Planned::storage(
+                "the texture buffer",
+                size_of(tex_words.len(), 4),
+                format!("the scene's {} textures{largest}", scene.textures.len()),
+            ),
+            Planned::storage(
+                "the light buffer",
+                size_of(lights.len(), std::mem::size_of::<GpuLight>()),
+                format!(
+                    "the scene ({} punctual lights, {} emissive triangles)",
+                    scene.lights.len(),
+                    built.emissive_triangles
+                ),
+            ),
+            Planned::storage(
+                "the scene tables",
+                size_of(tables.words.len(), 4),
+                tables.described(),
+            ),
+            Planned::storage(
+                "the per-triangle light index",
+                size_of(triangle_light.len(), 4),
+                format!("the scene ({n_tri} triangles)"),
+            ),
+        ])?;
 
         let res = gpu.scoped(|| SceneResources {
             vertices: buffer::storage(d, "vertices", &vertices),
@@ -474,7 +592,7 @@ impl SceneResources {
                 },
             ),
             lights: buffer::storage(d, "lights", &lights),
-            tables: buffer::storage(d, "tables", &tables.0),
+            tables: buffer::storage(d, "tables", &tables.words),
             triangle_light: buffer::storage(d, "triangle lights", &triangle_light),
             bvh: gpu_bvh,
             glints,
@@ -489,13 +607,6 @@ impl SceneResources {
             scene_radius: radius,
             built,
         })?;
-        for (what, bytes) in [
-            ("vertices", res.vertices.size()),
-            ("tables", res.tables.size()),
-            ("textures", res.textures.size()),
-        ] {
-            buffer::check_binding(d, what, bytes)?;
-        }
         Ok(res)
     }
 }
