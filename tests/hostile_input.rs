@@ -482,3 +482,77 @@ fn proxies_are_found_from_any_folder() {
     );
     assert!(err.is_empty(), "{err}");
 }
+
+/// A one-triangle glTF whose material has a base-colour texture `tex.png` beside it.
+fn textured_triangle(dir: &Path) -> PathBuf {
+    let mut bin = Vec::new();
+    for v in [[0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        v.iter().for_each(|x| bin.extend(x.to_le_bytes()));
+    }
+    for v in [[0f32, 0.0], [1.0, 0.0], [0.0, 1.0]] {
+        v.iter().for_each(|x| bin.extend(x.to_le_bytes()));
+    }
+    let b64 = facet_render::scene::data_uri::encode_base64(&bin);
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{b64}")}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 24}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [0.0, 0.0, 0.0], "max": [1.0, 1.0, 0.0]},
+            {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}
+        ],
+        "images": [{"uri": "tex.png"}],
+        "textures": [{"source": 0}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0
+    });
+    let path = dir.join("tri.gltf");
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    image::save_buffer(
+        dir.join("tex.png"),
+        &[255u8, 0, 0, 255],
+        1,
+        1,
+        image::ExtendedColorType::Rgba8,
+    )
+    .unwrap();
+    path
+}
+
+#[test]
+fn a_render_never_replaces_a_file_its_scene_reads() {
+    let dir = scratch("hostile_render_outputs");
+    let scene = textured_triangle(&dir);
+    let tex = dir.join("tex.png");
+    let before = std::fs::read(&tex).unwrap();
+    let (ok, _, err) = facet(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--out",
+        tex.to_str().unwrap(),
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--spp",
+        "1",
+    ]);
+    assert!(!ok, "rendering over the scene's texture succeeded");
+    assert!(
+        err.contains("would replace the input") && err.contains("tex.png"),
+        "{err}"
+    );
+    assert_eq!(
+        std::fs::read(&tex).unwrap(),
+        before,
+        "the texture was replaced"
+    );
+    assert!(!dir.join("tex.exr").exists());
+}

@@ -154,6 +154,12 @@ fn load_document(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sce
     let mut scene = Scene::default();
     let mut loader = MaterialLoader::new(path, &buffers, &options.materials);
     scene.materials = loader.load_all(&document, &mut scene.textures, &mut scene.warnings)?;
+    scene.inputs = buffers
+        .files()
+        .iter()
+        .chain(loader.files())
+        .cloned()
+        .collect();
 
     let placed = walk_nodes(path, &document, &mut scene.warnings)?;
     let mut default_material = None;

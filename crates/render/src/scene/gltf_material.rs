@@ -157,6 +157,15 @@ impl<'a> MaterialLoader<'a> {
         }
     }
 
+    /// Every file read (or tried) so far: image files and fits.
+    pub fn files(&self) -> impl Iterator<Item = &PathBuf> {
+        let images = self.images.keys().filter_map(|k| match k {
+            ImageKey::File(f) => Some(f),
+            ImageKey::Image(_) => None,
+        });
+        images.chain(self.fits.keys())
+    }
+
     /// All materials of `doc`, textures appended to `textures`, warnings to `warnings`.
     pub fn load_all(
         &mut self,
@@ -260,9 +269,9 @@ impl<'a> MaterialLoader<'a> {
         let fit = match self.fits.get(&source) {
             Some(f) => f.clone(),
             None => {
-                let f = FittedMaterial::load(&source).map_err(|e| {
-                    RenderError::input(&source, format!("fit of material `{name}`: {e}"))
-                })?;
+                // The fit's error names its file.
+                let f = FittedMaterial::load(&source)
+                    .map_err(|e| RenderError::Scene(format!("material `{name}`: {e}")))?;
                 let f = Arc::new(f);
                 self.fits.insert(source.clone(), f.clone());
                 f
