@@ -25,3 +25,12 @@ impl RenderError {
         }
     }
 }
+
+impl From<facet_fit::input::InputError> for RenderError {
+    fn from(e: facet_fit::input::InputError) -> Self {
+        RenderError::Input {
+            path: e.path,
+            message: e.problem,
+        }
+    }
+}

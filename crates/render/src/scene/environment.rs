@@ -13,6 +13,7 @@
 //! dω = 2π² sin θ du dv the solid-angle density is `p_xy · w · h / (2π² sin θ)`.
 
 use crate::error::RenderError;
+use facet_fit::input::{self, Cap};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
@@ -57,6 +58,27 @@ pub fn uv_to_direction(uv: Vec2) -> Vec3 {
     Vec3::new(st * cp, ct, st * sp)
 }
 
+/// The widest or tallest environment map read: 16384 pixels.
+pub const MAX_ENV_SIDE: u64 = 16384;
+/// The most pixels an environment map may have: 2²⁶ (a 11585² square, 16384 × 4096); its
+/// texels and sampling tables then take about 1.3 GiB.
+pub const MAX_ENV_PIXELS: u64 = 1 << 26;
+
+/// Refuses a `width × height` map over [`MAX_ENV_SIDE`] or [`MAX_ENV_PIXELS`].
+fn check_env_size(width: u64, height: u64) -> Result<(), String> {
+    if width > MAX_ENV_SIDE || height > MAX_ENV_SIDE {
+        return Err(format!(
+            "{width} × {height} pixels: a side is over the {MAX_ENV_SIDE} an environment map may have"
+        ));
+    }
+    if width * height > MAX_ENV_PIXELS {
+        return Err(format!(
+            "{width} × {height} pixels is more than the {MAX_ENV_PIXELS} an environment map may have"
+        ));
+    }
+    Ok(())
+}
+
 /// Rec. 709 luminance: 0.2126 R + 0.7152 G + 0.0722 B.
 pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
@@ -81,17 +103,68 @@ pub struct EnvironmentMap {
 
 impl EnvironmentMap {
     /// Reads the first RGB(A) layer of an OpenEXR file (alpha ignored). Texels that are
-    /// negative or not finite become 0; the returned strings say how many.
+    /// negative or not finite become 0; the returned strings say how many. The file is read
+    /// through [`facet_fit::input`] ([`Cap::EXR`]), then [`Self::from_exr_bytes`].
     pub fn load(path: &Path) -> Result<(EnvironmentMap, Vec<String>), RenderError> {
-        std::fs::metadata(path).map_err(|e| RenderError::input(path, e))?;
-        let image = exr::prelude::read_first_rgba_layer_from_file(
-            path,
-            |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-            |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-                px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
-            },
-        )
-        .map_err(|e| RenderError::input(path, format!("not a readable RGB OpenEXR image: {e}")))?;
+        let bytes = input::read(path, Cap::EXR)?;
+        Self::from_exr_bytes(path, &bytes)
+    }
+
+    /// [`Self::load`] of an OpenEXR file already in memory (`path` names it in messages).
+    ///
+    /// The header is read first, alone: a layer wider or taller than [`MAX_ENV_SIDE`] or with
+    /// more than [`MAX_ENV_PIXELS`] pixels (data or display window) is refused before any pixel
+    /// buffer exists. A panic of the decoder on a malformed file is caught and reported as an
+    /// error naming the file.
+    pub fn from_exr_bytes(
+        path: &Path,
+        bytes: &[u8],
+    ) -> Result<(EnvironmentMap, Vec<String>), RenderError> {
+        let not_exr = |e: exr::error::Error| {
+            RenderError::input(path, format!("not a readable RGB OpenEXR image: {e}"))
+        };
+        let caught = |payload: Box<dyn std::any::Any + Send>| {
+            RenderError::input(
+                path,
+                format!(
+                    "internal error while reading the OpenEXR image: {}; please report it",
+                    crate::scene::gltf_file::panic_message(payload.as_ref())
+                ),
+            )
+        };
+        let meta = std::panic::catch_unwind(|| {
+            exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(bytes), false)
+        })
+        .map_err(caught)?
+        .map_err(not_exr)?;
+        for (i, header) in meta.headers.iter().enumerate() {
+            let display = header.shared_attributes.display_window.size;
+            for (window, size) in [
+                ("data window", header.layer_size),
+                ("display window", display),
+            ] {
+                check_env_size(size.0 as u64, size.1 as u64).map_err(|m| {
+                    RenderError::input(path, format!("layer {i}'s {window}: {m}"))
+                })?;
+            }
+        }
+        let image = std::panic::catch_unwind(|| {
+            use exr::prelude::{ReadChannels as _, ReadLayers as _};
+            exr::prelude::read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .rgba_channels(
+                    |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
+                    |(w, px): &mut (usize, Vec<Vec3>), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+                        px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b);
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(std::io::Cursor::new(bytes))
+        })
+        .map_err(caught)?
+        .map_err(not_exr)?;
         let size = image.layer_data.size;
         let (_, mut texels) = image.layer_data.channel_data.pixels;
         let mut bad = 0usize;

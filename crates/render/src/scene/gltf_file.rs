@@ -17,10 +17,15 @@
 //! for directional), direction = the node's −Z. `range` is ignored: the renderer uses the
 //! physical inverse-square falloff everywhere, which is what glTF prescribes inside the range.
 
+use super::gltf_buffers::Buffers;
+use super::gltf_check::{
+    Attribute, CameraKind, MAX_TRIANGLES, MAX_VERTICES, check_accessor, check_camera, check_light,
+};
 use super::gltf_material::MaterialLoader;
 use super::mesh::{RawPrimitive, clean_primitive};
 use super::{Camera, Light, Material, Scene};
 use crate::error::RenderError;
+use facet_fit::input::{self, Cap};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::khr_lights_punctual::Kind;
 use std::path::{Path, PathBuf};
@@ -41,12 +46,90 @@ pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
 /// Loads a glTF 2.0 file into a world-space [`Scene`]. Bad input is a [`RenderError::Input`]
 /// naming the file; a scene without any renderable triangle is a [`RenderError::Scene`].
+/// The file is read through [`facet_fit::input`] (a regular file of at most
+/// [`Cap::GLTF`](facet_fit::input::Cap::GLTF) bytes), then [`load_gltf_bytes`].
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderError> {
+    let bytes = input::read(path, Cap::GLTF)?;
+    load_gltf_bytes(path, &bytes, options)
+}
+
+/// [`load_gltf`] of a glTF JSON or `.glb` already in memory: `path` names it in messages and
+/// is where relative URIs (buffers, images, fits) are resolved from.
+///
+/// Hostile input is an error naming the file and what is wrong with it (see
+/// [`super::gltf_check`]); should the `gltf` crate still panic, the panic is caught and becomes
+/// a [`RenderError::Input`] too ("internal error while reading the glTF …; please report it").
+/// The default panic hook still prints that panic to stderr: silencing it would need the
+/// process-wide hook, which other threads share.
+pub fn load_gltf_bytes(
+    path: &Path,
+    bytes: &[u8],
+    options: &LoadOptions,
+) -> Result<Scene, RenderError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        load_document(path, bytes, options)
+    }))
+    .unwrap_or_else(|payload| {
+        Err(RenderError::input(
+            path,
+            format!(
+                "internal error while reading the glTF: {}; please report it",
+                panic_message(payload.as_ref())
+            ),
+        ))
+    })
+}
+
+/// The message of a caught panic.
+pub(crate) fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_owned()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "a panic without a message".into()
+    }
+}
+
+/// The GLB header (magic, version, length) checked before the `gltf` crate reads it: its
+/// `length − 12` underflows on a length under 12.
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let word = |i: usize| {
+        bytes
+            .get(i..i + 4)
+            .map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]]))
+    };
+    let (Some(version), Some(length)) = (word(4), word(8)) else {
+        return Err(format!(
+            "GLB header: {} bytes, shorter than the 12-byte header",
+            bytes.len()
+        ));
+    };
+    if version != 2 {
+        return Err(format!("GLB header: version {version}, not 2"));
+    }
+    if length < 20 {
+        return Err(format!(
+            "GLB header: length {length} is shorter than a header and one chunk header (20 bytes)"
+        ));
+    }
+    if length as usize > bytes.len() {
+        return Err(format!(
+            "GLB header: length {length} but the file has {} bytes (truncated?)",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
+fn load_document(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Scene, RenderError> {
+    check_glb_header(bytes).map_err(|m| RenderError::input(path, m))?;
     let gltf::Gltf { document, blob } =
-        gltf::Gltf::open(path).map_err(|e| RenderError::input(path, describe(e)))?;
-    let base = path.parent().unwrap_or(Path::new(""));
-    let buffers = gltf::import_buffers(&document, Some(base), blob)
-        .map_err(|e| RenderError::input(path, format!("loading buffers: {}", describe(e))))?;
+        gltf::Gltf::from_slice(bytes).map_err(|e| RenderError::input(path, describe(e)))?;
+    let buffers = Buffers::load(path, &document, blob)?;
 
     let mut scene = Scene::default();
     let mut loader = MaterialLoader::new(path, &buffers, &options.materials);
@@ -58,6 +141,7 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderErro
         if let Some(mesh) = node.mesh() {
             add_mesh(
                 &mut scene,
+                &document,
                 &mesh,
                 *world,
                 &buffers,
@@ -66,12 +150,34 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderErro
             )?;
         }
         if let Some(light) = node.light() {
-            scene.lights.extend(world_light(&light, *world));
+            match check_light(&light) {
+                Ok(()) => scene.lights.extend(world_light(&light, *world)),
+                Err(problem) => scene.warnings.push(format!(
+                    "light {} on node {}: {problem}; skipped",
+                    light.index(),
+                    node_name(node)
+                )),
+            }
         }
     }
     if scene.indices.is_empty() {
+        let why = if scene.warnings.is_empty() {
+            String::new()
+        } else {
+            let shown: Vec<&str> = scene.warnings.iter().take(8).map(String::as_str).collect();
+            let more = scene.warnings.len().saturating_sub(shown.len());
+            format!(
+                " ({}{})",
+                shown.join("; "),
+                if more > 0 {
+                    format!("; and {more} more")
+                } else {
+                    String::new()
+                }
+            )
+        };
         return Err(RenderError::Scene(format!(
-            "{} has no triangles",
+            "{} has no triangles{why}",
             path.display()
         )));
     }
@@ -83,6 +189,24 @@ pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderErro
 fn describe(e: gltf::Error) -> String {
     match e {
         gltf::Error::Io(io) => io.to_string(),
+        // One entry per bad value: a hostile file can have millions.
+        gltf::Error::Validation(list) => {
+            let shown: Vec<String> = list
+                .iter()
+                .take(10)
+                .map(|(p, e)| format!("{p}: {e}"))
+                .collect();
+            let more = list.len().saturating_sub(shown.len());
+            format!(
+                "invalid glTF: {}{}",
+                shown.join("; "),
+                if more > 0 {
+                    format!("; and {more} more")
+                } else {
+                    String::new()
+                }
+            )
+        }
         other => other.to_string(),
     }
 }
@@ -134,12 +258,16 @@ fn node_name(n: &gltf::Node) -> String {
         .map_or(format!("{}", n.index()), |s| format!("`{s}`"))
 }
 
-/// Appends every triangle primitive of `mesh`, placed by `world`.
+/// Appends every triangle primitive of `mesh`, placed by `world`. Every accessor read is
+/// checked first ([`check_accessor`]), and so are the counts against POSITION's and the scene's
+/// totals against [`MAX_VERTICES`] and [`MAX_TRIANGLES`] (a mesh placed on many nodes is read
+/// once per node).
 fn add_mesh(
     scene: &mut Scene,
+    doc: &gltf::Document,
     mesh: &gltf::Mesh,
     world: Mat4,
-    buffers: &[gltf::buffer::Data],
+    buffers: &Buffers,
     path: &Path,
     default_material: &mut Option<u32>,
 ) -> Result<(), RenderError> {
@@ -151,6 +279,8 @@ fn add_mesh(
     let normal_matrix = (m3.determinant() != 0.0).then(|| m3.inverse().transpose());
     let mirrored = m3.determinant() < 0.0;
     let mut dropped = 0;
+    let root = doc.as_json();
+    let buffer_len = |i: usize| buffers.len_of(i);
     for prim in mesh.primitives() {
         if prim.mode() != gltf::mesh::Mode::Triangles {
             scene.warnings.push(format!(
@@ -160,7 +290,65 @@ fn add_mesh(
             ));
             continue;
         }
-        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let Some(position_accessor) = prim.get(&gltf::Semantic::Positions) else {
+            scene.warnings.push(format!(
+                "{mesh_name}: primitive {} has no POSITION; skipped",
+                prim.index()
+            ));
+            continue;
+        };
+        // The accessors this primitive is read through, checked before any reader runs.
+        let attributes = [
+            (Attribute::Position, Some(position_accessor)),
+            (Attribute::Normal, prim.get(&gltf::Semantic::Normals)),
+            (Attribute::Tangent, prim.get(&gltf::Semantic::Tangents)),
+            (Attribute::TexCoord0, prim.get(&gltf::Semantic::TexCoords(0))),
+            (Attribute::Indices, prim.indices()),
+        ];
+        let n_positions = root
+            .accessors
+            .get(attributes[0].1.as_ref().map_or(0, |a| a.index()))
+            .map_or(0, |a| a.count.0);
+        for (attribute, accessor) in &attributes {
+            let Some(accessor) = accessor else { continue };
+            let at_fault = |problem: String| {
+                RenderError::input(
+                    path,
+                    format!(
+                        "accessor {} ({} of {mesh_name}, primitive {}): {problem}",
+                        accessor.index(),
+                        attribute.name(),
+                        prim.index()
+                    ),
+                )
+            };
+            check_accessor(root, accessor.index(), *attribute, &buffer_len).map_err(at_fault)?;
+            let count = root.accessors[accessor.index()].count.0;
+            if *attribute != Attribute::Indices && count != n_positions {
+                return Err(at_fault(format!(
+                    "count {count} differs from POSITION's {n_positions}"
+                )));
+            }
+            if *attribute == Attribute::Indices && !count.is_multiple_of(3) {
+                return Err(at_fault(format!("count {count} is not a multiple of 3")));
+            }
+        }
+        let n_triangles = match &attributes[4].1 {
+            Some(a) => root.accessors[a.index()].count.0 / 3,
+            None => n_positions / 3,
+        };
+        if scene.positions.len() as u64 + n_positions > MAX_VERTICES
+            || scene.indices.len() as u64 + n_triangles > MAX_TRIANGLES
+        {
+            return Err(RenderError::input(
+                path,
+                format!(
+                    "{mesh_name}, primitive {}: the scene would have more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (a mesh placed on many nodes counts once per node)",
+                    prim.index()
+                ),
+            ));
+        }
+        let reader = prim.reader(|b| buffers.get(b.index()));
         let Some(positions) = reader.read_positions() else {
             scene.warnings.push(format!(
                 "{mesh_name}: primitive {} has no readable POSITION; skipped",
@@ -303,7 +491,14 @@ fn world_light(light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Option<
     })
 }
 
-/// The requested camera, the first one in the scene, or the framing default (with a warning).
+/// The requested camera, the first perspective one in the scene, or the framing default (with a
+/// warning).
+///
+/// Every camera is checked from its JSON ([`check_camera`]) before the `gltf` crate's
+/// `projection()` (which panics when `type` has no matching block) is ever called. The camera
+/// used is `--camera`, or else the first placed node whose camera's `type` is perspective: if it
+/// fails the check, that is an error naming it. Any other camera that fails is not used and only
+/// gets a warning.
 fn choose_camera(
     path: &Path,
     doc: &gltf::Document,
@@ -311,34 +506,39 @@ fn choose_camera(
     options: &LoadOptions,
     scene: &mut Scene,
 ) -> Result<Camera, RenderError> {
-    let perspective = |c: &gltf::Camera| match c.projection() {
-        gltf::camera::Projection::Perspective(p) => Some(p.yfov()),
-        gltf::camera::Projection::Orthographic(_) => None,
+    let cameras = &doc.as_json().cameras;
+    let label = |c: &gltf::Camera| match c.name() {
+        Some(n) => format!("camera {} `{n}`", c.index()),
+        None => format!("camera {}", c.index()),
     };
-    let from_node = |yfov: f32, world: Mat4| -> Result<Camera, RenderError> {
+    let from_node = |label: &str, yfov: f32, world: Mat4| -> Result<Camera, RenderError> {
         let position = world.transform_point3(Vec3::ZERO);
         let forward = world.transform_vector3(Vec3::NEG_Z).try_normalize();
         let up = world.transform_vector3(Vec3::Y);
         // Gram–Schmidt: up ⟂ forward.
         let up = forward.and_then(|f| (up - f * f.dot(up)).try_normalize());
+        // The pinhole of [`crate::camera::CameraFrame`] needs yfov in [1e-4, π − 1e-3].
+        if !(yfov > 1e-4 && yfov < std::f32::consts::PI - 1e-3) {
+            return Err(RenderError::input(
+                path,
+                format!("{label}: yfov {yfov} is too close to 0 or π to render"),
+            ));
+        }
         match (forward, up) {
-            (Some(forward), Some(up))
-                if position.is_finite() && yfov.is_finite() && yfov > 0.0 && yfov < 3.1 =>
-            {
-                Ok(Camera {
-                    position,
-                    forward,
-                    up,
-                    yfov,
-                })
-            }
+            (Some(forward), Some(up)) if position.is_finite() => Ok(Camera {
+                position,
+                forward,
+                up,
+                yfov,
+            }),
             _ => Err(RenderError::Scene(format!(
-                "{}: the camera's node transform or yfov ({yfov}) is degenerate",
+                "{}: {label}: its node transform is degenerate",
                 path.display()
             ))),
         }
     };
-    if let Some(wanted) = &options.camera {
+    // The camera used, with its world matrix.
+    let (used, world) = if let Some(wanted) = &options.camera {
         let camera = doc
             .cameras()
             .find(|c| c.index().to_string() == *wanted || c.name().is_some_and(|n| n == wanted));
@@ -355,9 +555,6 @@ fn choose_camera(
                 format!("no camera `{wanted}` (available: {available:?})"),
             ));
         };
-        let yfov = perspective(&camera).ok_or_else(|| {
-            RenderError::input(path, format!("camera `{wanted}` is not perspective"))
-        })?;
         let world = placed
             .iter()
             .find(|(n, _)| n.camera().is_some_and(|c| c.index() == camera.index()))
@@ -368,17 +565,44 @@ fn choose_camera(
                     format!("camera `{wanted}` is on no node of the scene"),
                 )
             })?;
-        return from_node(yfov, world);
-    }
-    for (node, world) in placed {
-        if let Some(yfov) = node.camera().as_ref().and_then(perspective) {
-            return from_node(yfov, *world);
+        (Some(camera), world)
+    } else {
+        let perspective = |c: &gltf::Camera| {
+            matches!(
+                cameras[c.index()].type_,
+                gltf::json::validation::Checked::Valid(gltf::json::camera::Type::Perspective)
+            )
+        };
+        placed
+            .iter()
+            .find_map(|(n, w)| n.camera().filter(perspective).map(|c| (Some(c), *w)))
+            .unwrap_or((None, Mat4::IDENTITY))
+    };
+    for c in doc.cameras() {
+        if used.as_ref().is_some_and(|u| u.index() == c.index()) {
+            continue;
+        }
+        if let Err(problem) = check_camera(&cameras[c.index()]) {
+            scene
+                .warnings
+                .push(format!("{}: {problem}; not used", label(&c)));
         }
     }
-    scene
-        .warnings
-        .push("no camera in the scene; using a framing default".into());
-    Ok(framing_camera(scene.bounds()))
+    let Some(camera) = used else {
+        scene
+            .warnings
+            .push("no camera in the scene; using a framing default".into());
+        return Ok(framing_camera(scene.bounds()));
+    };
+    let name = label(&camera);
+    match check_camera(&cameras[camera.index()]) {
+        Ok(CameraKind::Perspective(yfov)) => from_node(&name, yfov, world),
+        Ok(CameraKind::Orthographic) => Err(RenderError::input(
+            path,
+            format!("{name} is not perspective (orthographic cameras are not supported)"),
+        )),
+        Err(problem) => Err(RenderError::input(path, format!("{name}: {problem}"))),
+    }
 }
 
 /// Looks at the centre of `(lo, hi)` from `normalize(0, 0.35, 1)`, far enough that the bounding

@@ -9,11 +9,17 @@
 //! The fit path is relative to the glTF file's folder; `model` defaults to `tabulated`;
 //! `glint.density` is required, `gamma_deg` defaults to 2 and `threshold` to 50.
 //! Images are decoded here, one at a time, so that a missing or broken image only costs its
-//! texture (a warning naming the image and the material), never the whole scene.
+//! texture (a warning naming the image, its file and the problem, and the material), never the
+//! whole scene. An image file is read through [`facet_fit::input`] ([`Cap::TEXTURE`]); its header
+//! is read first and a size over [`MAX_TEXTURE_SIDE`] on a side, or one that would bring the
+//! scene's textures past [`MAX_SCENE_TEXELS`], is refused before any pixel is decoded; the
+//! decoder then runs under [`image::Limits`] (the same sides, [`MAX_DECODE_BYTES`]).
 
-use super::data_uri::decode_data_uri;
+use super::gltf_buffers::Buffers;
+use super::uri::{UriTarget, resolve};
 use super::{FacetMaterial, FacetModel, GlintParams, Material, Texture};
 use crate::error::RenderError;
+use facet_fit::input::{self, Cap};
 use facet_fit::material::{FittedMaterial, ModelChoice};
 use glam::{Vec3, Vec4};
 use serde_json::Value;
@@ -101,17 +107,34 @@ fn parse_glint(g: &Value) -> Result<GlintParams, String> {
     Ok(p)
 }
 
+/// The widest and tallest texture read: 16384 texels.
+pub const MAX_TEXTURE_SIDE: u32 = 16384;
+/// The most texels all textures of a scene may hold together: 2²⁸ (1 GiB of RGBA8).
+pub const MAX_SCENE_TEXELS: u64 = 1 << 28;
+/// The most memory the image decoder may allocate for one image: 1 GiB.
+pub const MAX_DECODE_BYTES: u64 = 1 << 30;
+
 /// A decoded image: width, height, RGBA8 texels row by row.
-type Decoded = (u32, u32, Vec<[u8; 4]>);
+type Decoded = Arc<(u32, u32, Vec<[u8; 4]>)>;
+
+/// What an image is read from, for the cache: a file is decoded once however many images name
+/// it.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum ImageKey {
+    File(PathBuf),
+    Image(usize),
+}
 
 /// Builds every material of the document (same indices), its textures and Facet fits.
 pub(crate) struct MaterialLoader<'a> {
     pub gltf_path: &'a Path,
-    pub buffers: &'a [gltf::buffer::Data],
+    pub buffers: &'a Buffers,
     /// `--material NAME=FILE` overrides.
     pub overrides: &'a [(String, PathBuf)],
-    /// Decoded images by image index (`None`: not tried yet).
-    images: HashMap<usize, Result<Decoded, String>>,
+    /// Decoded images (or why not) by what they were read from.
+    images: HashMap<ImageKey, Result<Decoded, String>>,
+    /// Texels of the scene textures made so far (against [`MAX_SCENE_TEXELS`]).
+    texels: u64,
     /// Scene texture index by (image index, sRGB).
     textures: HashMap<(usize, bool), u32>,
     fits: HashMap<PathBuf, Arc<FittedMaterial>>,
@@ -120,7 +143,7 @@ pub(crate) struct MaterialLoader<'a> {
 impl<'a> MaterialLoader<'a> {
     pub fn new(
         gltf_path: &'a Path,
-        buffers: &'a [gltf::buffer::Data],
+        buffers: &'a Buffers,
         overrides: &'a [(String, PathBuf)],
     ) -> Self {
         MaterialLoader {
@@ -128,6 +151,7 @@ impl<'a> MaterialLoader<'a> {
             buffers,
             overrides,
             images: HashMap::new(),
+            texels: 0,
             textures: HashMap::new(),
             fits: HashMap::new(),
         }
@@ -279,13 +303,37 @@ impl<'a> MaterialLoader<'a> {
         if let Some(&t) = self.textures.get(&(image.index(), srgb)) {
             return Some(t);
         }
+        let (key, source) = match image_source(image, self.gltf_path) {
+            Ok(found) => found,
+            Err(e) => {
+                warnings.push(format!(
+                    "texture {label} of material `{material}` not loaded ({e}); using the factor alone"
+                ));
+                return None;
+            }
+        };
+        let budget = MAX_SCENE_TEXELS - self.texels;
         let decoded = self
             .images
-            .entry(image.index())
-            .or_insert_with(|| decode_image(image, self.gltf_path, self.buffers));
-        match decoded {
-            Ok((width, height, texels)) => {
+            .entry(key)
+            .or_insert_with(|| decode_image(source, self.buffers, budget))
+            .clone();
+        let fits = |d: &Decoded| {
+            let n = u64::from(d.0) * u64::from(d.1);
+            if n <= budget {
+                Ok(d.clone())
+            } else {
+                Err(format!(
+                    "{}×{} texels would bring the scene's textures past {MAX_SCENE_TEXELS} texels",
+                    d.0, d.1
+                ))
+            }
+        };
+        match decoded.and_then(|d| fits(&d)) {
+            Ok(d) => {
+                let (width, height, texels) = &*d;
                 let t = textures.len() as u32;
+                self.texels += u64::from(*width) * u64::from(*height);
                 textures.push(Texture {
                     name: label,
                     width: *width,
@@ -324,33 +372,94 @@ fn image_label(image: &gltf::Image) -> String {
     }
 }
 
-/// Reads and decodes one image to RGBA8 (file, data URI or buffer view).
-fn decode_image(
-    image: &gltf::Image,
+/// Where an image's bytes are.
+enum ImageSource<'a> {
+    Data(Vec<u8>),
+    File(PathBuf),
+    View(gltf::buffer::View<'a>),
+}
+
+/// The cache key and source of `image`; `Err` for a URI that is refused.
+fn image_source<'a>(
+    image: &gltf::Image<'a>,
     gltf_path: &Path,
-    buffers: &[gltf::buffer::Data],
-) -> Result<Decoded, String> {
-    let bytes: Vec<u8> = match image.source() {
-        gltf::image::Source::Uri { uri, .. } => match decode_data_uri(uri) {
-            Some(decoded) => decoded?,
-            None => {
-                let file = gltf_path
-                    .parent()
-                    .unwrap_or(Path::new(""))
-                    .join(percent_decode(uri));
-                std::fs::read(&file).map_err(|e| format!("{}: {e}", file.display()))?
-            }
+) -> Result<(ImageKey, ImageSource<'a>), String> {
+    let by_index = ImageKey::Image(image.index());
+    match image.source() {
+        gltf::image::Source::Uri { uri, .. } => match resolve(gltf_path, uri)? {
+            UriTarget::Data(d) => Ok((by_index, ImageSource::Data(d))),
+            UriTarget::File(f) => Ok((ImageKey::File(f.clone()), ImageSource::File(f))),
         },
-        gltf::image::Source::View { view, .. } => {
+        gltf::image::Source::View { view, .. } => Ok((by_index, ImageSource::View(view))),
+    }
+}
+
+/// Reads and decodes one image to RGBA8 (file, data URI or buffer view); at most `budget`
+/// texels. A file's errors name it.
+fn decode_image(source: ImageSource, buffers: &Buffers, budget: u64) -> Result<Decoded, String> {
+    let (bytes, file): (std::borrow::Cow<[u8]>, Option<PathBuf>) = match source {
+        ImageSource::Data(d) => (d.into(), None),
+        ImageSource::File(f) => {
+            let bytes = input::read(&f, Cap::TEXTURE).map_err(|e| e.to_string())?;
+            (bytes.into(), Some(f))
+        }
+        ImageSource::View(view) => {
             let data = buffers
                 .get(view.buffer().index())
                 .ok_or("buffer view points to a missing buffer")?;
-            data.get(view.offset()..view.offset() + view.length())
-                .ok_or("buffer view lies outside its buffer")?
-                .to_vec()
+            let end = view.offset().checked_add(view.length());
+            let bytes = end
+                .and_then(|end| data.get(view.offset()..end))
+                .ok_or_else(|| {
+                    format!(
+                        "bufferView {} (byteOffset {} + byteLength {}) lies outside its buffer ({} bytes)",
+                        view.index(),
+                        view.offset(),
+                        view.length(),
+                        data.len()
+                    )
+                })?;
+            (bytes.into(), None)
         }
     };
-    let rgba = image::load_from_memory(&bytes)
+    decode_bytes(&bytes, budget).map_err(|e| match &file {
+        Some(f) => format!("{}: {e}", f.display()),
+        None => e,
+    })
+}
+
+/// PNG or JPEG bytes → RGBA8: the header first (size checks), then the pixels under
+/// [`image::Limits`].
+fn decode_bytes(bytes: &[u8], budget: u64) -> Result<Decoded, String> {
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|e| format!("cannot read: {e}"))
+    };
+    let (w, h) = reader()?
+        .into_dimensions()
+        .map_err(|e| format!("cannot decode: {e}"))?;
+    if w == 0 || h == 0 {
+        return Err("zero-sized image".into());
+    }
+    if w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
+        return Err(format!(
+            "{w}×{h} texels is larger than the {MAX_TEXTURE_SIDE}×{MAX_TEXTURE_SIDE} a texture may be"
+        ));
+    }
+    if u64::from(w) * u64::from(h) > budget {
+        return Err(format!(
+            "{w}×{h} texels would bring the scene's textures past {MAX_SCENE_TEXELS} texels"
+        ));
+    }
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE_SIDE);
+    limits.max_image_height = Some(MAX_TEXTURE_SIDE);
+    limits.max_alloc = Some(MAX_DECODE_BYTES);
+    let mut r = reader()?;
+    r.limits(limits);
+    let rgba = r
+        .decode()
         .map_err(|e| format!("cannot decode: {e}"))?
         .to_rgba8();
     let (w, h) = rgba.dimensions();
@@ -358,30 +467,5 @@ fn decode_image(
         return Err("zero-sized image".into());
     }
     let texels = rgba.pixels().map(|p| p.0).collect();
-    Ok((w, h, texels))
-}
-
-/// `%XX` escapes of a relative URI → bytes; anything malformed is kept as written.
-fn percent_decode(uri: &str) -> String {
-    let b = uri.as_bytes();
-    let mut out = Vec::with_capacity(b.len());
-    let mut i = 0;
-    while i < b.len() {
-        let hex = |c: u8| (c as char).to_digit(16);
-        match (
-            b[i],
-            b.get(i + 1).and_then(|&c| hex(c)),
-            b.get(i + 2).and_then(|&c| hex(c)),
-        ) {
-            (b'%', Some(h), Some(l)) => {
-                out.push((h * 16 + l) as u8);
-                i += 3;
-            }
-            (c, _, _) => {
-                out.push(c);
-                i += 1;
-            }
-        }
-    }
-    String::from_utf8_lossy(&out).into_owned()
+    Ok(Arc::new((w, h, texels)))
 }

@@ -10,13 +10,16 @@ use std::sync::Arc;
 
 pub mod data_uri;
 pub mod environment;
+pub(crate) mod gltf_buffers;
+pub mod gltf_check;
 pub mod gltf_file;
 pub mod gltf_material;
 pub mod mesh;
 pub mod shapes;
+pub mod uri;
 
 pub use environment::{Environment, EnvironmentMap};
-pub use gltf_file::{LoadOptions, load_gltf};
+pub use gltf_file::{LoadOptions, load_gltf, load_gltf_bytes};
 
 /// A whole scene in world space.
 #[derive(Clone, Debug, Default)]
