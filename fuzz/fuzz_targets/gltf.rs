@@ -3,11 +3,15 @@
 //! of the seeds resolves; any other relative URI finds nothing.
 #![no_main]
 
-use facet_fuzz::{FIT_JSON, FIT_NAME, assert_names, assert_scene_sane};
+use facet_fuzz::{assert_names, assert_scene_sane, run};
 use facet_render::scene::{LoadOptions, load_gltf_bytes};
 use libfuzzer_sys::fuzz_target;
 use std::path::PathBuf;
 use std::sync::OnceLock;
+
+/// The fit file beside the fuzzed glTF: the demo's, under the name the seeds use.
+const FIT_NAME: &str = "default_fit.json";
+const FIT_JSON: &str = include_str!("../../assets/demo/default_fit.json");
 
 fn path() -> &'static PathBuf {
     static PATH: OnceLock<PathBuf> = OnceLock::new();
@@ -19,10 +23,10 @@ fn path() -> &'static PathBuf {
     })
 }
 
-fuzz_target!(|data: &[u8]| {
+fuzz_target!(|data: &[u8]| run(|| {
     let path = path();
     match load_gltf_bytes(path, data, &LoadOptions::default()) {
         Ok(scene) => assert_scene_sane(&scene),
         Err(e) => assert_names(path, e),
     }
-});
+}));

@@ -10,7 +10,7 @@
 #![no_main]
 
 use facet_fit::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
-use facet_fuzz::{assert_brdf_sane, assert_names};
+use facet_fuzz::{assert_brdf_sane, assert_names, run};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 use std::sync::{Mutex, OnceLock};
@@ -40,12 +40,19 @@ fn check(path: &Path, bytes: &[u8], written: &[(usize, f64)], full: bool) {
         assert!(v <= MAX_STORED, "accepted value {index} = {v:e}");
         let (c, s) = (index / SAMPLES, index % SAMPLES);
         if let Some(rgb) = table.value_at(s) {
-            assert!(v >= 0.0 && rgb[c] == v * SCALE[c], "value {index} = {v:e} reads as {:e}", rgb[c]);
+            assert!(
+                v >= 0.0 && rgb[c] == v * SCALE[c],
+                "value {index} = {v:e} reads as {:e}",
+                rgb[c]
+            );
         }
     }
     for s in 0..SAMPLES {
         if let Some(v) = table.value_at(s) {
-            assert!(v.iter().all(|x| x.is_finite() && *x >= 0.0), "sample {s} is {v:?}");
+            assert!(
+                v.iter().all(|x| x.is_finite() && *x >= 0.0),
+                "sample {s} is {v:?}"
+            );
         }
     }
     if let Ok(brdf) = MerlBrdf::from_table("fuzzed", table) {
@@ -53,7 +60,7 @@ fn check(path: &Path, bytes: &[u8], written: &[(usize, f64)], full: bool) {
     }
 }
 
-fuzz_target!(|data: &[u8]| {
+fuzz_target!(|data: &[u8]| run(|| {
     let path = Path::new("fuzzed.binary");
     if data.first().is_some_and(|b| b & 1 == 1) {
         return check(path, &data[1..], &[], false);
@@ -78,10 +85,8 @@ fuzz_target!(|data: &[u8]| {
     let len = valid_len.saturating_add_signed(delta);
     file.resize(len.max(valid_len), 0);
     let standard = file[..12] == [90, 0, 0, 0, 90, 0, 0, 0, 180, 0, 0, 0];
-    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        check(path, &file[..len], &written, standard && delta == 0)
-    }));
-    // Restore before reporting, so that the next run starts from the valid file.
+    // A failed check aborts the process: no restoring needed then.
+    check(path, &file[..len], &written, standard && delta == 0);
     file.truncate(valid_len);
     for (at, old) in saved.into_iter().rev() {
         file[at..at + 8].copy_from_slice(&old);
@@ -89,8 +94,4 @@ fuzz_target!(|data: &[u8]| {
     for (i, x) in header.iter().enumerate() {
         file[i] ^= x;
     }
-    drop(file);
-    if let Err(panic) = result {
-        std::panic::resume_unwind(panic);
-    }
-});
+}));

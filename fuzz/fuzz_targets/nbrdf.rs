@@ -3,11 +3,11 @@
 #![no_main]
 
 use facet_fit::nbrdf::NbrdfLibrary;
-use facet_fuzz::{assert_brdf_sane, assert_names};
+use facet_fuzz::{assert_brdf_sane, assert_names, run};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
-fuzz_target!(|data: &[u8]| {
+fuzz_target!(|data: &[u8]| run(|| {
     let path = Path::new("fuzzed-nbrdf.json");
     let library = match NbrdfLibrary::parse(path, &String::from_utf8_lossy(data)) {
         Ok(l) => l,
@@ -19,4 +19,4 @@ fuzz_target!(|data: &[u8]| {
             Err(e) => assert_names(path, e),
         }
     }
-});
+}));
