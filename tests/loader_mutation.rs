@@ -918,7 +918,7 @@ impl Target for Merl {
         }
         // Every stored value as read: NaN, ∞ and values above MAX_STORED refused.
         for &(index, v) in &self.written {
-            if !(v <= MAX_STORED) {
+            if v.is_nan() || v > MAX_STORED {
                 return Err(format!("accepted a table whose value {index} is {v:e}"));
             }
             let (c, s) = (index / SAMPLES, index % SAMPLES);
