@@ -132,13 +132,13 @@ fn save_dir() -> PathBuf {
 }
 
 /// What makes two failures the same: the panic's location, else the problem up to its first
-/// `=`, `(` or `[`, without digits.
+/// `=`, `(`, `[` or a backquote (names), without digits.
 fn signature(problem: &str) -> String {
     if let Some(at) = problem.find("panicked at ") {
         let rest = &problem[at..];
         return rest[..rest.find(": ").unwrap_or(rest.len())].to_string();
     }
-    let head = &problem[..problem.find(['=', '(', '[']).unwrap_or(problem.len())];
+    let head = &problem[..problem.find(['=', '(', '[', '`']).unwrap_or(problem.len())];
     head.chars()
         .filter(|c| !c.is_ascii_digit())
         .take(120)
