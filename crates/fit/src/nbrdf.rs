@@ -72,7 +72,38 @@ pub struct NeuralBrdf {
     layers: [Layer; 3],
 }
 
+/// The largest pre-activation y of the last layer a network may reach, so that exp(y) − 1 is a
+/// finite f64 (exp(709) ≈ 8·10³⁰⁷); the 100 MERL networks stay below 40.
+pub const MAX_OUTPUT: f64 = 700.0;
+
 impl NeuralBrdf {
+    /// An upper bound of the last layer's output over every input the network is evaluated at,
+    /// by interval arithmetic: h = (sin θh, 0, cos θh) and d = (sin θd cos φd, sin θd sin φd,
+    /// cos θd) with θ ∈ [0, π/2], φd ∈ [0, π), so x ∈ [0,1]×{0}×[0,1]×[−1,1]×[0,1]×[0,1].
+    fn output_bound(&self) -> f64 {
+        let mut lo = vec![0.0, 0.0, 0.0, -1.0, 0.0, 0.0];
+        let mut hi = vec![1.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        for (n, layer) in self.layers.iter().enumerate() {
+            // y_j ∈ [b_j + Σ min(w lo, w hi), b_j + Σ max(w lo, w hi)]; ReLU between layers.
+            let (mut l, mut h) = (layer.b.clone(), layer.b.clone());
+            for i in 0..layer.inputs {
+                let row = &layer.w[i * layer.outputs..(i + 1) * layer.outputs];
+                for (j, &w) in row.iter().enumerate() {
+                    let (a, b) = (w * lo[i], w * hi[i]);
+                    l[j] += a.min(b);
+                    h[j] += a.max(b);
+                }
+            }
+            if n < 2 {
+                l.iter_mut()
+                    .chain(h.iter_mut())
+                    .for_each(|v| *v = v.max(0.0));
+            }
+            (lo, hi) = (l, h);
+        }
+        hi.into_iter().fold(f64::NEG_INFINITY, f64::max)
+    }
+
     /// f_r from the network inputs x = (h, d).
     fn forward(&self, x: [f64; 6]) -> Rgb {
         let mut a = [0.0; 64];
@@ -202,9 +233,60 @@ impl NbrdfLibrary {
                 "material `{name}`: layer sizes must be 6-H-H-3 with H ≤ 64"
             )));
         }
-        Ok(NeuralBrdf {
+        let net = NeuralBrdf {
             name: name.to_owned(),
             layers: [l1, l2, l3],
-        })
+        };
+        let bound = net.output_bound();
+        if !(bound <= MAX_OUTPUT) {
+            return Err(bad(format!(
+                "material `{name}`: the network's output can reach {bound:e} before exp (at most {MAX_OUTPUT}), so f_r = exp(y) − 1 could overflow"
+            )));
+        }
+        Ok(net)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_output_bound_holds_and_admits_every_merl_network() {
+        let lib = NbrdfLibrary::embedded();
+        let mut worst = 0.0f64;
+        for name in lib.names() {
+            let net = lib.get(name).unwrap();
+            let bound = net.output_bound();
+            worst = worst.max(bound);
+            // The bound is an upper bound: no input of the domain exceeds it.
+            for k in 0..=20 {
+                let (t, p) = (k as f64 / 20.0 * PI / 2.0, k as f64 / 21.0 * PI);
+                let x = [t.sin(), 0.0, t.cos(), p.cos() * 0.7, p.sin() * 0.7, 0.714];
+                let mut a = [0.0; 64];
+                let mut b = [0.0; 64];
+                net.layers[0].apply(&x, &mut a);
+                a.iter_mut().for_each(|v| *v = v.max(0.0));
+                net.layers[1].apply(&a, &mut b);
+                b.iter_mut().for_each(|v| *v = v.max(0.0));
+                net.layers[2].apply(&b, &mut a);
+                assert!(
+                    a[..3].iter().all(|&y| y <= bound),
+                    "{name}: {a:?} > {bound}"
+                );
+            }
+        }
+        assert!(
+            worst < 50.0,
+            "the MERL networks are bounded by 40; got {worst}"
+        );
+        // A bias of 710 passes every finiteness check but would make exp overflow.
+        let text = r#"{"m":{"W1":[[0],[0],[0],[0],[0],[0]],"b1":[0],"W2":[[0]],"b2":[0],"W3":[[0,0,0]],"b3":[710,0,0]}}"#;
+        let err = NbrdfLibrary::parse(Path::new("big.json"), text)
+            .unwrap()
+            .get("m")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("big.json") && err.contains("7.1e2"), "{err}");
     }
 }

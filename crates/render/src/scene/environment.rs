@@ -59,6 +59,11 @@ pub fn uv_to_direction(uv: Vec2) -> Vec3 {
     Vec3::new(st * cp, ct, st * sp)
 }
 
+/// The largest radiance a texel may hold: no sky comes near (the sun's disc is ~2·10⁷
+/// W m⁻² sr⁻¹), and 2²⁶ texels of it still sum inside f32 (~7·10²⁷ against 3·10³⁸), so the
+/// sampling tables stay finite.
+pub const MAX_ENV_RADIANCE: f32 = 1e20;
+
 /// The widest or tallest environment map read: 16384 pixels.
 pub const MAX_ENV_SIDE: u64 = 16384;
 /// The most pixels an environment map may have: 2²⁶ (a 11585² square, 16384 × 4096); its
@@ -211,14 +216,13 @@ impl EnvironmentMap {
                 format!("{} texels for a {w}×{h} map", texels.len()),
             ));
         }
-        if let Some(i) = texels
-            .iter()
-            .position(|t| !(t.is_finite() && t.min_element() >= 0.0))
-        {
+        if let Some(i) = texels.iter().position(|t| {
+            !(t.is_finite() && t.min_element() >= 0.0 && t.max_element() <= MAX_ENV_RADIANCE)
+        }) {
             return Err(RenderError::input(
                 path,
                 format!(
-                    "texel ({}, {}) is {} (negative or not finite)",
+                    "texel ({}, {}) is {} (negative, not finite, or above {MAX_ENV_RADIANCE:e})",
                     i % w,
                     i / w,
                     texels[i]

@@ -269,9 +269,10 @@ impl<'a> MaterialLoader<'a> {
         let fit = match self.fits.get(&source) {
             Some(f) => f.clone(),
             None => {
-                // The fit's error names its file.
-                let f = FittedMaterial::load(&source)
-                    .map_err(|e| RenderError::Scene(format!("material `{name}`: {e}")))?;
+                // The glTF, then the fit's own error, which names the fit file.
+                let f = FittedMaterial::load(&source).map_err(|e| {
+                    RenderError::input(self.gltf_path, format!("material `{name}`: {e}"))
+                })?;
                 let f = Arc::new(f);
                 self.fits.insert(source.clone(), f.clone());
                 f
