@@ -1,12 +1,23 @@
-//! The `facet` binary as a user runs it.
+//! The `facet` binary as a user runs it. It runs in a folder under the target tmp dir, never
+//! in the repository, so that an output it writes by default (`out/`) or one a broken guard
+//! lets through cannot land in the checkout.
 
 mod common;
 
+use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// Where `facet` runs: shared by the tests of this file, never emptied while they run.
+fn cwd() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("cli-cwd");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
 
 fn facet(args: &[&str]) -> (bool, String, String) {
     let out = Command::new(env!("CARGO_BIN_EXE_facet"))
         .args(args)
+        .current_dir(cwd())
         .output()
         .unwrap();
     (
@@ -175,14 +186,28 @@ fn dpf_query_and_exr_slices() {
     assert!(!ok && stderr.contains("--theta-o"), "{stderr}");
 }
 
-/// `facet render` on bad inputs: each error names the file and nothing is written.
+/// A copy of the committed demo scene (glTF, fit, sky) in `dir`, so that a render whose guard
+/// fails can only harm the copy.
+fn demo_copy(dir: &Path) -> PathBuf {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo");
+    for f in ["demo.gltf", "default_fit.json", "sky.exr"] {
+        std::fs::copy(src.join(f), dir.join(f)).unwrap();
+    }
+    dir.join("demo.gltf")
+}
+
+/// `facet render` on bad inputs: each error names the file and nothing is written. Runs on a
+/// copy of the demo scene: the output that would replace the environment map is aimed at the
+/// copy's sky, never at `assets/demo/`.
 #[test]
 fn render_bad_inputs_name_the_file() {
-    let dir = std::env::temp_dir().join(format!("facet-cli-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::scratch("cli_render_bad");
     let out = dir.join("img.png");
     let out_s = out.to_str().unwrap();
-    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let demo = demo_copy(&dir);
+    let demo = demo.to_str().unwrap();
+    let sky = dir.join("sky.exr");
+    let sky_before = std::fs::read(&sky).unwrap();
     let not_gltf = dir.join("broken.gltf");
     std::fs::write(&not_gltf, "{ this is not json").unwrap();
     let bad_fit = dir.join("bad_fit.json");
@@ -229,9 +254,9 @@ fn render_bad_inputs_name_the_file() {
                 "render".into(),
                 demo.into(),
                 "--env".into(),
-                demo.replace("demo.gltf", "sky.exr"),
+                sky.display().to_string(),
                 "--out".into(),
-                demo.replace("demo.gltf", "sky.png"),
+                dir.join("sky.png").display().to_string(),
             ],
             "would replace the input".into(),
         ),
@@ -241,6 +266,8 @@ fn render_bad_inputs_name_the_file() {
         if !a.contains(&"--out") {
             a.extend(["--out", out_s]);
         }
+        // Small, so that a check that fails to refuse costs a second, not a full render.
+        a.extend(["--width", "16", "--height", "9", "--spp", "1"]);
         let (ok, _, err) = facet(&a);
         assert!(!ok, "{a:?} succeeded");
         assert!(err.contains(&needle), "{a:?}: {err}");
@@ -248,6 +275,12 @@ fn render_bad_inputs_name_the_file() {
         println!("{a:?} -> {}", err.trim());
     }
     assert!(!out.exists() && !out.with_extension("exr").exists());
+    assert_eq!(
+        std::fs::read(&sky).unwrap(),
+        sky_before,
+        "the environment map was replaced"
+    );
+    assert!(!dir.join("sky.png").exists(), "a sky.png was written");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -1,5 +1,6 @@
 //! The fitter on the GPU against the f64 CPU reference (lavapipe here and in CI). Without an
-//! adapter these tests skip with a message, unless FACET_REQUIRE_GPU=1.
+//! adapter these tests skip with a visible `SKIPPED` line (`facet_gpu::gpu_for_tests`), unless
+//! FACET_REQUIRE_GPU=1.
 
 mod common;
 
@@ -123,15 +124,16 @@ fn gpu_extraction_matches_cpu_at_large_n() {
 
 #[test]
 fn without_an_adapter_gpu_tests_skip_or_fail_as_asked() {
-    // Re-runs one GPU test of this binary with the GPU switched off (FACET_BACKEND=cpu).
+    // Re-runs one GPU test of this binary with the GPU switched off (FACET_BACKEND=cpu), its
+    // skips logged to a file of its own (not to the FACET_SKIP_LOG of this run, if any).
+    let log = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("skip-log-{}.txt", std::process::id()));
     let run = |require: bool| {
+        let _ = std::fs::remove_file(&log);
         let mut cmd = std::process::Command::new(std::env::current_exe().unwrap());
-        cmd.args([
-            "gpu_extraction_matches_cpu_at_large_n",
-            "--exact",
-            "--nocapture",
-        ])
-        .env("FACET_BACKEND", "cpu");
+        cmd.args(["gpu_extraction_matches_cpu_at_large_n", "--exact"])
+            .env("FACET_BACKEND", "cpu")
+            .env(facet_gpu::skip::SKIP_LOG_VAR, &log);
         if require {
             cmd.env("FACET_REQUIRE_GPU", "1");
         } else {
@@ -140,17 +142,31 @@ fn without_an_adapter_gpu_tests_skip_or_fail_as_asked() {
         let out = cmd.output().unwrap();
         (
             out.status.success(),
-            String::from_utf8_lossy(&out.stdout).to_string()
-                + &String::from_utf8_lossy(&out.stderr),
+            String::from_utf8_lossy(&out.stdout).to_string(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+            std::fs::read_to_string(&log).unwrap_or_default(),
         )
     };
-    let (ok, text) = run(false);
+    // Without --nocapture: the SKIPPED line still reaches the terminal (stderr) past libtest's
+    // capture, and the log holds exactly that line.
+    let (ok, stdout, stderr, logged) = run(false);
+    let line = "SKIPPED gpu_extraction_matches_cpu_at_large_n: ";
+    assert!(ok, "{stdout}\n{stderr}");
     assert!(
-        ok && text.contains("SKIPPED gpu_extraction_matches_cpu_at_large_n"),
-        "{text}"
+        stderr.contains(line),
+        "the skip is not on the terminal:\n{stdout}\n{stderr}"
     );
-    let (ok, text) = run(true);
+    assert!(
+        logged.starts_with(line)
+            && logged.contains("FACET_BACKEND=cpu")
+            && logged.lines().count() == 1,
+        "the skip log holds {logged:?}"
+    );
+    let (ok, stdout, stderr, logged) = run(true);
+    let text = stdout + &stderr;
     assert!(!ok && text.contains("FACET_REQUIRE_GPU=1"), "{text}");
+    assert!(logged.is_empty(), "a failure is no skip: {logged:?}");
+    let _ = std::fs::remove_file(&log);
 }
 
 #[test]

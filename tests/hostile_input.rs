@@ -40,12 +40,13 @@ fn facet_in(cwd: &Path, args: &[&str], limit: Duration) -> (bool, String, String
     (out.status.success(), s(&out.stdout), s(&out.stderr))
 }
 
+/// [`facet_in`] a folder under the target tmp dir (shared, never emptied while tests run), not
+/// the repository: an output written by default (`out/`) when an argument check fails to
+/// refuse lands there, not in the checkout.
 fn facet(args: &[&str]) -> (bool, String, String) {
-    facet_in(
-        Path::new(env!("CARGO_MANIFEST_DIR")),
-        args,
-        Duration::from_secs(120),
-    )
+    let cwd = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("hostile-cwd");
+    std::fs::create_dir_all(&cwd).unwrap();
+    facet_in(&cwd, args, Duration::from_secs(120))
 }
 
 /// Every file under `dir`, recursively.

@@ -1,9 +1,8 @@
-//! Every WGSL file parses and validates with naga; every struct shared with Rust has the same
-//! size and offsets on both sides. No GPU needed.
+//! Every WGSL file parses and validates with naga; every struct shared with Rust has, field by
+//! field, the same names, offsets and sizes on both sides, and the same total size. No GPU
+//! needed.
 
-use facet_fit::gpu::{GpuNode, GpuSample, GpuState};
 use facet_gpu::shader;
-use std::mem::{offset_of, size_of};
 
 #[test]
 fn every_wgsl_file_validates() {
@@ -45,273 +44,267 @@ fn include_errors_name_the_file() {
     assert!(bad.contains("broken.wgsl") && bad.contains("x"), "{bad}");
 }
 
-fn layout(file: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+/// One run of Rust fields and the run of WGSL members that holds the same bytes: usually one
+/// field and the member of the same name; `cell: [u32; 2]` against `cell_x, cell_y`, say.
+struct Group {
+    /// (name, offset, size) of each Rust field, in order.
+    rust: Vec<(&'static str, usize, usize)>,
+    /// WGSL member names, in order.
+    wgsl: Vec<&'static str>,
+}
+
+/// What differs between Rust struct `rust` (`rust_size` bytes, fields in `groups`) and WGSL
+/// struct `wgsl` of `file` as naga lays it out; empty when they agree.
+fn layout_problems(
+    file: &str,
+    wgsl: &str,
+    rust: &str,
+    rust_size: usize,
+    groups: &[Group],
+) -> Vec<String> {
     let module = shader::validate(file, &shader::expand(file).unwrap()).unwrap();
-    shader::struct_layout(&module, name).unwrap_or_else(|| panic!("{file} has no struct {name}"))
+    let Some(layout) = shader::struct_layout(&module, wgsl) else {
+        return vec![format!("{file} has no struct {wgsl} (Rust {rust})")];
+    };
+    let mut problems = Vec::new();
+    let mut fail = |p: String| problems.push(format!("{rust} / {file} {wgsl}: {p}"));
+    if rust_size != layout.size as usize {
+        fail(format!("size {rust_size} in Rust, {} in WGSL", layout.size));
+    }
+    // Every WGSL member is listed, once, in its order.
+    let listed: Vec<&str> = groups.iter().flat_map(|g| g.wgsl.iter().copied()).collect();
+    let members: Vec<&str> = layout.members.iter().map(|m| m.name.as_str()).collect();
+    if listed != members {
+        fail(format!(
+            "the WGSL members are {members:?}, the check lists {listed:?}"
+        ));
+        return problems;
+    }
+    let mut next = 0;
+    for g in groups {
+        let wgsl_members = &layout.members[next..next + g.wgsl.len()];
+        next += g.wgsl.len();
+        // Each side's run is contiguous: no bytes in between that the other side could hold.
+        for w in g.rust.windows(2) {
+            if w[0].1 + w[0].2 != w[1].1 {
+                fail(format!(
+                    "Rust fields {} and {} are not adjacent",
+                    w[0].0, w[1].0
+                ));
+            }
+        }
+        for w in wgsl_members.windows(2) {
+            if w[0].offset + w[0].size != w[1].offset {
+                fail(format!(
+                    "WGSL members {} and {} are not adjacent",
+                    w[0].name, w[1].name
+                ));
+            }
+        }
+        let (first, last) = (g.rust[0], g.rust[g.rust.len() - 1]);
+        let rust_range = first.1..last.1 + last.2;
+        let (wf, wl) = (&wgsl_members[0], &wgsl_members[wgsl_members.len() - 1]);
+        let wgsl_range = wf.offset as usize..(wl.offset + wl.size) as usize;
+        if rust_range != wgsl_range {
+            let names = |v: Vec<&str>| v.join(", ");
+            fail(format!(
+                "Rust {} at bytes {rust_range:?}, WGSL {} at bytes {wgsl_range:?}",
+                names(g.rust.iter().map(|f| f.0).collect()),
+                names(g.wgsl.clone()),
+            ));
+        }
+    }
+    problems
 }
 
-#[test]
-fn shared_structs_match_naga_layouts() {
-    let (size, members) = layout("fit/kernel.wgsl", "Node");
-    assert_eq!(size as usize, size_of::<GpuNode>());
-    let rust = [
-        ("x", offset_of!(GpuNode, x)),
-        ("y", offset_of!(GpuNode, y)),
-        ("z", offset_of!(GpuNode, z)),
-        ("row_scale", offset_of!(GpuNode, row_scale)),
-        ("col_weight", offset_of!(GpuNode, col_weight)),
-        ("norm_weight", offset_of!(GpuNode, norm_weight)),
-    ];
-    for (name, off) in rust {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Node.{name}: {members:?}"
-        );
-    }
-    let (size, members) = layout("fit/normalise.wgsl", "State");
-    assert_eq!(size as usize, size_of::<GpuState>());
-    assert!(members.contains(&("iteration".into(), offset_of!(GpuState, iteration) as u32)));
-    assert!(members.contains(&("lambda".into(), offset_of!(GpuState, lambda) as u32)));
-    let (size, members) = layout("fit/fresnel.wgsl", "Sample");
-    assert_eq!(size as usize, size_of::<GpuSample>());
-    let rust = [
-        ("x", offset_of!(GpuSample, x)),
-        ("i", offset_of!(GpuSample, i)),
-        ("gi", offset_of!(GpuSample, gi)),
-        ("go", offset_of!(GpuSample, go)),
-        ("inv_cos_i", offset_of!(GpuSample, inv_cos_i)),
-        ("inv_cos_o", offset_of!(GpuSample, inv_cos_o)),
-        ("corr", offset_of!(GpuSample, corr)),
-    ];
-    for (name, off) in rust {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Sample.{name}: {members:?}"
-        );
-    }
-}
-
-#[test]
-fn dpf_params_match_naga() {
-    use facet_glint::gpu::DpfParams;
-    let (size, members) = layout("glint/dpf_build.wgsl", "Params");
-    assert_eq!(size as usize, size_of::<DpfParams>());
-    for (name, off) in [
-        ("n_theta", offset_of!(DpfParams, n_theta)),
-        ("gamma", offset_of!(DpfParams, gamma)),
-        ("ndf_kind", offset_of!(DpfParams, ndf_kind)),
-        ("rotation", offset_of!(DpfParams, rotation)),
-        ("table_nphi", offset_of!(DpfParams, table_nphi)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Params.{name}: {members:?}"
-        );
-    }
-}
-
-#[test]
-fn glint_structs_match_naga() {
-    use facet_glint::gpu::{GlintField, GlintQuery};
-    let (size, members) = layout("glint/glint_count.wgsl", "Field");
-    assert_eq!(size as usize, size_of::<GlintField>());
-    for (name, off) in [
-        ("density", offset_of!(GlintField, density)),
-        ("root_count", offset_of!(GlintField, root_count)),
-        ("threshold", offset_of!(GlintField, threshold)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Field.{name}: {members:?}"
-        );
-    }
-    let (size, members) = layout("glint/glint_count.wgsl", "Query");
-    assert_eq!(size as usize, size_of::<GlintQuery>());
-    for (name, off) in [
-        ("center", offset_of!(GlintQuery, center)),
-        ("a", offset_of!(GlintQuery, a)),
-        ("b", offset_of!(GlintQuery, b)),
-        ("p", offset_of!(GlintQuery, p)),
-        ("cell_x", offset_of!(GlintQuery, cell)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Query.{name}: {members:?}"
-        );
-    }
-}
-
-#[test]
-fn glint_eval_structs_match_naga() {
-    use facet_glint::gpu::{GlintEvalParams, GlintEvalQuery};
-    let (size, members) = layout("glint/glint_eval.wgsl", "EvalParams");
-    assert_eq!(size as usize, size_of::<GlintEvalParams>());
-    for (name, off) in [
-        ("sigma1", offset_of!(GlintEvalParams, sigma1)),
-        ("level_t", offset_of!(GlintEvalParams, level_t)),
-        ("ndf_kind", offset_of!(GlintEvalParams, ndf_kind)),
-        ("rotation", offset_of!(GlintEvalParams, rotation)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "EvalParams.{name}: {members:?}"
-        );
-    }
-    let (size, members) = layout("glint/glint_eval.wgsl", "EvalQuery");
-    assert_eq!(size as usize, size_of::<GlintEvalQuery>());
-    for (name, off) in [
-        ("wo", offset_of!(GlintEvalQuery, wo)),
-        ("center", offset_of!(GlintEvalQuery, center)),
-        ("b", offset_of!(GlintEvalQuery, b)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "EvalQuery.{name}: {members:?}"
-        );
-    }
-}
-
-/// Every member of a WGSL struct at the offset of the Rust field of the same name.
-macro_rules! check_struct {
-    ($file:expr, $wgsl:expr, $rust:ty, [$($field:ident),* $(,)?]) => {{
-        let (size, members) = layout($file, $wgsl);
-        assert_eq!(size as usize, size_of::<$rust>(), "{} size", $wgsl);
-        $(
-            assert!(
-                members.contains(&(stringify!($field).to_string(), offset_of!($rust, $field) as u32)),
-                "{}.{}: {members:?}", $wgsl, stringify!($field)
-            );
-        )*
-        assert_eq!(members.len(), [$(stringify!($field)),*].len(), "{} members: {members:?}", $wgsl);
+/// The checks of one Rust struct against its WGSL twin, each Rust field named once:
+///
+/// `layout_check!(Type, "file.wgsl", "WgslName", { a, b, c => [c_x, c_y], [d, e] => [de] })`
+///
+/// `a` is the Rust field `a` against the WGSL member `a`; `c => [..]` one Rust field against
+/// several adjacent members; `[d, e] => [..]` several adjacent fields against members. A
+/// pattern that destructures the struct with exactly the listed fields makes a Rust field that
+/// is not listed a compile error; the WGSL members must be exactly the listed ones, in order.
+/// Evaluates to (the Rust struct's name, the list of differences).
+macro_rules! layout_check {
+    (@munch $rust:path, $file:expr, $wgsl:expr, [$($done:tt)*]
+        [$($f:ident),+ $(,)?] => [$($m:ident),+ $(,)?] $(, $($rest:tt)*)?) => {
+        layout_check!(@munch $rust, $file, $wgsl, [$($done)* ([$($f),+] [$($m),+])] $($($rest)*)?)
+    };
+    (@munch $rust:path, $file:expr, $wgsl:expr, [$($done:tt)*]
+        $f:ident => [$($m:ident),+ $(,)?] $(, $($rest:tt)*)?) => {
+        layout_check!(@munch $rust, $file, $wgsl, [$($done)* ([$f] [$($m),+])] $($($rest)*)?)
+    };
+    (@munch $rust:path, $file:expr, $wgsl:expr, [$($done:tt)*] $f:ident $(, $($rest:tt)*)?) => {
+        layout_check!(@munch $rust, $file, $wgsl, [$($done)* ([$f] [$f])] $($($rest)*)?)
+    };
+    (@munch $rust:path, $file:expr, $wgsl:expr, [$(([$($f:ident),+] [$($m:ident),+]))*]) => {{
+        #[allow(dead_code)]
+        fn every_field_is_listed(v: &$rust) {
+            // A compile error here ("pattern does not mention field", or "requires `..` due
+            // to inaccessible fields") is a Rust field missing from the list.
+            let $rust { $($($f: _),+),* } = v;
+        }
+        let zero: $rust = bytemuck::Zeroable::zeroed();
+        let groups = vec![$(Group {
+            rust: vec![$((
+                stringify!($f),
+                std::mem::offset_of!($rust, $f),
+                std::mem::size_of_val(&zero.$f),
+            )),+],
+            wgsl: vec![$(stringify!($m)),+],
+        }),*];
+        (
+            stringify!($rust),
+            layout_problems($file, $wgsl, stringify!($rust), std::mem::size_of::<$rust>(), &groups),
+        )
     }};
+    ($rust:path, $file:expr, $wgsl:expr, { $($body:tt)* }) => {
+        layout_check!(@munch $rust, $file, $wgsl, [] $($body)*)
+    };
 }
 
-#[test]
-fn render_structs_match_naga() {
+/// Every Rust struct uploaded to or read back from a WGSL buffer, with its WGSL twin. The
+/// struct is named by its last path segment (`every_repr_c_struct_is_checked` finds the
+/// `#[repr(C)]` structs by that name).
+fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
+    use facet_fit::gpu::{GpuNode, GpuSample, GpuState};
+    use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
     use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial};
-    check_struct!(
-        "render/extend.wgsl",
-        "Frame",
-        GpuFrame,
-        [
-            width,
-            height,
-            tile_base,
-            tile_pixels,
-            wavefront,
-            sample_end,
-            max_depth,
-            seed,
-            rr_depth,
-            n_vertices,
-            n_lights,
-            light_cdf,
-            env_kind,
-            env_width,
-            env_height,
-            env_texels,
-            env_marginal,
-            env_conditional,
-            scene_radius,
-            ray_epsilon,
-            env_color,
-            cam_pos,
-            cam_forward,
-            cam_up,
-            cam_right
-        ]
-    );
-    check_struct!(
-        "render/extend.wgsl",
-        "Material",
-        GpuMaterial,
-        [
-            base_color,
-            emissive,
-            diffuse,
-            kind,
-            ndf_kind,
-            alpha_x,
-            alpha_y,
-            rotation,
-            metallic,
-            roughness,
-            normal_scale,
-            tex_base,
-            tex_mr,
-            tex_normal,
-            tex_emissive,
-            fresnel_offset,
-            fresnel_count,
-            tab_offset,
-            queue
-        ]
-    );
-    check_struct!(
-        "render/extend.wgsl",
-        "Light",
-        GpuLight,
-        [
-            kind, prim, cos_inner, cos_outer, position, direction, intensity
-        ]
-    );
-}
-
-#[test]
-fn trace_structs_match_naga() {
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
     use facet_render::trace::{GpuHit, GpuRay};
-    let file = "render/trace.wgsl";
-    let (size, members) = layout(file, "Ray");
-    assert_eq!(size as usize, size_of::<GpuRay>());
-    for (name, off) in [
-        ("origin", offset_of!(GpuRay, origin)),
-        ("tmin", offset_of!(GpuRay, tmin)),
-        ("dir", offset_of!(GpuRay, dir)),
-        ("tmax", offset_of!(GpuRay, tmax)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Ray.{name}: {members:?}"
+    vec![
+        layout_check!(GpuNode, "fit/kernel.wgsl", "Node", {
+            x, y, z, row_scale, col_weight, norm_weight, pad0, pad1,
+        }),
+        layout_check!(GpuState, "fit/normalise.wgsl", "State", {
+            iteration, lambda, pad0, pad1,
+        }),
+        layout_check!(GpuSample, "fit/fresnel.wgsl", "Sample", {
+            x, i, gi, go, inv_cos_i, inv_cos_o, corr, pad => [pad0, pad1, pad2],
+        }),
+        layout_check!(DpfParams, "glint/dpf_build.wgsl", "Params", {
+            n_theta, n_dphi, n_psi, n_chi, gamma, ndf_kind, alpha_x, alpha_y, rotation,
+            table_nu, table_nphi, pad0,
+        }),
+        layout_check!(GlintField, "glint/glint_count.wgsl", "Field", {
+            density, seed, root_count, filtered, threshold, pad => [pad0, pad1, pad2],
+        }),
+        layout_check!(GlintQuery, "glint/glint_count.wgsl", "Query", {
+            center, a, b, p, cell => [cell_x, cell_y], pad => [pad0, pad1, pad2],
+        }),
+        layout_check!(GlintEvalParams, "glint/glint_eval.wgsl", "EvalParams", {
+            gamma, sigma, sigma0, sigma1, level_t, n_theta, n_dphi, ndf_kind, alpha_x,
+            alpha_y, rotation, pad0,
+        }),
+        layout_check!(GlintEvalQuery, "glint/glint_eval.wgsl", "EvalQuery", {
+            wi, wo, center, a, b, pad,
+        }),
+        layout_check!(GpuFrame, "render/extend.wgsl", "Frame", {
+            width, height, tile_base, tile_pixels, wavefront, sample_end, max_depth, seed,
+            rr_depth, n_vertices, n_lights, light_cdf, env_kind, env_width, env_height,
+            env_texels, env_marginal, env_conditional, scene_radius, ray_epsilon, env_color,
+            cam_pos, cam_forward, cam_up, cam_right,
+        }),
+        layout_check!(GpuMaterial, "render/extend.wgsl", "Material", {
+            base_color, emissive, diffuse, kind, ndf_kind, alpha_x, alpha_y, rotation,
+            metallic, roughness, normal_scale, tex_base, tex_mr, tex_normal, tex_emissive,
+            fresnel_offset, fresnel_count, tab_offset, queue,
+        }),
+        layout_check!(GpuLight, "render/extend.wgsl", "Light", {
+            kind, prim, cos_inner, cos_outer, position, direction, intensity,
+        }),
+        layout_check!(GpuRay, "render/trace.wgsl", "Ray", { origin, tmin, dir, tmax }),
+        layout_check!(GpuHit, "render/trace.wgsl", "Hit", { t, prim, u, v }),
+        // obvhs's node is uploaded as it is: WGSL CwNode packs its u8 fields into u32 words;
+        // e[0..3] and imask are the bytes of e_imask.
+        layout_check!(CwBvhNode, "render/trace.wgsl", "CwNode", {
+                p, [e, imask] => [e_imask], child_base_idx, primitive_base_idx, child_meta,
+            child_min_x, child_max_x, child_min_y, child_max_y, child_min_z, child_max_z,
+        }),
+    ]
+}
+
+#[test]
+fn shared_structs_match_naga_field_by_field() {
+    let checks = shared_struct_checks();
+    let problems: Vec<&String> = checks.iter().flat_map(|(_, p)| p).collect();
+    for (name, p) in &checks {
+        println!(
+            "{name}: {}",
+            if p.is_empty() { "matches" } else { "DIFFERS" }
         );
     }
-    let (size, members) = layout(file, "Hit");
-    assert_eq!(size as usize, size_of::<GpuHit>());
-    for (name, off) in [
-        ("t", offset_of!(GpuHit, t)),
-        ("prim", offset_of!(GpuHit, prim)),
-        ("u", offset_of!(GpuHit, u)),
-        ("v", offset_of!(GpuHit, v)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "Hit.{name}: {members:?}"
-        );
-    }
-    // obvhs's node is uploaded as it is: WGSL CwNode packs its u8 fields into u32 words.
-    let (size, members) = layout(file, "CwNode");
-    assert_eq!(size as usize, size_of::<CwBvhNode>());
-    for (name, off) in [
-        ("p", offset_of!(CwBvhNode, p)),
-        ("e_imask", offset_of!(CwBvhNode, e)),
-        ("child_base_idx", offset_of!(CwBvhNode, child_base_idx)),
-        (
-            "primitive_base_idx",
-            offset_of!(CwBvhNode, primitive_base_idx),
-        ),
-        ("child_meta", offset_of!(CwBvhNode, child_meta)),
-        ("child_min_x", offset_of!(CwBvhNode, child_min_x)),
-        ("child_max_x", offset_of!(CwBvhNode, child_max_x)),
-        ("child_min_y", offset_of!(CwBvhNode, child_min_y)),
-        ("child_max_y", offset_of!(CwBvhNode, child_max_y)),
-        ("child_min_z", offset_of!(CwBvhNode, child_min_z)),
-        ("child_max_z", offset_of!(CwBvhNode, child_max_z)),
-    ] {
-        assert!(
-            members.contains(&(name.to_string(), off as u32)),
-            "CwNode.{name}: {members:?}"
-        );
-    }
+    assert!(
+        problems.is_empty(),
+        "Rust and WGSL layouts differ:\n{}",
+        problems
+            .iter()
+            .map(|p| p.as_str())
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
     // imask is the byte after e[0..3], the top byte of the e_imask word.
-    assert_eq!(offset_of!(CwBvhNode, imask), offset_of!(CwBvhNode, e) + 3);
+    use facet_render::obvhs::cwbvh::node::CwBvhNode;
+    assert_eq!(
+        std::mem::offset_of!(CwBvhNode, imask),
+        std::mem::offset_of!(CwBvhNode, e) + 3
+    );
+}
+
+/// Every `#[repr(C)]` struct in the crates' sources is in [`shared_struct_checks`] (they are
+/// all shared with WGSL; one that is not would be named here with the reason).
+#[test]
+fn every_repr_c_struct_is_checked() {
+    fn rust_files(dir: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                rust_files(&p, out);
+            } else if p.extension().is_some_and(|e| e == "rs") {
+                out.push(p);
+            }
+        }
+    }
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = Vec::new();
+    rust_files(&root.join("src"), &mut files);
+    for krate in std::fs::read_dir(root.join("crates")).unwrap() {
+        rust_files(&krate.unwrap().path().join("src"), &mut files);
+    }
+    let checked: Vec<&str> = shared_struct_checks().iter().map(|(n, _)| *n).collect();
+    let mut found = Vec::new();
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        let lines: Vec<&str> = text.lines().map(str::trim).collect();
+        for (i, l) in lines.iter().enumerate() {
+            if !l.starts_with("#[repr(C") {
+                continue;
+            }
+            // The item after the attributes and doc comments that follow.
+            let item = lines[i + 1..]
+                .iter()
+                .find(|l| !l.starts_with("#[") && !l.starts_with("///"))
+                .unwrap();
+            if let Some(rest) = item
+                .strip_prefix("pub struct ")
+                .or(item.strip_prefix("struct "))
+            {
+                let name: String = rest
+                    .chars()
+                    .take_while(|c| c.is_alphanumeric() || *c == '_')
+                    .collect();
+                found.push((name, f.strip_prefix(root).unwrap().display().to_string()));
+            }
+        }
+    }
+    assert!(found.len() >= 13, "found only {found:?}");
+    let missing: Vec<_> = found
+        .iter()
+        .filter(|(n, _)| !checked.contains(&n.as_str()))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "#[repr(C)] structs without a field-by-field layout check in shared_struct_checks: {missing:?}"
+    );
 }

@@ -215,16 +215,29 @@ impl Gpu {
     }
 }
 
-/// For tests: the GPU if there is one; otherwise prints why the test skips, or panics when
-/// `FACET_REQUIRE_GPU=1` (CI).
+/// For tests: the GPU if there is one. Without one the test is skipped: `None`, after
+/// [`report_skip`](crate::skip::report_skip) wrote `SKIPPED <test>: <why>` where a person sees
+/// it (on the terminal past libtest's capture, and into the `FACET_SKIP_LOG` file when that is
+/// set; `.ci/run` prints that file at the end). With `FACET_REQUIRE_GPU=1` (CI) it panics
+/// instead. "No GPU" is any error choosing the adapter or creating the device, including
+/// `FACET_BACKEND=cpu`.
 pub fn gpu_for_tests(test: &str) -> Option<Gpu> {
-    match Gpu::new() {
+    gpu_for_tests_with(test, |options| options)
+}
+
+/// [`gpu_for_tests`] with the options from the environment adjusted by `adjust` (a capped
+/// storage binding size, say); skips and `FACET_REQUIRE_GPU=1` the same way.
+pub fn gpu_for_tests_with(
+    test: &str,
+    adjust: impl FnOnce(GpuOptions) -> GpuOptions,
+) -> Option<Gpu> {
+    match GpuOptions::from_env().and_then(|options| Gpu::with_options(&adjust(options))) {
         Ok(g) => Some(g),
         Err(e) => {
             if std::env::var("FACET_REQUIRE_GPU").is_ok_and(|v| v == "1") {
                 panic!("{test}: FACET_REQUIRE_GPU=1 but {e}");
             }
-            eprintln!("SKIPPED {test}: {e}");
+            crate::skip::report_skip(test, &e.to_string());
             None
         }
     }

@@ -2,7 +2,8 @@
 //!
 //! Adapter and device selection ([`Gpu`]), WGSL loading from `shaders/` with includes and naga
 //! validation ([`shader`]), buffer upload and read-back ([`buffer`]), GPU timestamps
-//! ([`timer::GpuTimer`]) and errors a caller can act on ([`GpuError`]). Nothing domain-specific.
+//! ([`timer::GpuTimer`]) and errors a caller can act on ([`GpuError`]), and for tests the GPU or a visible skip
+//! ([`gpu_for_tests`], [`skip`]). Nothing domain-specific.
 //!
 //! ```no_run
 //! let gpu = facet_gpu::Gpu::new()?; // honours FACET_BACKEND and FACET_ADAPTER
@@ -17,8 +18,10 @@ pub mod dispatch;
 pub mod error;
 pub mod runtime_dir;
 pub mod shader;
+pub mod skip;
 pub mod timer;
 
-pub use context::{Gpu, GpuOptions, gpu_for_tests};
+pub use context::{Gpu, GpuOptions, gpu_for_tests, gpu_for_tests_with};
 pub use error::GpuError;
 pub use runtime_dir::ensure_runtime_dir;
+pub use skip::report_skip;

@@ -131,25 +131,47 @@ pub fn compute_pipeline_with_layout(
     )
 }
 
-pub fn struct_layout(module: &naga::Module, name: &str) -> Option<(u32, Vec<(String, u32)>)> {
+/// A WGSL struct's layout as naga computes it (WGSL's alignment and size rules).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StructLayout {
+    /// The struct's size in bytes (its span, trailing padding included).
+    pub size: u32,
+    /// The members in declaration order.
+    pub members: Vec<MemberLayout>,
+}
+
+/// One member of a [`StructLayout`].
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MemberLayout {
+    pub name: String,
+    /// Byte offset in the struct.
+    pub offset: u32,
+    /// Size of the member's type in bytes (what the host must write there; padding after it,
+    /// from alignment or `@size`, is not included).
+    pub size: u32,
+}
+
+/// The layout of struct `name` of `module`, `None` if it has no such struct (or naga cannot
+/// lay its types out).
+pub fn struct_layout(module: &naga::Module, name: &str) -> Option<StructLayout> {
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).ok()?;
-    module
-        .types
-        .iter()
-        .find_map(|(handle, ty)| match &ty.inner {
-            naga::TypeInner::Struct { members, span } if ty.name.as_deref() == Some(name) => {
-                let _ = handle;
-                Some((
-                    *span,
-                    members
-                        .iter()
-                        .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
-                        .collect(),
-                ))
-            }
-            _ => None,
-        })
+    module.types.iter().find_map(|(_, ty)| match &ty.inner {
+        naga::TypeInner::Struct { members, span } if ty.name.as_deref() == Some(name) => {
+            Some(StructLayout {
+                size: *span,
+                members: members
+                    .iter()
+                    .map(|m| MemberLayout {
+                        name: m.name.clone().unwrap_or_default(),
+                        offset: m.offset,
+                        size: layouter[m.ty].size,
+                    })
+                    .collect(),
+            })
+        }
+        _ => None,
+    })
 }
 
 /// `@workgroup_size` x of entry point `entry` of shader file `name`, as naga reads it: drivers

@@ -146,11 +146,35 @@ impl Bvh {
         }
         let cwbvh =
             build_cwbvh_from_tris(&triangles, config.preset.params(), &mut Duration::default());
-        Bvh {
+        let bvh = Bvh {
             cwbvh,
             triangles,
             build_ms: start.elapsed().as_secs_f64() * 1e3,
+        };
+        // Debug builds check every tree they build (tests too: the test profile keeps debug
+        // assertions on at opt-level 2). obvhs 0.4's builder runs the same check under its own
+        // `cfg(debug_assertions)`; this one does not depend on obvhs keeping it, nor on how
+        // obvhs itself was compiled.
+        #[cfg(debug_assertions)]
+        bvh.validate();
+        bvh
+    }
+
+    /// Checks the tree with obvhs's `CwBvh::validate` against [`Bvh::triangles`]: every node
+    /// and primitive slot reached exactly once, one slot per triangle (without spatial
+    /// splits), each node's origin inside its parent's child box, the child metadata
+    /// consistent with `imask`, and the depth under obvhs's traversal stack of 32 entries
+    /// (`BVH_STACK_SIZE` of the WGSL traversal too). Without spatial splits, each triangle must
+    /// also lie inside the box of the node holding its leaf (not checked for leaves of the
+    /// root, nor at all with the pre-split presets). Panics on the first violation; returns
+    /// obvhs's statistics. Linear in the tree's size: about 2 ms for 2·10^4 triangles at the
+    /// test profile's opt-level, against about 26 ms for the build. Debug builds run it after
+    /// every [`Bvh::build`].
+    pub fn validate(&self) -> obvhs::cwbvh::CwBvhValidationResult {
+        if self.is_empty() {
+            return Default::default();
         }
+        self.cwbvh.validate(&self.triangles, false)
     }
 
     pub fn is_empty(&self) -> bool {

@@ -130,6 +130,41 @@ fn barycentrics_reproduce_the_hit_point() {
     assert!(checked > rays.len() / 2, "{checked}");
 }
 
+/// `Bvh::validate`, which debug builds (tests included) run after every build: it passes on a
+/// built tree, with every triangle found once, and panics on a tree whose triangle was moved
+/// out of its leaf's box after the build.
+#[test]
+fn validation_passes_built_trees_and_catches_a_moved_triangle() {
+    let (mesh, bvh) = scene_bvh(20_000, BvhConfig::medium());
+    let t = std::time::Instant::now();
+    let stats = bvh.validate();
+    let ms = t.elapsed().as_secs_f64() * 1e3;
+    println!(
+        "validate: {ms:.1} ms for {} nodes, {} triangles (build {:.1} ms)",
+        stats.node_count, stats.prim_count, bvh.build_ms
+    );
+    assert_eq!(stats.prim_count, mesh.triangle_count());
+    assert_eq!(stats.node_count, bvh.cwbvh.nodes.len());
+    assert!(stats.max_depth < 32, "depth {}", stats.max_depth);
+    // obvhs checks a leaf's triangles against the box of the node holding the leaf, and the
+    // root has none: move a triangle that is not in a leaf of the root.
+    let root = &bvh.cwbvh.nodes[0];
+    let in_root_leaf: Vec<u32> = (0..8)
+        .filter(|&ch| !root.is_child_empty(ch) && root.is_leaf(ch))
+        .flat_map(|ch| {
+            let (first, count) = root.child_primitives(ch);
+            (first..first + count).map(|slot| bvh.cwbvh.primitive_indices[slot as usize])
+        })
+        .collect();
+    let victim = (0..bvh.triangles.len() as u32)
+        .find(|i| !in_root_leaf.contains(i))
+        .unwrap() as usize;
+    let mut moved = bvh.clone();
+    moved.triangles[victim].v0 += glam::Vec3A::splat(100.0);
+    let caught = std::panic::catch_unwind(|| moved.validate()).is_err();
+    assert!(caught, "validate accepted a triangle outside its leaf");
+}
+
 #[test]
 fn empty_scene_misses_on_the_cpu() {
     let bvh = Bvh::build(&[], &[], BvhConfig::default());

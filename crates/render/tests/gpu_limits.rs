@@ -11,22 +11,13 @@ use std::sync::Arc;
 
 const CAP: u64 = 1 << 20;
 
-/// A device whose storage bindings are capped at 1 MiB, or `None` (skip) without a GPU.
+/// A device whose storage bindings are capped at 1 MiB, or `None` (a reported skip) without a
+/// GPU; panics under `FACET_REQUIRE_GPU=1`.
 fn small_gpu(test: &str) -> Option<Gpu> {
-    let options = GpuOptions {
+    facet_gpu::gpu_for_tests_with(test, |options| GpuOptions {
         max_storage_binding: Some(CAP),
-        ..GpuOptions::from_env().ok()?
-    };
-    match Gpu::with_options(&options) {
-        Ok(g) => Some(g),
-        Err(e) => {
-            if std::env::var("FACET_REQUIRE_GPU").is_ok_and(|v| v == "1") {
-                panic!("{test}: FACET_REQUIRE_GPU=1 but {e}");
-            }
-            eprintln!("SKIPPED {test}: {e}");
-            None
-        }
-    }
+        ..options
+    })
 }
 
 fn sphere(segments: u32, rings: u32) -> Scene {

@@ -198,7 +198,7 @@ fn neural_proxies_are_listed_and_fitted_by_name() {
             assert_eq!(h.state().material.source, spec);
             println!("fitted {spec} in {:.1} s", t.elapsed().as_secs_f64());
         }
-        Err(e) => eprintln!("SKIPPED neural_proxies_are_listed_and_fitted_by_name: {e}"),
+        Err(e) => facet_gpu::report_skip("neural_proxies_are_listed_and_fitted_by_name", &e),
     }
 }
 

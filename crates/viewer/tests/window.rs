@@ -3,8 +3,12 @@
 //! and the sphere's region differs from the sky's. Prints the measured frame time, samples
 //! per second and the edit-to-frame latency (run with --nocapture).
 //!
-//! Skips with a message without `DISPLAY`, unless `FACET_REQUIRE_GPU=1` and
-//! `FACET_REQUIRE_DISPLAY=1`, where it fails instead.
+//! Skips without `DISPLAY` (a `SKIPPED` line through `facet_gpu::report_skip`), unless
+//! `FACET_REQUIRE_GPU=1` and `FACET_REQUIRE_DISPLAY=1`, where it fails instead; skips without
+//! a GPU adapter as every GPU test does (`facet_gpu::gpu_for_tests`, checked in this process
+//! before the window is opened). Once there is a display and an adapter, a viewer that exits
+//! with an error, dies on a signal or writes no screenshot fails the test, whatever the
+//! variables say.
 
 use std::process::Command;
 
@@ -32,13 +36,17 @@ fn stats(img: &image::RgbaImage, x0: u32, y0: u32, x1: u32, y1: u32) -> ([f64; 3
 fn window_renders_the_sphere_on_the_gpu() {
     let require = std::env::var("FACET_REQUIRE_GPU").is_ok_and(|v| v == "1")
         && std::env::var("FACET_REQUIRE_DISPLAY").is_ok_and(|v| v == "1");
+    const TEST: &str = "window_renders_the_sphere_on_the_gpu";
     if std::env::var_os("DISPLAY").is_none() {
         if require {
             panic!("FACET_REQUIRE_DISPLAY=1 but DISPLAY is not set (run under xvfb-run -a)");
         }
-        eprintln!(
-            "SKIPPED window_renders_the_sphere_on_the_gpu: no DISPLAY (run under xvfb-run -a)"
-        );
+        facet_gpu::report_skip(TEST, "no DISPLAY (run under xvfb-run -a)");
+        return;
+    }
+    // No adapter at all is a skip (or a failure under FACET_REQUIRE_GPU=1), decided here and
+    // not from the viewer's exit status, which only ever means a failure.
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
         return;
     }
     let out = std::env::var_os("FACET_VIEWER_SCREENSHOT")
@@ -46,6 +54,9 @@ fn window_renders_the_sphere_on_the_gpu() {
         .unwrap_or_else(|| {
             std::env::temp_dir().join(format!("facet-viewer-{}.png", std::process::id()))
         });
+    // A screenshot left by an earlier run must not pass for this one's.
+    let _ = std::fs::remove_file(&out);
+    let _ = std::fs::remove_file(out.with_extension("json"));
     let frames = std::env::var("FACET_VIEWER_FRAMES").unwrap_or_else(|_| "16".into());
     let t = std::time::Instant::now();
     let status = Command::new(env!("CARGO_BIN_EXE_facet-viewer"))
@@ -53,13 +64,16 @@ fn window_renders_the_sphere_on_the_gpu() {
         .status()
         .expect("run facet-viewer");
     let wall = t.elapsed().as_secs_f64();
-    if !status.success() || !out.exists() {
-        if require {
-            panic!("facet-viewer failed ({status}) or wrote no screenshot");
-        }
-        eprintln!("SKIPPED window test: facet-viewer exited with {status} (no GPU adapter?)");
-        return;
-    }
+    assert!(
+        status.success(),
+        "facet-viewer failed ({status}) under DISPLAY={:?}",
+        std::env::var_os("DISPLAY").unwrap_or_default()
+    );
+    assert!(
+        out.exists(),
+        "facet-viewer exited 0 but wrote no screenshot at {}",
+        out.display()
+    );
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.with_extension("json")).unwrap())
             .unwrap();
