@@ -1,5 +1,5 @@
 // Extend stage: closest hit of every flying path (CWBVH traversal, render/bvh.inc.wgsl). A miss
-// adds the environment (MIS-weighted against light sampling) and ends the path; a hit adds the
+// adds the environment (weighted against light sampling, `emission_weight`) and ends the path; a hit adds the
 // surface's emission (likewise), widens the ray cone to the hit and queues the path for its
 // material's shading stage.
 
@@ -20,10 +20,7 @@ fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     let hit = trace_closest(o.xyz, d.xyz, 3.0e38);
     if (hit.prim == 0xffffffffu) {
         if (frame.env_kind != 0u) {
-            var w = 1.0;
-            if (beta.w > 0.0) {
-                w = mis_weight(beta.w, env_light_pmf() * env_pdf(d.xyz));
-            }
+            let w = emission_weight(beta.w, env_light_pmf() * env_pdf(d.xyz));
             l = vec4<f32>(l.xyz + beta.xyz * env_radiance(d.xyz) * w, l.w);
             path_set(R_L, slot, l);
         }
@@ -33,10 +30,7 @@ fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     let s = surface_at(hit.prim, hit.u, hit.v, -d.xyz);
     let le = emitted(s);
     if (any(le > vec3<f32>(0.0))) {
-        var w = 1.0;
-        if (beta.w > 0.0) {
-            w = mis_weight(beta.w, triangle_light_pdf(hit.prim, o.xyz, s.p, s.ng, s.area));
-        }
+        let w = emission_weight(beta.w, triangle_light_pdf(hit.prim, o.xyz, s.p, s.ng, s.area));
         path_set(R_L, slot, vec4<f32>(l.xyz + beta.xyz * le * w, l.w));
     }
     path_set(R_HIT, slot, vec4<f32>(hit.t, bitcast<f32>(hit.prim), hit.u, hit.v));

@@ -27,6 +27,12 @@ const SLOT_FLYING: u32 = 1u;   // a ray to trace
 const SLOT_ENDED: u32 = 2u;    // a finished path to accumulate
 const SLOT_IDLE: u32 = 3u;     // all its samples done
 
+// How direct light is estimated (facet_render::integrator::Strategy): both techniques weighted
+// by the power heuristic, light sampling alone, or BSDF sampling alone.
+const STRATEGY_MIS: u32 = 0u;
+const STRATEGY_LIGHT: u32 = 1u;
+const STRATEGY_BSDF: u32 = 2u;
+
 // Rust: facet_render::gpu_types::GpuFrame.
 struct Frame {
     width: u32,
@@ -49,6 +55,11 @@ struct Frame {
     env_conditional: u32,
     scene_radius: f32,
     ray_epsilon: f32,
+    // STRATEGY_* below
+    strategy: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
     // Constant environment radiance (env_kind 1); w: 1 / Σ weights of the map (env_kind 2).
     env_color: vec4<f32>,
     // xyz position, w tan(yfov / 2)

@@ -450,3 +450,26 @@ fn mis_weight(a: f32, b: f32) -> f32 {
     let b2 = b * b;
     return select(1.0, a2 / (a2 + b2), a2 + b2 > 0.0);
 }
+
+// Weight of a light sample of solid-angle pdf `pdf_light` (0: a delta light, which only light
+// sampling reaches), against BSDF sampling's pdf of the same direction; frame.strategy decides.
+// Under STRATEGY_BSDF the shading stage does not take such samples at all.
+fn light_sample_weight(pdf_light: f32, pdf_bsdf: f32) -> f32 {
+    if (pdf_light <= 0.0 || frame.strategy == STRATEGY_LIGHT) {
+        return 1.0;
+    }
+    return mis_weight(pdf_light, pdf_bsdf);
+}
+
+// Weight of emission a ray finds: `pdf_bsdf` that of the BSDF sample that made the ray (0: a
+// camera ray or a delta lobe, which only this technique reaches), `pdf_light` light sampling's
+// for the same direction (0: an emitter light sampling never picks).
+fn emission_weight(pdf_bsdf: f32, pdf_light: f32) -> f32 {
+    if (pdf_bsdf <= 0.0 || pdf_light <= 0.0 || frame.strategy == STRATEGY_BSDF) {
+        return 1.0;
+    }
+    if (frame.strategy == STRATEGY_LIGHT) {
+        return 0.0;
+    }
+    return mis_weight(pdf_bsdf, pdf_light);
+}

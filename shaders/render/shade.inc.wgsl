@@ -1,6 +1,6 @@
 // Include-only. The body every shading stage shares: next-event estimation toward one light
-// (MIS with BSDF sampling, power heuristic), a BSDF sample for the continuation, the ray cone's
-// new spread. The includer defines `Bsdf` and
+// (MIS with BSDF sampling, power heuristic, unless frame.strategy picks one technique), a BSDF
+// sample for the continuation, the ray cone's new spread. The includer defines `Bsdf` and
 //   bsdf_setup(s, slot) -> Bsdf, bsdf_eval(b, wi, wo) -> f (no cosine),
 //   bsdf_pdf(b, wi, wo) -> solid-angle pdf, bsdf_sample(b, wo, u) -> BsdfSample,
 //   bsdf_roughness(b) -> α of the lobe (for the cone),
@@ -33,14 +33,12 @@ fn shade(slot: u32) {
 
     // Next-event estimation.
     let ls = sample_light(s.p, path_rand(slot, 0u), vec2<f32>(path_rand(slot, 1u), path_rand(slot, 2u)));
-    if (any(ls.weight > vec3<f32>(0.0)) && dot(ls.wi, s.ng) > 0.0) {
+    let nee = frame.strategy != STRATEGY_BSDF || ls.pdf <= 0.0;
+    if (nee && any(ls.weight > vec3<f32>(0.0)) && dot(ls.wi, s.ng) > 0.0) {
         let wi = to_local(s, ls.wi);
         if (wi.z > 0.0) {
             let f = bsdf_eval(b, wi, wo);
-            var w = 1.0;
-            if (ls.pdf > 0.0) {
-                w = mis_weight(ls.pdf, bsdf_pdf(b, wi, wo));
-            }
+            let w = light_sample_weight(ls.pdf, bsdf_pdf(b, wi, wo));
             let c = beta.xyz * f * wi.z * ls.weight * w;
             if (any(c > vec3<f32>(0.0))) {
                 let origin = offset_origin(s, ls.wi);

@@ -34,6 +34,9 @@ pub struct GpuFrame {
     pub env_conditional: u32,
     pub scene_radius: f32,
     pub ray_epsilon: f32,
+    /// [`Strategy`](crate::integrator::Strategy) as `u32`.
+    pub strategy: u32,
+    pub pad: [u32; 3],
     pub env_color: [f32; 4],
     pub cam_pos: [f32; 4],
     pub cam_forward: [f32; 4],

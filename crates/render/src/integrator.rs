@@ -19,6 +19,21 @@ use crate::stages::{Layouts, Stage, queue_args};
 use facet_gpu::{Gpu, buffer, shader};
 use std::time::Instant;
 
+/// How direct light is estimated. Every choice converges to the same image; [`Strategy::Mis`]
+/// has the least noise, the others are for checking it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Strategy {
+    /// Light sampling and BSDF sampling, combined by the power heuristic (Veach 1997).
+    #[default]
+    Mis = 0,
+    /// Light sampling alone: emission that a BSDF-sampled ray finds counts only when light
+    /// sampling could not have found it.
+    Light = 1,
+    /// BSDF sampling alone: only delta lights (point, spot, directional) are sampled.
+    Bsdf = 2,
+}
+
 /// Settings of one render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderConfig {
@@ -39,6 +54,7 @@ pub struct RenderConfig {
     pub time_limit: Option<f64>,
     /// Iterations submitted between checks for completion.
     pub iterations_per_check: u32,
+    pub strategy: Strategy,
 }
 
 impl RenderConfig {
@@ -55,6 +71,7 @@ impl RenderConfig {
             spp_per_pass: 4,
             time_limit: None,
             iterations_per_check: 8,
+            strategy: Strategy::Mis,
         }
     }
 
@@ -71,6 +88,7 @@ impl RenderConfig {
             spp_per_pass: 4,
             time_limit: None,
             iterations_per_check: 8,
+            strategy: Strategy::Mis,
         }
     }
 }
@@ -312,6 +330,7 @@ impl Integrator {
         (frame.env_texels, frame.env_marginal, frame.env_conditional) = scene.env_offsets;
         frame.env_color = scene.env_color;
         frame.scene_radius = scene.scene_radius;
+        frame.strategy = config.strategy as u32;
 
         let tiles = pixels.div_ceil(w);
         let per_pass = config.spp_per_pass.max(1);

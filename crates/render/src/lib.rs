@@ -38,7 +38,7 @@ pub mod trace;
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use error::RenderError;
 pub use film::Image;
-pub use integrator::{Integrator, RenderConfig, RenderStats};
+pub use integrator::{Integrator, RenderConfig, RenderStats, Strategy};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
 pub use resources::{Built, ResourceConfig, SceneResources};
