@@ -318,3 +318,392 @@ fn render_demo_scene_writes_png_and_exr() {
     assert!(stdout.contains("classes [\"diffuse\", \"analytic\", \"tabulated\", \"glint\"]"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+// ---- features that must visibly act -------------------------------------------------------
+
+#[path = "../crates/render/tests/common/mod.rs"]
+mod render_common;
+
+/// The linear pixels of an EXR (width, height, rgb).
+fn read_exr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
+    use exr::prelude::*;
+    let img = read_first_rgba_layer_from_file(
+        path,
+        |res, _| (res.width(), vec![[0f32; 3]; res.width() * res.height()]),
+        |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| px[pos.y() * *w + pos.x()] = [r, g, b],
+    )
+    .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let size = img.layer_data.size;
+    (
+        size.width(),
+        size.height(),
+        img.layer_data.channel_data.pixels.1,
+    )
+}
+
+/// The README's tone map, written out here: 255 · sRGB(1 − exp(−2^e L)), before rounding.
+fn tone_map(l: f32, exposure: f64) -> f64 {
+    let v = 1.0 - (-(exposure.exp2()) * (l.max(0.0) as f64)).exp();
+    let s = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    255.0 * s
+}
+
+/// Asserts that every `step`-th pixel of the PNG is its EXR pixel through the tone map, rounded
+/// (within half a step: f32 in the writer, f64 here); returns their mean byte.
+fn check_tone_map(png: &image::RgbImage, exr: &[[f32; 3]], exposure: f64, step: usize) -> f64 {
+    let (mut sum, mut n) = (0.0, 0);
+    for (i, p) in png.pixels().enumerate().step_by(step) {
+        for (c, (&byte, &l)) in p.0.iter().zip(&exr[i]).enumerate() {
+            let want = tone_map(l, exposure);
+            assert!(
+                (byte as f64 - want).abs() <= 0.5 + 1e-3,
+                "exposure {exposure}: pixel {i} channel {c} is {byte} for {want:.3}"
+            );
+            sum += byte as f64;
+            n += 1;
+        }
+    }
+    sum / n as f64
+}
+
+/// `spp` in "timings (ms): … (N spp, …)".
+fn reported_spp(stdout: &str) -> u32 {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("timings (ms): resources"))
+        .unwrap_or_else(|| panic!("no timings line in {stdout}"));
+    let (before, _) = line.split_once(" spp,").unwrap();
+    before.rsplit('(').next().unwrap().parse().unwrap()
+}
+
+/// Samples per pixel of `render_small`, unless `--time-limit` cuts it short.
+const SMALL_SPP: u32 = 2;
+
+/// A 40 × 24 render of `demo` at SMALL_SPP (or at 2000 spp with a `--time-limit` in `extra`).
+fn render_small(demo: &str, out: &Path, extra: &[&str]) -> String {
+    let spp = if extra.contains(&"--time-limit") {
+        "2000".to_string()
+    } else {
+        SMALL_SPP.to_string()
+    };
+    let mut args = vec![
+        "render",
+        demo,
+        "--width",
+        "40",
+        "--height",
+        "24",
+        "--spp",
+        &spp,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    let (ok, stdout, err) = facet(&args);
+    assert!(ok, "{args:?}: {stdout}\n{err}");
+    stdout
+}
+
+/// A copy of the demo whose glint sphere has 1000× fewer flakes, so that renders repeat bit for
+/// bit on lavapipe too. At the demo's density (and still at a tenth of it) footprints hold
+/// enough flakes for llvmpipe's cap of 65 535 iterations per loop, which it counts over a SIMD
+/// group of invocations, to cut some counts short; which paths share a group changes from run
+/// to run, so a dozen glint pixels of 960 differ between identical renders there.
+fn reproducible_demo_copy(dir: &Path) -> PathBuf {
+    let demo = demo_copy(dir);
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&demo).unwrap()).unwrap();
+    let mut changed = 0;
+    for m in doc["materials"].as_array_mut().unwrap() {
+        if let Some(g) = m.pointer_mut("/extras/facet/glint/density") {
+            *g = serde_json::json!(g.as_f64().unwrap() / 1000.0);
+            changed += 1;
+        }
+    }
+    assert_eq!(changed, 1, "the demo has one glint material");
+    std::fs::write(&demo, serde_json::to_string(&doc).unwrap()).unwrap();
+    demo
+}
+
+/// `--exposure` scales what the PNG shows exactly as the tone map says, and leaves the EXR
+/// (linear) alone: every PNG byte is the tone map of its EXR pixel, rounded.
+#[test]
+fn exposure_changes_the_png_as_the_tone_map_says() {
+    if facet_gpu::gpu_for_tests("exposure_changes_the_png_as_the_tone_map_says").is_none() {
+        return;
+    }
+    let dir = common::scratch("cli_exposure");
+    let demo = reproducible_demo_copy(&dir);
+    let sky = dir.join("sky.exr");
+    let mut exrs = Vec::new();
+    let mut means = Vec::new();
+    for exposure in [0.0, 2.0, -1.5] {
+        let out = dir.join(format!("e{exposure}.png"));
+        let e = format!("{exposure}");
+        render_small(
+            demo.to_str().unwrap(),
+            &out,
+            &["--env", sky.to_str().unwrap(), "--exposure", &e],
+        );
+        let (w, h, px) = read_exr(&out.with_extension("exr"));
+        let png = image::open(&out).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), (w as u32, h as u32));
+        means.push(check_tone_map(&png, &px, exposure, 1));
+        exrs.push(px);
+    }
+    println!("mean PNG byte at exposure 0, +2, −1.5: {means:.1?}");
+    assert!(
+        exrs[1] == exrs[0] && exrs[2] == exrs[0],
+        "the EXR changed with --exposure"
+    );
+    assert!(means[2] < means[0] && means[0] < means[1], "{means:?}");
+}
+
+/// `--time-limit` stops after the pass in which the time runs out: fewer samples than asked
+/// for, reported as such, and both outputs written.
+#[test]
+fn time_limit_stops_early_with_fewer_spp() {
+    if facet_gpu::gpu_for_tests("time_limit_stops_early_with_fewer_spp").is_none() {
+        return;
+    }
+    let dir = common::scratch("cli_time_limit");
+    let demo = demo_copy(&dir);
+    let out = dir.join("t.png");
+    // 2000 spp take half a minute on lavapipe; half a second allows a few passes of 4 spp.
+    let stdout = render_small(demo.to_str().unwrap(), &out, &["--time-limit", "0.5"]);
+    let spp = reported_spp(&stdout);
+    println!("time limit 0.5 s: {spp} of 2000 spp");
+    assert!((1..2000).contains(&spp), "{spp} spp");
+    assert!(out.exists() && out.with_extension("exr").exists());
+    let (_, _, px) = read_exr(&out.with_extension("exr"));
+    assert!(px.iter().flatten().all(|v| v.is_finite()));
+    // Without the limit the same command takes every sample.
+    let stdout = render_small(demo.to_str().unwrap(), &dir.join("full.png"), &[]);
+    assert_eq!(reported_spp(&stdout), SMALL_SPP);
+}
+
+/// The wavefront size is scheduling only: 64 paths in flight (the minimum, many tiles), a size
+/// that splits the image unevenly and the default give the same image, bit for bit.
+#[test]
+fn wavefront_sizes_give_the_same_image() {
+    if facet_gpu::gpu_for_tests("wavefront_sizes_give_the_same_image").is_none() {
+        return;
+    }
+    let dir = common::scratch("cli_wavefront");
+    let demo = reproducible_demo_copy(&dir);
+    let images: Vec<_> = [None, Some("64"), Some("333")]
+        .iter()
+        .enumerate()
+        .map(|(k, w)| {
+            let out = dir.join(format!("w{k}.png"));
+            let extra: Vec<&str> = w.map(|w| vec!["--wavefront", w]).unwrap_or_default();
+            render_small(demo.to_str().unwrap(), &out, &extra);
+            read_exr(&out.with_extension("exr")).2
+        })
+        .collect();
+    assert!(images[0].iter().flatten().any(|&v| v > 0.0));
+    assert!(images[1] == images[0], "--wavefront 64 changed the image");
+    assert!(images[2] == images[0], "--wavefront 333 changed the image");
+}
+
+/// `--material ball=FIT` puts a fitted material on the glTF material "ball": a blue Lambertian
+/// sphere in a white furnace becomes the fit, whose pixels are its directional albedo E(θo),
+/// computed on the CPU from the same fit JSON.
+#[test]
+fn material_flag_replaces_the_material_as_predicted() {
+    if facet_gpu::gpu_for_tests("material_flag_replaces_the_material_as_predicted").is_none() {
+        return;
+    }
+    use facet_fit::material::{FittedMaterial, ModelChoice};
+    use glam::DVec3;
+    let dir = common::scratch("cli_material");
+    // The fit: a grey GGX conductor.
+    let (ok, stdout, err) = facet(&[
+        "fit",
+        "analytic:ggx?alpha=0.3&f0=0.5",
+        "--backend",
+        "cpu",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{err}");
+    let fit_path = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .expect("a fit JSON");
+    // The scene: a unit sphere, material "ball" (blue, Lambertian), camera at z = 3.
+    let mut b = render_common::GltfBuilder::default();
+    let (p, n, _, _, idx) = render_common::demo::uv_sphere(1.0);
+    let (pa, na, ia) = (b.vec3s(&p), b.vec3s(&n), b.indices(&idx));
+    let ball = b.material(serde_json::json!({
+        "name": "ball",
+        "pbrMetallicRoughness": {"baseColorFactor": [0.05, 0.1, 0.9, 1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0},
+        "extensions": {"KHR_materials_specular": {"specularFactor": 0.0}}
+    }));
+    b.extensions_used.push("KHR_materials_specular");
+    let mesh = b.mesh(
+        "ball",
+        serde_json::json!({"POSITION": pa, "NORMAL": na}),
+        Some(ia),
+        Some(ball),
+    );
+    b.cameras.push(
+        serde_json::json!({"type": "perspective", "perspective": {"yfov": 0.6, "znear": 0.01}}),
+    );
+    let m = b.node(serde_json::json!({"mesh": mesh}));
+    let c = b.node(serde_json::json!({"camera": 0, "translation": [0.0, 0.0, 3.0]}));
+    let scene = dir.join("ball.gltf");
+    b.write(&[m, c], &scene);
+    let size = 48u32;
+    let render = |out: &str, extra: &[&str]| {
+        let out = dir.join(out);
+        let s = size.to_string();
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--env-color",
+            "1",
+            "--width",
+            &s,
+            "--height",
+            &s,
+            "--spp",
+            "32",
+            "--max-depth",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let (ok, stdout, err) = facet(&args);
+        assert!(ok, "{args:?}: {stdout}\n{err}");
+        read_exr(&out.with_extension("exr")).2
+    };
+    let before = render("before.png", &[]);
+    let spec = format!("ball={}", fit_path.display());
+    let after = render("after.png", &["--material", &spec]);
+    // θo of each pixel centre on the exact sphere, kept below 70° (away from the silhouette).
+    let t = (0.5f64 * 0.6).tan();
+    let theta = |x: u32, y: u32| {
+        let ndc = (
+            2.0 * (x as f64 + 0.5) / size as f64 - 1.0,
+            1.0 - 2.0 * (y as f64 + 0.5) / size as f64,
+        );
+        let (o, d) = (
+            DVec3::new(0.0, 0.0, 3.0),
+            DVec3::new(ndc.0 * t, ndc.1 * t, -1.0).normalize(),
+        );
+        let b = o.dot(d);
+        let disc = b * b - (o.length_squared() - 1.0);
+        (disc > 0.0)
+            .then(|| {
+                let n = (o + (-b - disc.sqrt()) * d).normalize();
+                n.dot(-d).clamp(-1.0, 1.0).acos()
+            })
+            .filter(|t| t.to_degrees() < 70.0)
+    };
+    let fit = FittedMaterial::load(&fit_path).unwrap();
+    let brdf = fit.model(ModelChoice::Tabulated).unwrap();
+    let (mut gpu, mut cpu, mut blue, mut count) = (DVec3::ZERO, DVec3::ZERO, DVec3::ZERO, 0);
+    for y in 0..size {
+        for x in 0..size {
+            let Some(th) = theta(x, y) else { continue };
+            let i = (y * size + x) as usize;
+            gpu += DVec3::from_array(after[i].map(f64::from));
+            blue += DVec3::from_array(before[i].map(f64::from));
+            let e = facet_fit::albedo::directional_albedo(
+                brdf,
+                DVec3::new(th.sin(), 0.0, th.cos()),
+                64,
+            );
+            cpu += DVec3::from_array(e);
+            count += 1;
+        }
+    }
+    let (gpu, cpu, blue) = (gpu / count as f64, cpu / count as f64, blue / count as f64);
+    println!(
+        "sphere mean over {count} pixels: before {blue:.4}, after {gpu:.4}, CPU albedo {cpu:.4}"
+    );
+    // Before: the blue Lambertian's albedo, exactly (white furnace, one bounce).
+    assert!(
+        (blue - DVec3::new(0.05, 0.1, 0.9)).abs().max_element() < 0.01,
+        "{blue}"
+    );
+    // After: the fit's albedo, to 1.5 % (the tabulated model's GPU tables against its CPU twin).
+    assert!(
+        ((gpu - cpu) / cpu).abs().max_element() < 0.015,
+        "{gpu} vs {cpu}"
+    );
+}
+
+/// `facet` with no arguments in an empty folder runs the demo and writes what the README says:
+/// `out/default-gold-ggx.json` (a GGX fit with α = 0.15) and its tables, `out/demo.png` and
+/// `out/demo.exr` at 480 × 270.
+#[test]
+fn demo_runs_and_writes_what_the_readme_says() {
+    if facet_gpu::gpu_for_tests("demo_runs_and_writes_what_the_readme_says").is_none() {
+        return;
+    }
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    for claim in [
+        "`out/default-gold-ggx.json`",
+        "`out/demo.png`",
+        "`out/demo.exr` (480 × 270, 16 spp)",
+        "(α = 0.15)",
+    ] {
+        assert!(readme.contains(claim), "the README no longer says {claim}");
+    }
+    let cwd = common::scratch("cli_demo_cwd");
+    let out = Command::new(env!("CARGO_BIN_EXE_facet"))
+        .current_dir(&cwd)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    println!("{stdout}");
+    assert_eq!(reported_spp(&stdout), 16);
+    let mut names: Vec<String> = std::fs::read_dir(&cwd)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    assert_eq!(names, ["out"], "the demo wrote outside out/");
+    names = std::fs::read_dir(cwd.join("out"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "default-gold-ggx.json",
+            "default-gold-ggx.tables.csv",
+            "demo.exr",
+            "demo.png"
+        ]
+    );
+    let png = image::open(cwd.join("out/demo.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (480, 270));
+    let (w, h, px) = read_exr(&cwd.join("out/demo.exr"));
+    assert_eq!((w, h), (480, 270));
+    // The PNG is the EXR through the tone map at exposure 0.
+    check_tone_map(&png, &px, 0.0, 97);
+    let fit =
+        facet_fit::material::FittedMaterial::load(&cwd.join("out/default-gold-ggx.json")).unwrap();
+    let ggx = fit.record.ggx.as_ref().unwrap();
+    assert!(
+        (ggx.alpha_x - 0.15).abs() < 0.003 && (ggx.alpha_y - 0.15).abs() < 0.003,
+        "{ggx:?}"
+    );
+    let mean: f64 = px.iter().map(|p| p[1] as f64).sum::<f64>() / px.len() as f64;
+    assert!(mean > 0.02 && mean.is_finite(), "mean green {mean}");
+}

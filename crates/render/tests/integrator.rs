@@ -314,6 +314,96 @@ fn glint_filter_switch_leaves_no_seam() {
     }
 }
 
+/// The threshold decides, footprint by footprint, whether flakes are counted or replaced by
+/// their mean N·a·P. One sample per pixel of a sphere under a directional light, direct light
+/// only: each pixel is one evaluation of the glint BRDF, so with the same seed a pixel under
+/// threshold T is bit for bit either the counted render's or the all-mean render's. Raising T
+/// can only move footprints from the mean to the count; T = 0 is the mean everywhere, T = ∞ and
+/// the filter switched off are the count everywhere.
+#[test]
+fn glint_threshold_decides_which_footprints_are_counted() {
+    let Some(gpu) = gpu_for_tests("glint_threshold_decides_which_footprints_are_counted") else {
+        return;
+    };
+    let render_with = |threshold: f32, filter: bool| {
+        let mut scene = sphere_scene(glint(2e6, threshold));
+        scene.lights.push(facet_render::scene::Light::Directional {
+            direction: Vec3::new(0.3, -0.4, -1.0).normalize(),
+            irradiance: Vec3::splat(2.0),
+        });
+        let rc = ResourceConfig {
+            glint_filter: filter,
+            ..ResourceConfig::standard()
+        };
+        let res = SceneResources::new(&gpu, &scene, None, rc).unwrap();
+        let integrator = Integrator::new(&gpu.device, &res).unwrap();
+        let camera = CameraFrame::new(&scene.camera).unwrap();
+        let c = RenderConfig {
+            max_depth: 1,
+            ..config(1)
+        };
+        integrator
+            .render(&gpu, &res, &camera, &c, &mut |_| {})
+            .unwrap()
+            .0
+            .pixels
+    };
+    let counted = render_with(0.0, false);
+    let mean = render_with(0.0, true);
+    assert_eq!(
+        render_with(1e30, true),
+        counted,
+        "T = ∞ must count every footprint"
+    );
+    // Pixels where counting and the mean differ say which one a render took.
+    let telling: Vec<usize> = (0..counted.len())
+        .filter(|&i| counted[i] != mean[i])
+        .collect();
+    println!(
+        "{} of {} pixels tell the count from the mean",
+        telling.len(),
+        counted.len()
+    );
+    assert!(telling.len() > 500, "{}", telling.len());
+    let mut previous: Option<Vec<bool>> = None;
+    for threshold in [0.0, 0.02, 0.05, 0.2] {
+        let img = render_with(threshold, true);
+        let mut took_mean = Vec::new();
+        for &i in &telling {
+            let m = img[i] == mean[i];
+            assert!(
+                m || img[i] == counted[i],
+                "T = {threshold}: pixel {i} is neither"
+            );
+            took_mean.push(m);
+        }
+        let n = took_mean.iter().filter(|&&m| m).count();
+        println!(
+            "T = {threshold}: {n} of {} footprints replaced by the mean",
+            telling.len()
+        );
+        if threshold == 0.0 {
+            assert_eq!(n, telling.len(), "T = 0 must replace every footprint");
+        } else {
+            assert!(n > 0 && n < telling.len(), "T = {threshold}: {n}");
+        }
+        if let Some(p) = &previous {
+            for (k, (&now, &before)) in took_mean.iter().zip(p).enumerate() {
+                assert!(
+                    !now || before,
+                    "pixel {} went back to the mean as T grew",
+                    telling[k]
+                );
+            }
+            assert!(
+                n < p.iter().filter(|&&m| m).count(),
+                "T = {threshold} changed nothing"
+            );
+        }
+        previous = Some(took_mean);
+    }
+}
+
 #[test]
 fn same_seed_same_image() {
     let Some(gpu) = gpu_for_tests("same_seed_same_image") else {
