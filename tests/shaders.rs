@@ -172,6 +172,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
     use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial};
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
+    use facet_render::tonemap::ToneMapParams;
     use facet_render::trace::{GpuHit, GpuRay};
     vec![
         layout_check!(GpuNode, "fit/kernel.wgsl", "Node", {
@@ -214,6 +215,9 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         }),
         layout_check!(GpuLight, "render/extend.wgsl", "Light", {
             kind, prim, cos_inner, cos_outer, position, direction, intensity,
+        }),
+        layout_check!(ToneMapParams, "render/tonemap.wgsl", "Params", {
+            pixels, scale, pad0, pad1,
         }),
         layout_check!(GpuRay, "render/trace.wgsl", "Ray", { origin, tmin, dir, tmax }),
         layout_check!(GpuHit, "render/trace.wgsl", "Hit", { t, prim, u, v }),

@@ -1,9 +1,6 @@
-//! The pinhole camera as the generate stage takes it, with the ray cone's pixel spread angle
-//! (Akenine-Möller et al. 2019: α = atan(2 tan(yfov/2) / height)).
+//! The pinhole camera as the generate stage takes it (its uniform: `wavefront::frame_uniform`).
 
 use crate::error::RenderError;
-use crate::gpu_types::GpuFrame;
-use crate::integrator::RenderConfig;
 use crate::scene::Camera;
 use glam::Vec3;
 
@@ -40,25 +37,5 @@ impl CameraFrame {
             right,
             yfov: camera.yfov,
         })
-    }
-
-    /// The camera fields of the frame uniform for an image of `config`'s size.
-    pub fn gpu_frame(&self, config: &RenderConfig) -> GpuFrame {
-        let tan_half = (0.5 * self.yfov).tan();
-        let aspect = config.width as f32 / config.height as f32;
-        let spread = (2.0 * tan_half / config.height as f32).atan();
-        GpuFrame {
-            width: config.width,
-            height: config.height,
-            max_depth: config.max_depth,
-            seed: config.seed,
-            rr_depth: config.rr_depth,
-            ray_epsilon: 1e-5,
-            cam_pos: self.position.extend(tan_half).to_array(),
-            cam_forward: self.forward.extend(aspect).to_array(),
-            cam_up: self.up.extend(spread).to_array(),
-            cam_right: self.right.extend(0.0).to_array(),
-            ..Default::default()
-        }
     }
 }

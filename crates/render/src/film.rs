@@ -81,14 +81,19 @@ impl Image {
         })
     }
 
+    /// 8-bit sRGB pixels after the tone mapping in the module doc (the GPU's twin:
+    /// [`Wavefront::tone_mapped`](crate::Wavefront::tone_mapped)).
+    pub fn tone_mapped(&self, exposure: f32) -> Vec<[u8; 3]> {
+        let scale = exposure.exp2();
+        self.pixels
+            .iter()
+            .map(|p| p.map(|v| encode_srgb(1.0 - (-scale * v.max(0.0)).exp())))
+            .collect()
+    }
+
     /// 8-bit sRGB PNG after the tone mapping in the module doc.
     pub fn write_png(&self, path: &Path, exposure: f32) -> Result<(), RenderError> {
-        let scale = exposure.exp2();
-        let bytes: Vec<u8> = self
-            .pixels
-            .iter()
-            .flat_map(|p| p.map(|v| encode_srgb(1.0 - (-scale * v.max(0.0)).exp())))
-            .collect();
+        let bytes: Vec<u8> = self.tone_mapped(exposure).concat();
         let (w, h) = (self.width, self.height);
         write_atomically(path, |tmp| {
             image::save_buffer_with_format(

@@ -11,12 +11,11 @@
 use crate::camera::CameraFrame;
 use crate::error::RenderError;
 use crate::film::Image;
-use crate::gpu_types::{GpuFrame, PATH_REGIONS};
-use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::resources::SceneResources;
 use crate::stages::{Layouts, Stage, queue_args};
-use facet_gpu::{Gpu, buffer, shader};
+use crate::wavefront::Wavefront;
+use facet_gpu::{Gpu, shader};
 use std::time::Instant;
 
 /// How direct light is estimated. Every choice converges to the same image; [`Strategy::Mis`]
@@ -194,8 +193,9 @@ impl Integrator {
         v
     }
 
-    /// Renders `config.spp` samples per pixel (or fewer under a time limit); `progress` gets the
-    /// fraction done after every tile.
+    /// Renders `config.spp` samples per pixel (or fewer under a time limit) into a fresh
+    /// [`Wavefront`]; `progress` gets the fraction done after every tile. Renders that repeat
+    /// (a viewer, a benchmark) keep a `Wavefront` and call its `render_more` instead.
     pub fn render(
         &self,
         gpu: &Gpu,
@@ -204,208 +204,51 @@ impl Integrator {
         config: &RenderConfig,
         progress: &mut dyn FnMut(f64),
     ) -> Result<(Image, RenderStats), RenderError> {
-        let d = &gpu.device;
         if config.width == 0 || config.height == 0 || config.spp == 0 {
             return Err(RenderError::Scene(format!(
                 "nothing to render: {}×{} at {} spp",
                 config.width, config.height, config.spp
             )));
         }
-        let pixels = config.width as u64 * config.height as u64;
-        // One dispatch reaches 65 535 × 65 535 × 64 threads; queues index with u32.
-        let wavefront = (config.wavefront.max(64) as u64).min(pixels).min(1 << 24) as u32;
-        let w = wavefront as u64;
-        let nq = self.n_queues as u64;
-        let render_size = format!(
-            "the render size (--width × --height = {} × {})",
-            config.width, config.height
-        );
-        let slots = format!(
-            "--wavefront and --width × --height ({wavefront} paths in flight for {} × {} pixels)",
-            config.width, config.height
-        );
-        let film_bytes = product(&[pixels, 16]);
-        DeviceLimits::of(d).check(&[
-            Planned::storage("the path state", product(&[PATH_REGIONS, w, 16]), &slots),
-            Planned::storage("the path info", product(&[w, 16]), &slots),
-            Planned::storage("the queues", product(&[nq, w, 4]), &slots),
-            Planned::storage("the film", film_bytes, &render_size),
-            Planned::buffer("the film read-back", film_bytes, &render_size),
-        ])?;
         let t0 = Instant::now();
-        let (frame_buf, paths, info, counters, sizes, args, queues, film) = gpu.scoped(|| {
-            (
-                buffer::uniform(d, "frame", &GpuFrame::default()),
-                buffer::storage_zeroed(d, "paths", PATH_REGIONS * w * 16),
-                buffer::storage_zeroed(d, "path info", w * 16),
-                buffer::storage_zeroed(d, "queue counters", nq * 4),
-                buffer::storage_zeroed(d, "queue sizes", nq * 4),
-                d.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("queue dispatch args"),
-                    size: nq * 12,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-                    mapped_at_creation: false,
-                }),
-                buffer::storage_zeroed(d, "queues", nq * w * 4),
-                buffer::storage_zeroed(d, "film", pixels * 16),
-            )
-        })?;
-        let group = |layout: &wgpu::BindGroupLayout, label, res: &[wgpu::BindingResource]| {
-            let entries: Vec<wgpu::BindGroupEntry> = res
-                .iter()
-                .enumerate()
-                .map(|(i, r)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: r.clone(),
-                })
-                .collect();
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout,
-                entries: &entries,
-            })
-        };
-        let frame_group = group(
-            &self.layouts.frame,
-            "frame",
-            &[
-                frame_buf.as_entire_binding(),
-                paths.as_entire_binding(),
-                info.as_entire_binding(),
-                counters.as_entire_binding(),
-                sizes.as_entire_binding(),
-                queues.as_entire_binding(),
-                film.as_entire_binding(),
-            ],
-        );
-        let scene_group = group(
-            &self.layouts.scene,
-            "scene",
-            &[
-                scene.bvh.nodes.as_entire_binding(),
-                scene.bvh.primitives.as_entire_binding(),
-                scene.bvh.triangles.as_entire_binding(),
-                scene.vertices.as_entire_binding(),
-                scene.triangles.as_entire_binding(),
-                scene.materials.as_entire_binding(),
-                scene.textures.as_entire_binding(),
-                scene.lights.as_entire_binding(),
-                scene.tables.as_entire_binding(),
-                scene.triangle_light.as_entire_binding(),
-            ],
-        );
-        let glint_groups: Vec<wgpu::BindGroup> = scene
-            .glints
-            .iter()
-            .map(|g| {
-                group(
-                    &self.layouts.glint,
-                    "glint",
-                    &[
-                        g.field.as_entire_binding(),
-                        g.params.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&g.level0),
-                        wgpu::BindingResource::TextureView(&g.level1),
-                    ],
-                )
-            })
-            .collect();
-        let args_group = group(
-            &self.layouts.queue_args,
-            "queue args",
-            &[
-                counters.as_entire_binding(),
-                sizes.as_entire_binding(),
-                args.as_entire_binding(),
-            ],
-        );
-
-        let mut frame = camera.gpu_frame(config);
-        frame.wavefront = wavefront;
-        frame.n_vertices = scene.n_vertices;
-        frame.n_lights = scene.n_lights;
-        frame.light_cdf = scene.light_cdf;
-        frame.env_kind = scene.env_kind;
-        (frame.env_width, frame.env_height) = scene.env_size;
-        (frame.env_texels, frame.env_marginal, frame.env_conditional) = scene.env_offsets;
-        frame.env_color = scene.env_color;
-        frame.scene_radius = scene.scene_radius;
-        frame.strategy = config.strategy as u32;
-
-        let tiles = pixels.div_ceil(w);
-        let per_pass = config.spp_per_pass.max(1);
-        let passes = config.spp.div_ceil(per_pass);
-        let mut stats = RenderStats::default();
-        let all_slots = facet_gpu::dispatch::workgroups(wavefront, self.wg);
-        'passes: for pass in 0..passes {
-            let begin = pass * per_pass;
-            let end = (begin + per_pass).min(config.spp);
-            for tile in 0..tiles {
-                let base = tile * w;
-                frame.tile_base = base as u32;
-                frame.tile_pixels = (pixels - base).min(w) as u32;
-                frame.sample_end = end;
-                gpu.queue
-                    .write_buffer(&frame_buf, 0, bytemuck::bytes_of(&frame));
-                let start: Vec<[u32; 4]> = vec![[0, begin, 0, 0]; frame.tile_pixels as usize];
-                gpu.queue
-                    .write_buffer(&info, 0, bytemuck::cast_slice(&start));
-                gpu.queue
-                    .write_buffer(&counters, 0, &vec![0u8; (nq * 4) as usize]);
-                loop {
-                    let mut enc = d.create_command_encoder(&Default::default());
-                    {
-                        let mut pass = enc.begin_compute_pass(&Default::default());
-                        for _ in 0..config.iterations_per_check {
-                            self.iteration(
-                                &mut pass,
-                                &frame_group,
-                                &scene_group,
-                                &glint_groups,
-                                &args_group,
-                                &args,
-                                all_slots,
-                            );
-                        }
-                    }
-                    gpu.queue.submit([enc.finish()]);
-                    stats.iterations += config.iterations_per_check as u64;
-                    let s: Vec<u32> = buffer::read(d, &gpu.queue, &sizes, nq as usize)?;
-                    gpu.check_lost()?;
-                    // Nothing traced in the last iteration: every slot is idle.
-                    if s[Queue::Extend.index() as usize] == 0 {
-                        break;
-                    }
-                }
-                stats.samples += frame.tile_pixels as u64 * (end - begin) as u64;
-                let done = (pass as u64 * tiles + tile + 1) as f64 / (passes as u64 * tiles) as f64;
-                progress(done);
-            }
-            stats.spp = end;
-            if let Some(limit) = config.time_limit
-                && t0.elapsed().as_secs_f64() >= limit
-            {
-                break 'passes;
-            }
-        }
-        let film: Vec<[f32; 4]> = buffer::read(d, &gpu.queue, &film, pixels as usize)?;
-        gpu.check_lost()?;
+        let mut wavefront = Wavefront::new(
+            gpu,
+            self,
+            scene,
+            config.width,
+            config.height,
+            config.wavefront,
+        )?;
+        let mut stats = wavefront.render_more(gpu, self, scene, camera, config, progress)?;
+        let image = wavefront.image(gpu)?;
         stats.ms = t0.elapsed().as_secs_f64() * 1e3;
-        Ok((Image::from_film(config.width, config.height, &film), stats))
+        Ok((image, stats))
     }
 
-    /// One iteration of the stage loop, encoded into `pass`.
-    #[allow(clippy::too_many_arguments)]
-    fn iteration(
+    pub(crate) fn layouts(&self) -> &Layouts {
+        &self.layouts
+    }
+
+    /// Queues of the scene the integrator was built for.
+    pub(crate) fn n_queues(&self) -> u32 {
+        self.n_queues
+    }
+
+    /// Workgroup size of the stages.
+    pub(crate) fn workgroup(&self) -> u32 {
+        self.wg
+    }
+
+    /// One iteration of the stage loop over `wf`'s paths, encoded into `pass`.
+    pub(crate) fn iteration(
         &self,
         pass: &mut wgpu::ComputePass,
-        frame_group: &wgpu::BindGroup,
-        scene_group: &wgpu::BindGroup,
-        glint_groups: &[wgpu::BindGroup],
-        args_group: &wgpu::BindGroup,
-        args: &wgpu::Buffer,
+        wf: &Wavefront,
         all_slots: (u32, u32),
     ) {
+        let (frame_group, scene_group, glint_groups) =
+            (&wf.frame_group, &wf.scene_group, &wf.glint_groups);
+        let (args_group, args) = (&wf.args_group, wf.args());
         let close = |pass: &mut wgpu::ComputePass, p: &wgpu::ComputePipeline| {
             pass.set_pipeline(p);
             pass.set_bind_group(0, args_group, &[]);

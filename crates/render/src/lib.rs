@@ -33,7 +33,9 @@ pub mod queues;
 pub mod resources;
 pub mod scene;
 pub mod stages;
+pub mod tonemap;
 pub mod trace;
+pub mod wavefront;
 
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use error::RenderError;
@@ -43,3 +45,4 @@ pub use integrator::{Integrator, RenderConfig, RenderStats, Strategy};
 pub use obvhs;
 pub use resources::{Built, ResourceConfig, SceneResources};
 pub use trace::{GpuHit, GpuRay, RayTracer};
+pub use wavefront::Wavefront;
