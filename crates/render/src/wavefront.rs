@@ -350,6 +350,6 @@ impl Wavefront {
             self.tone_map = Some(ToneMap::new(gpu, &self.film, self.width, self.height)?);
         }
         let t = self.tone_map.as_ref().expect("made above");
-        Ok(t.run(gpu, exposure)?)
+        t.run(gpu, exposure)
     }
 }
