@@ -51,8 +51,8 @@ pub struct ViewerApp {
     pub texture: Option<egui::TextureHandle>,
     /// The preview frame the texture shows.
     pub shown_frame: u64,
-    /// The exposure the texture was tone mapped with.
-    pub shown_exposure: f32,
+    /// The exposure last sent to the preview worker (which tone maps).
+    pub sent_exposure: f32,
     /// Where the preview image was drawn last (points).
     pub preview_rect: Option<egui::Rect>,
     /// The network file for `nbrdf:` inputs (`FACET_NBRDF`), `None`: the embedded proxies.
@@ -81,7 +81,7 @@ impl ViewerApp {
             preview_error: None,
             texture: None,
             shown_frame: 0,
-            shown_exposure: 0.0,
+            sent_exposure: 0.0,
             preview_rect: None,
             nbrdf: facet_fit::nbrdf::NbrdfLibrary::override_path(None),
             proxy_names: None,

@@ -1,17 +1,18 @@
 //! The progressive preview: a path-traced sphere on a plane under the demo sky, rendered on a
 //! worker thread that shares eframe's device and queue.
 //!
-//! Why a thread: `Integrator::render` submits and then waits for the GPU. On lavapipe one
-//! sample per pixel of a 256² image takes tens of milliseconds, and rebuilding the pipelines
-//! after a change of material class takes about half a second; done inside `App::ui` either
-//! would freeze the window. The worker renders one sample per pixel per batch, adds it to a
-//! CPU accumulation buffer, publishes the mean, asks for a repaint, and reads the UI's
-//! commands between batches, so a slider move restarts accumulation within one batch.
+//! Why a thread: a render submits and then waits for the GPU. On lavapipe one sample per pixel
+//! of a 256² image takes tens of milliseconds, and rebuilding the pipelines after a change of
+//! material class takes about half a second; done inside `App::ui` either would freeze the
+//! window. The worker keeps one [`Wavefront`] (path state, queues, film) for the scene and adds
+//! samples to its film on the GPU, a batch per frame sized to take about [`FRAME_MS`]; it reads
+//! back only the tone-mapped image (4 bytes a pixel), publishes it, asks for a repaint and reads
+//! the UI's commands between batches, so a slider move restarts accumulation within one batch.
 
 use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
 use glam::{Vec3, Vec4};
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
@@ -21,6 +22,10 @@ use std::time::Instant;
 pub const SPHERE: usize = 1;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
+/// The time one batch of samples aims at, ms (a frame at 60 Hz).
+pub const FRAME_MS: f64 = 16.0;
+/// The most samples per pixel in one batch.
+pub const MAX_SPP_PER_FRAME: u32 = 64;
 
 /// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -133,6 +138,8 @@ pub enum Command {
         sent: Instant,
     },
     Camera(Orbit),
+    /// Tone map the image at this exposure (stops) from now on.
+    Exposure(f32),
     /// Another scene (resources and pipelines are rebuilt).
     Scene(Box<PreviewScene>),
     Quit,
@@ -145,12 +152,16 @@ pub struct Shared {
     pub generation: u64,
     pub width: u32,
     pub height: u32,
-    /// Mean linear RGB so far.
-    pub mean: Vec<[f32; 3]>,
+    /// The image so far, tone mapped on the GPU (RGBA8, alpha 255).
+    pub rgba: Vec<[u8; 4]>,
+    /// The exposure `rgba` was tone mapped with.
+    pub exposure: f32,
     pub samples: u32,
+    /// Samples per pixel the last batch added.
+    pub spp_per_frame: u32,
     /// Bumped on every published frame.
     pub frame: u64,
-    /// Wall time of the last batch (render + readback + accumulation), ms.
+    /// Wall time of the last batch (render + tone map + read-back), ms.
     pub frame_ms: f64,
     /// Samples per pixel per second over the current accumulation.
     pub spp_per_s: f64,
@@ -262,13 +273,26 @@ impl Preview {
 struct Built {
     res: SceneResources,
     integrator: Integrator,
+    wavefront: Wavefront,
 }
 
-fn build(gpu: &Gpu, scene: &Scene, env: &Environment) -> Result<Built, String> {
+fn build(gpu: &Gpu, scene: &Scene, env: &Environment, size: (u32, u32)) -> Result<Built, String> {
     let res = SceneResources::new(gpu, scene, Some(env), ResourceConfig::standard())
         .map_err(|e| e.to_string())?;
     let integrator = Integrator::new(&gpu.device, &res).map_err(|e| e.to_string())?;
-    Ok(Built { res, integrator })
+    let wavefront = Wavefront::new(gpu, &integrator, &res, size.0, size.1, size.0 * size.1)
+        .map_err(|e| e.to_string())?;
+    Ok(Built {
+        res,
+        integrator,
+        wavefront,
+    })
+}
+
+/// The next batch size: the last one scaled toward FRAME_MS, at most doubling or halving.
+fn next_batch(spp: u32, ms: f64) -> u32 {
+    let scale = (FRAME_MS / ms.max(1e-3)).clamp(0.5, 2.0);
+    ((spp as f64 * scale).floor() as u32).clamp(1, MAX_SPP_PER_FRAME)
 }
 
 fn worker(
@@ -286,16 +310,16 @@ fn worker(
         orbit,
     } = preview;
     let mut orbit = orbit;
-    let mut built = build(&gpu, &scene, &env)?;
+    let size = (width, height);
+    let mut built = build(&gpu, &scene, &env, size)?;
     let mut camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
     let n = (width * height) as usize;
-    let mut sum = vec![[0f32; 3]; n];
-    let mut samples = 0u32;
+    let mut exposure = 0f32;
+    let mut batch = 1u32;
     let mut generation = 0u64;
     let mut pending_latency: Option<Instant> = None;
     let mut started = Instant::now();
     let mut frame = 0u64;
-    let mut seed = 0u32;
     {
         let mut s = shared.lock().unwrap();
         s.rebuilding = false;
@@ -305,7 +329,7 @@ fn worker(
     loop {
         // Commands: block only when there is nothing left to render.
         let mut cmds = Vec::new();
-        if samples >= MAX_SAMPLES {
+        if built.wavefront.spp() >= MAX_SAMPLES {
             match rx.recv() {
                 Ok(c) => cmds.push(c),
                 Err(_) => return Ok(()),
@@ -319,6 +343,7 @@ fn worker(
             }
         }
         let mut restart = false;
+        let mut retone = false;
         let mut new_material = None;
         for c in cmds {
             match c {
@@ -326,7 +351,7 @@ fn worker(
                 Command::Scene(p) => {
                     shared.lock().unwrap().rebuilding = true;
                     repaint();
-                    let b = build(&gpu, &p.scene, &env);
+                    let b = build(&gpu, &p.scene, &env, size);
                     let mut s = shared.lock().unwrap();
                     s.rebuilding = false;
                     match b {
@@ -343,6 +368,10 @@ fn worker(
                 Command::Camera(o) => {
                     orbit = o;
                     restart = true;
+                }
+                Command::Exposure(e) => {
+                    exposure = e;
+                    retone = true;
                 }
                 Command::Material {
                     generation: g,
@@ -361,7 +390,7 @@ fn worker(
             if !in_place {
                 shared.lock().unwrap().rebuilding = true;
                 repaint();
-                let b = build(&gpu, &scene, &env);
+                let b = build(&gpu, &scene, &env, size);
                 let mut s = shared.lock().unwrap();
                 s.rebuilding = false;
                 match b {
@@ -381,49 +410,54 @@ fn worker(
         }
         if restart {
             camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
-            sum.iter_mut().for_each(|p| *p = [0.0; 3]);
-            samples = 0;
+            built.wavefront.clear(&gpu);
             started = Instant::now();
         }
-        if samples >= MAX_SAMPLES {
+        let t = Instant::now();
+        let sampling = built.wavefront.spp() < MAX_SAMPLES;
+        if sampling {
+            let cfg = RenderConfig {
+                width,
+                height,
+                spp: batch.min(MAX_SAMPLES - built.wavefront.spp()),
+                spp_per_pass: MAX_SPP_PER_FRAME,
+                ..RenderConfig::preview()
+            };
+            let Built {
+                res,
+                integrator,
+                wavefront,
+            } = &mut built;
+            wavefront
+                .render_more(&gpu, integrator, res, &camera, &cfg, &mut |_| {})
+                .map_err(|e| format!("preview render: {e}"))?;
+        } else if !retone {
             continue;
         }
-        let t = Instant::now();
-        let cfg = RenderConfig {
-            width,
-            height,
-            spp: 1,
-            spp_per_pass: 1,
-            wavefront: width * height,
-            seed,
-            ..RenderConfig::preview()
-        };
-        seed = seed.wrapping_add(1);
-        let (image, _) = built
-            .integrator
-            .render(&gpu, &built.res, &camera, &cfg, &mut |_| {})
-            .map_err(|e| format!("preview render: {e}"))?;
+        let rgba = built
+            .wavefront
+            .tone_mapped(&gpu, exposure)
+            .map_err(|e| format!("preview tone map: {e}"))?;
         gpu.check_lost().map_err(|e| e.to_string())?;
-        for (s, p) in sum.iter_mut().zip(&image.pixels) {
-            for (a, v) in s.iter_mut().zip(p) {
-                if v.is_finite() {
-                    *a += v;
-                }
-            }
-        }
-        samples += 1;
-        frame += 1;
-        let inv = 1.0 / samples as f32;
-        let mean: Vec<[f32; 3]> = sum.iter().map(|s| s.map(|v| v * inv)).collect();
         let frame_ms = t.elapsed().as_secs_f64() * 1e3;
+        let added = if sampling { batch } else { 0 };
+        if sampling {
+            batch = next_batch(batch, frame_ms);
+        }
+        frame += 1;
+        let samples = built.wavefront.spp();
         let secs = started.elapsed().as_secs_f64().max(1e-9);
         {
             let mut s = shared.lock().unwrap();
             s.generation = generation;
-            s.mean = mean;
+            s.rgba = rgba;
+            s.exposure = exposure;
             s.samples = samples;
             s.frame = frame;
-            s.frame_ms = frame_ms;
+            if sampling {
+                s.frame_ms = frame_ms;
+                s.spp_per_frame = added;
+            }
             s.spp_per_s = samples as f64 / secs;
             s.samples_per_s = samples as f64 * n as f64 / secs;
             if let Some(sent) = pending_latency.take() {
@@ -432,24 +466,4 @@ fn worker(
         }
         repaint();
     }
-}
-
-/// The README's tone mapping: v = 1 − exp(−2^exposure · L), then sRGB.
-pub fn tone_map(mean: &[[f32; 3]], exposure: f32) -> Vec<egui::Color32> {
-    let k = 2f32.powf(exposure);
-    let srgb = |v: f32| {
-        let v = v.clamp(0.0, 1.0);
-        let s = if v <= 0.003_130_8 {
-            12.92 * v
-        } else {
-            1.055 * v.powf(1.0 / 2.4) - 0.055
-        };
-        (s * 255.0 + 0.5) as u8
-    };
-    mean.iter()
-        .map(|p| {
-            let m = p.map(|l| srgb(1.0 - (-k * l.max(0.0)).exp()));
-            egui::Color32::from_rgb(m[0], m[1], m[2])
-        })
-        .collect()
 }

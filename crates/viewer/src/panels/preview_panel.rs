@@ -1,7 +1,7 @@
 //! The preview panel: the accumulated image, orbit and zoom, timings; the screenshot run.
 
 use crate::app::ViewerApp;
-use crate::preview::{Command, tone_map};
+use crate::preview::Command;
 use std::sync::atomic::Ordering;
 
 pub fn preview_panel(app: &mut ViewerApp, ui: &mut egui::Ui) {
@@ -33,9 +33,19 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     if let Some(e) = &s.error {
         ui.colored_label(egui::Color32::from_rgb(230, 80, 60), format!("Error: {e}"));
     }
-    // A new frame, or the same one under another exposure (accumulation may have stopped).
-    if (s.frame != app.shown_frame || app.exposure != app.shown_exposure) && !s.mean.is_empty() {
-        let pixels = tone_map(&s.mean, app.exposure);
+    // The worker tone maps on the GPU: a new exposure goes to it, a new frame comes back.
+    if app.exposure != app.sent_exposure {
+        if let Some(p) = &app.preview {
+            p.send(Command::Exposure(app.exposure));
+        }
+        app.sent_exposure = app.exposure;
+    }
+    if s.frame != app.shown_frame && !s.rgba.is_empty() {
+        let pixels: Vec<egui::Color32> = s
+            .rgba
+            .iter()
+            .map(|p| egui::Color32::from_rgb(p[0], p[1], p[2]))
+            .collect();
         let image = egui::ColorImage::new([s.width as usize, s.height as usize], pixels);
         match &mut app.texture {
             Some(t) => t.set(image, egui::TextureOptions::LINEAR),
@@ -48,13 +58,13 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
             }
         }
         app.shown_frame = s.frame;
-        app.shown_exposure = app.exposure;
     }
     let current = s.generation == app.generation;
     ui.label(format!(
-        "{} · {:.1} ms/frame · {} spp · {:.2} Msamples/s · edit to frame {}{}",
+        "{} · {:.1} ms/frame ({} spp each) · {} spp · {:.2} Msamples/s · edit to frame {}{}",
         s.adapter,
         s.frame_ms,
+        s.spp_per_frame,
         if current { s.samples } else { 0 },
         s.samples_per_s / 1e6,
         s.latency_ms
