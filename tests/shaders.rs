@@ -23,8 +23,12 @@ fn every_wgsl_file_validates() {
     {
         let first = src
             .lines()
-            .find(|l| l.starts_with("fn ") || l.starts_with("struct "))
-            .unwrap();
+            .find(|l| {
+                ["fn ", "struct ", "const "]
+                    .iter()
+                    .any(|k| l.starts_with(k))
+            })
+            .unwrap_or_else(|| panic!("{name} declares nothing"));
         assert!(
             expanded.iter().any(|e| e.contains(first)),
             "{name} is included by no pipeline file"

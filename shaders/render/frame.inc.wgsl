@@ -11,27 +11,8 @@ override Q_GEN: u32;
 override Q_EXTEND: u32;
 override Q_SHADOW: u32;
 
-// Path-state regions (facet_render::gpu_types::Region).
-const R_ORIGIN: u32 = 0u;    // xyz origin, w cone width at the origin
-const R_DIR: u32 = 1u;       // xyz direction, w cone spread angle
-const R_BETA: u32 = 2u;      // rgb throughput β, w pdf of the BSDF sample that made the ray (0: no MIS)
-const R_L: u32 = 3u;         // rgb radiance so far
-const R_HIT: u32 = 4u;       // t, primitive (bits), barycentrics u, v
-const R_SHADOW_O: u32 = 5u;  // xyz shadow-ray origin, w tmax
-const R_SHADOW_D: u32 = 6u;  // xyz shadow-ray direction
-const R_SHADOW_C: u32 = 7u;  // rgb unoccluded contribution
-
-// info.x: what the slot holds.
-const SLOT_START: u32 = 0u;    // nothing yet: start a path
-const SLOT_FLYING: u32 = 1u;   // a ray to trace
-const SLOT_ENDED: u32 = 2u;    // a finished path to accumulate
-const SLOT_IDLE: u32 = 3u;     // all its samples done
-
-// How direct light is estimated (facet_render::integrator::Strategy): both techniques weighted
-// by the power heuristic, light sampling alone, or BSDF sampling alone.
-const STRATEGY_MIS: u32 = 0u;
-const STRATEGY_LIGHT: u32 = 1u;
-const STRATEGY_BSDF: u32 = 2u;
+// Path-state regions R_*, slot states SLOT_* (info.x), strategies STRATEGY_*.
+#include "render/tags.inc.wgsl"
 
 // Rust: facet_render::gpu_types::GpuFrame.
 struct Frame {
@@ -47,6 +28,7 @@ struct Frame {
     n_vertices: u32,
     n_lights: u32,
     light_cdf: u32,
+    // ENV_*
     env_kind: u32,
     env_width: u32,
     env_height: u32,
@@ -55,7 +37,7 @@ struct Frame {
     env_conditional: u32,
     scene_radius: f32,
     ray_epsilon: f32,
-    // STRATEGY_* below
+    // STRATEGY_*
     strategy: u32,
     pad0: u32,
     pad1: u32,

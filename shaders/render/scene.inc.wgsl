@@ -1,15 +1,11 @@
-// Include-only. Group 1 of the integrator stages: the scene (Rust: facet_render::scene_gpu).
+// Include-only. Group 1 of the integrator stages: the scene (Rust: facet_render::resources).
 // Geometry, BVH, materials, textures, lights and one f32 `tables` buffer holding the light CDF,
 // the environment map and its CDFs, the Fresnel tables and the tabulated NDFs at offsets.
 
+#include "render/tags.inc.wgsl"
+
 const PI: f32 = 3.14159265358979;
 const NONE: u32 = 0xffffffffu;
-
-// Material kinds (facet_render::gpu_types::MaterialKind).
-const MAT_GLTF: u32 = 0u;
-const MAT_ANALYTIC: u32 = 1u;
-const MAT_TABULATED: u32 = 2u;
-const MAT_GLINT: u32 = 3u;
 
 // Rust: facet_render::gpu_types::GpuMaterial.
 struct Material {
@@ -35,13 +31,6 @@ struct Material {
     tab_offset: u32,
     queue: u32,
 }
-
-// Light kinds (facet_render::gpu_types::LightKind).
-const LIGHT_POINT: u32 = 0u;
-const LIGHT_SPOT: u32 = 1u;
-const LIGHT_DIRECTIONAL: u32 = 2u;
-const LIGHT_TRIANGLE: u32 = 3u;
-const LIGHT_ENVIRONMENT: u32 = 4u;
 
 // Rust: facet_render::gpu_types::GpuLight.
 struct Light {
@@ -257,10 +246,10 @@ fn env_pixel(d: vec3<f32>) -> vec2<u32> {
 }
 
 fn env_radiance(d: vec3<f32>) -> vec3<f32> {
-    if (frame.env_kind == 1u) {
+    if (frame.env_kind == ENV_CONSTANT) {
         return frame.env_color.xyz;
     }
-    if (frame.env_kind == 2u) {
+    if (frame.env_kind == ENV_MAP) {
         let px = env_pixel(d);
         let o = frame.env_texels + 3u * (px.y * frame.env_width + px.x);
         return vec3<f32>(tables[o], tables[o + 1u], tables[o + 2u]);
@@ -278,10 +267,10 @@ fn env_pixel_prob(px: vec2<u32>) -> f32 {
 
 // Solid-angle density of env_sample: p · w · h / (2π² sin θ).
 fn env_pdf(d: vec3<f32>) -> f32 {
-    if (frame.env_kind == 1u) {
+    if (frame.env_kind == ENV_CONSTANT) {
         return 1.0 / (4.0 * PI);
     }
-    if (frame.env_kind != 2u) {
+    if (frame.env_kind != ENV_MAP) {
         return 0.0;
     }
     let sin_t = sqrt(max(1.0 - d.y * d.y, 0.0));
@@ -308,7 +297,7 @@ fn cdf_search(base: u32, n: u32, u: f32) -> u32 {
 }
 
 fn env_sample(u: vec2<f32>) -> vec3<f32> {
-    if (frame.env_kind != 2u) {
+    if (frame.env_kind != ENV_MAP) {
         // Uniform sphere.
         let y = 1.0 - 2.0 * u.x;
         let r = sqrt(max(1.0 - y * y, 0.0));

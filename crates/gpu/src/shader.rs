@@ -15,6 +15,11 @@ pub fn raw_source(name: &str) -> Option<&'static str> {
     SHADERS.iter().find(|(n, _)| *n == name).map(|(_, s)| *s)
 }
 
+/// Every shader file, includes too.
+pub fn all_files() -> impl Iterator<Item = &'static str> {
+    SHADERS.iter().map(|(n, _)| *n)
+}
+
 /// Every pipeline (non-include) shader file.
 pub fn pipeline_files() -> impl Iterator<Item = &'static str> {
     SHADERS

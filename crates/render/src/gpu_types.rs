@@ -3,11 +3,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
+pub use crate::tags::{LightKind, MaterialKind};
+
 /// Texture index meaning "none" (WGSL `NONE`).
 pub const NONE: u32 = u32::MAX;
 
-/// Regions of the path-state buffer (`shaders/render/frame.inc.wgsl`), one vec4 per slot each.
-pub const PATH_REGIONS: u64 = 8;
+/// Regions of the path-state buffer ([`Region`](crate::tags::Region)), one vec4 per slot each.
+pub const PATH_REGIONS: u64 = crate::tags::Region::ALL.len() as u64;
 
 /// WGSL `Frame` (`shaders/render/frame.inc.wgsl`).
 #[repr(C)]
@@ -25,7 +27,7 @@ pub struct GpuFrame {
     pub n_vertices: u32,
     pub n_lights: u32,
     pub light_cdf: u32,
-    /// 0 none, 1 constant, 2 map.
+    /// [`EnvKind`](crate::tags::EnvKind) as `u32`.
     pub env_kind: u32,
     pub env_width: u32,
     pub env_height: u32,
@@ -34,7 +36,7 @@ pub struct GpuFrame {
     pub env_conditional: u32,
     pub scene_radius: f32,
     pub ray_epsilon: f32,
-    /// [`Strategy`](crate::integrator::Strategy) as `u32`.
+    /// [`Strategy`](crate::tags::Strategy) as `u32`.
     pub strategy: u32,
     pub pad: [u32; 3],
     pub env_color: [f32; 4],
@@ -42,16 +44,6 @@ pub struct GpuFrame {
     pub cam_forward: [f32; 4],
     pub cam_up: [f32; 4],
     pub cam_right: [f32; 4],
-}
-
-/// Material kinds (WGSL `MAT_*`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum MaterialKind {
-    Gltf = 0,
-    Analytic = 1,
-    Tabulated = 2,
-    Glint = 3,
 }
 
 /// WGSL `Material` (`shaders/render/scene.inc.wgsl`).
@@ -82,17 +74,6 @@ pub struct GpuMaterial {
     pub tab_offset: u32,
     /// The shading queue its hits go to.
     pub queue: u32,
-}
-
-/// Light kinds (WGSL `LIGHT_*`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
-pub enum LightKind {
-    Point = 0,
-    Spot = 1,
-    Directional = 2,
-    Triangle = 3,
-    Environment = 4,
 }
 
 /// WGSL `Light`.

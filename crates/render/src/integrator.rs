@@ -18,20 +18,7 @@ use crate::wavefront::Wavefront;
 use facet_gpu::{Gpu, shader};
 use std::time::Instant;
 
-/// How direct light is estimated. Every choice converges to the same image; [`Strategy::Mis`]
-/// has the least noise, the others are for checking it.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-#[repr(u32)]
-pub enum Strategy {
-    /// Light sampling and BSDF sampling, combined by the power heuristic (Veach 1997).
-    #[default]
-    Mis = 0,
-    /// Light sampling alone: emission that a BSDF-sampled ray finds counts only when light
-    /// sampling could not have found it.
-    Light = 1,
-    /// BSDF sampling alone: only delta lights (point, spot, directional) are sampled.
-    Bsdf = 2,
-}
+pub use crate::tags::Strategy;
 
 /// Settings of one render.
 #[derive(Clone, Copy, Debug, PartialEq)]

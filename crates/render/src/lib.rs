@@ -33,6 +33,7 @@ pub mod queues;
 pub mod resources;
 pub mod scene;
 pub mod stages;
+pub mod tags;
 pub mod tonemap;
 pub mod trace;
 pub mod wavefront;

@@ -11,6 +11,7 @@ use crate::gpu_types::{GpuLight, GpuMaterial, LightKind, MaterialKind, NONE};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::scene::{Environment, FacetModel, Light, Scene};
+use crate::tags::EnvKind;
 use facet_fit::microfacet::{Ndf, NdfKind};
 use facet_glint::dpf::DpfConfig;
 use facet_glint::gpu::{GlintEvalParams, GlintField, GpuDpf};
@@ -465,10 +466,10 @@ impl SceneResources {
             triangle_light.push(NONE);
         }
         let (mut env_kind, mut env_size, mut env_offsets, mut env_color) =
-            (0, (1, 1), (0, 0, 0), [0.0; 4]);
+            (EnvKind::None as u32, (1, 1), (0, 0, 0), [0.0; 4]);
         match environment {
             Some(Environment::Constant(c)) => {
-                env_kind = 1;
+                env_kind = EnvKind::Constant as u32;
                 env_color = c.extend(0.0).to_array();
                 if lum(*c) > 0.0 {
                     lights.push(GpuLight {
@@ -480,7 +481,7 @@ impl SceneResources {
                 }
             }
             Some(Environment::Map(map)) => {
-                env_kind = 2;
+                env_kind = EnvKind::Map as u32;
                 env_size = (map.width, map.height);
                 let source = format!("the environment map {}", map.path.display());
                 // Checked before the copy into the tables: the map is the largest input.

@@ -1,0 +1,187 @@
+//! The closed sets the Rust side and the WGSL stages share — material and light kinds, the
+//! environment's kind, the sampling strategy, the path-state regions and the slot states —
+//! written once, here. [`wgsl`] renders them as WGSL constants; the committed
+//! `shaders/render/tags.inc.wgsl` is its output (`cargo test -p facet-render --test tags`
+//! fails when the two differ; `FACET_REGENERATE=1` rewrites the file) and no other WGSL file
+//! may define a constant with one of the prefixes.
+
+/// Declares a `#[repr(u32)]` enum whose variants are WGSL constants `PREFIX` + name.
+macro_rules! tags {
+    ($(#[$meta:meta])* $name:ident, $prefix:literal {
+        $($(#[doc = $doc:literal])* $variant:ident = $value:literal => $wgsl:literal,)+
+    }) => {
+        $(#[$meta])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[repr(u32)]
+        pub enum $name {
+            $($(#[doc = $doc])* $variant = $value,)+
+        }
+
+        impl $name {
+            pub const ALL: &[$name] = &[$($name::$variant),+];
+            pub const WGSL_PREFIX: &str = $prefix;
+
+            /// The WGSL constant's name.
+            pub const fn wgsl_name(self) -> &'static str {
+                match self {
+                    $($name::$variant => concat!($prefix, $wgsl),)+
+                }
+            }
+
+            /// The first line of the variant's doc, for the WGSL comment.
+            pub const fn doc(self) -> &'static str {
+                match self {
+                    $($name::$variant => tags!(@first $($doc)*),)+
+                }
+            }
+        }
+    };
+    (@first) => { "" };
+    (@first $first:literal $($rest:literal)*) => { $first };
+}
+
+tags!(
+    /// Material kinds (`Material.kind`).
+    MaterialKind, "MAT_" {
+        /// a glTF metallic-roughness material
+        Gltf = 0 => "GLTF",
+        /// a fit's GGX or Beckmann model
+        Analytic = 1 => "ANALYTIC",
+        /// a fit's tabulated NDF
+        Tabulated = 2 => "TABULATED",
+        /// a glint material
+        Glint = 3 => "GLINT",
+    }
+);
+
+tags!(
+    /// Light kinds (`Light.kind`).
+    LightKind, "LIGHT_" {
+        /// KHR_lights_punctual point light
+        Point = 0 => "POINT",
+        /// KHR_lights_punctual spot light
+        Spot = 1 => "SPOT",
+        /// KHR_lights_punctual directional light
+        Directional = 2 => "DIRECTIONAL",
+        /// an emissive triangle
+        Triangle = 3 => "TRIANGLE",
+        /// the environment (constant or map)
+        Environment = 4 => "ENVIRONMENT",
+    }
+);
+
+tags!(
+    /// What a ray that leaves the scene sees (`Frame.env_kind`).
+    EnvKind, "ENV_" {
+        /// black
+        None = 0 => "NONE",
+        /// a constant radiance (`Frame.env_color`)
+        Constant = 1 => "CONSTANT",
+        /// an equirectangular map with its sampling tables
+        Map = 2 => "MAP",
+    }
+);
+
+tags!(
+    /// How direct light is estimated (`Frame.strategy`). Every choice converges to the same
+    /// image; [`Strategy::Mis`] has the least noise, the others are for checking it.
+    Strategy, "STRATEGY_" {
+        /// light and BSDF sampling combined by the power heuristic (Veach 1997)
+        Mis = 0 => "MIS",
+        /// light sampling alone: emission a BSDF ray finds counts only if light sampling cannot
+        Light = 1 => "LIGHT",
+        /// BSDF sampling alone: only delta lights (point, spot, directional) are sampled
+        Bsdf = 2 => "BSDF",
+    }
+);
+
+// By hand: `tags!` takes doc attributes only on variants.
+#[allow(clippy::derivable_impls)]
+impl Default for Strategy {
+    fn default() -> Self {
+        Strategy::Mis
+    }
+}
+
+tags!(
+    /// Regions of the path state: one vec4 per slot each, region r of slot s at
+    /// `paths[r · wavefront + s]`.
+    Region, "R_" {
+        /// xyz origin, w cone width at the origin
+        Origin = 0 => "ORIGIN",
+        /// xyz direction, w cone spread angle
+        Dir = 1 => "DIR",
+        /// rgb throughput β, w pdf of the BSDF sample that made the ray (0: no MIS)
+        Beta = 2 => "BETA",
+        /// rgb radiance so far
+        L = 3 => "L",
+        /// t, primitive (bits), barycentrics u, v
+        Hit = 4 => "HIT",
+        /// xyz shadow-ray origin, w tmax
+        ShadowOrigin = 5 => "SHADOW_O",
+        /// xyz shadow-ray direction
+        ShadowDir = 6 => "SHADOW_D",
+        /// rgb unoccluded contribution
+        ShadowContribution = 7 => "SHADOW_C",
+    }
+);
+
+tags!(
+    /// What a slot holds (`info.x`).
+    SlotState, "SLOT_" {
+        /// nothing yet: start a path
+        Start = 0 => "START",
+        /// a ray to trace
+        Flying = 1 => "FLYING",
+        /// a finished path to accumulate
+        Ended = 2 => "ENDED",
+        /// all its samples done
+        Idle = 3 => "IDLE",
+    }
+);
+
+/// One tag enum: its Rust name, its WGSL prefix and its (WGSL name, value, doc) constants.
+pub struct TagSet {
+    pub rust: &'static str,
+    pub prefix: &'static str,
+    pub tags: Vec<(&'static str, u32, &'static str)>,
+}
+
+/// Every tag set.
+pub fn all() -> Vec<TagSet> {
+    macro_rules! set {
+        ($t:ident) => {
+            TagSet {
+                rust: stringify!($t),
+                prefix: $t::WGSL_PREFIX,
+                tags: $t::ALL
+                    .iter()
+                    .map(|&v| (v.wgsl_name(), v as u32, v.doc()))
+                    .collect(),
+            }
+        };
+    }
+    vec![
+        set!(MaterialKind),
+        set!(LightKind),
+        set!(EnvKind),
+        set!(Strategy),
+        set!(Region),
+        set!(SlotState),
+    ]
+}
+
+/// The committed `shaders/render/tags.inc.wgsl`, generated.
+pub fn wgsl() -> String {
+    let mut s = String::from(
+        "// Include-only. Generated from facet_render::tags (crates/render/src/tags.rs): do not edit;\n\
+         // `FACET_REGENERATE=1 cargo test -p facet-render --test tags` rewrites it.\n",
+    );
+    for set in all() {
+        s += &format!("\n// facet_render::tags::{}\n", set.rust);
+        for (name, value, doc) in set.tags {
+            s += &format!("const {name}: u32 = {value}u; // {}\n", doc.trim());
+        }
+    }
+    s
+}
