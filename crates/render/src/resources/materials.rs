@@ -1,0 +1,168 @@
+//! A scene material to its GPU record: the one conversion both the first upload and
+//! [`SceneResources::update_material`](super::SceneResources::update_material) use.
+
+use super::tables::Tables;
+use crate::error::RenderError;
+use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
+use crate::queues::Queue;
+use crate::scene::{FacetModel, GlintParams, Material};
+use facet_fit::material::ModelChoice;
+use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+use facet_fit::tabulated::TabulatedNdf;
+
+/// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
+pub const FRESNEL_NODES: usize = 91;
+
+/// What one material needs on the GPU: its record (table offsets and queue still to be
+/// assigned), its Fresnel table, its tabulated NDF, its glint parameters.
+pub struct MaterialPlan<'a> {
+    pub gpu: GpuMaterial,
+    /// F(θd) at FRESNEL_NODES nodes, RGB interleaved (fitted materials).
+    pub fresnel: Option<Vec<f32>>,
+    pub tabulated: Option<&'a TabulatedNdf>,
+    /// A glint material's NDF and parameters.
+    pub glint: Option<(AnalyticNdf, GlintParams)>,
+}
+
+impl MaterialPlan<'_> {
+    /// Whether `self` fits in place of `old` (the record uploaded before): the same class and
+    /// NDF kind, no glints, so the same tables at the same offsets.
+    pub fn fits_in_place_of(&self, old: &GpuMaterial) -> Result<(), &'static str> {
+        if self.glint.is_some() || old.kind == MaterialKind::Glint as u32 {
+            return Err("glint materials are rebuilt");
+        }
+        if self.gpu.kind != old.kind || self.gpu.ndf_kind != old.ndf_kind {
+            return Err("the material class changed");
+        }
+        if self.fresnel.is_none() {
+            return Err("not a fitted material");
+        }
+        Ok(())
+    }
+
+    /// Appends the plan's tables (Fresnel, tabulated NDF) to `tables` and sets their offsets.
+    pub fn place_tables(&mut self, tables: &mut Tables, source: &str) {
+        if let Some(f) = &self.fresnel {
+            self.gpu.fresnel_offset = tables.push(source, f.iter().copied());
+            self.gpu.fresnel_count = FRESNEL_NODES as u32;
+        }
+        if let Some(tab) = self.tabulated {
+            let tt = tab.tables();
+            let (cdf, cell_pdf) = tab.sampling_tables();
+            let header = [tt.nu as f32, tt.nphi as f32, tt.ng as f32, 0.0];
+            self.gpu.tab_offset = tables.push(source, header);
+            tables.push(source, tt.d.iter().map(|v| *v as f32));
+            tables.push(source, tt.g1.iter().map(|v| *v as f32));
+            tables.push(source, cdf.iter().map(|v| *v as f32));
+            tables.push(source, cell_pdf.iter().map(|v| *v as f32));
+        }
+    }
+}
+
+fn texture(t: Option<u32>) -> u32 {
+    t.unwrap_or(NONE)
+}
+
+/// The plan of material `m`. A fitted material takes its model's NDF, Fresnel and diffuse term;
+/// a glint material needs an analytic model.
+pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
+    let mut gpu = GpuMaterial {
+        base_color: m.base_color.to_array(),
+        emissive: m.emissive.extend(m.specular).to_array(),
+        kind: MaterialKind::Gltf as u32,
+        alpha_x: 1.0,
+        alpha_y: 1.0,
+        metallic: m.metallic,
+        roughness: m.roughness,
+        normal_scale: m.normal_scale,
+        tex_base: texture(m.base_color_texture),
+        tex_mr: texture(m.metallic_roughness_texture),
+        tex_normal: texture(m.normal_texture),
+        tex_emissive: texture(m.emissive_texture),
+        queue: Queue::Diffuse.index(),
+        ..Default::default()
+    };
+    let Some(f) = &m.facet else {
+        return Ok(MaterialPlan {
+            gpu,
+            fresnel: None,
+            tabulated: None,
+            glint: None,
+        });
+    };
+    let choice = match f.model {
+        FacetModel::Tabulated => ModelChoice::Tabulated,
+        FacetModel::Ggx => ModelChoice::Ggx,
+        FacetModel::Beckmann => ModelChoice::Beckmann,
+    };
+    let brdf = f.fit.model(choice).ok_or_else(|| {
+        RenderError::input(
+            &f.source,
+            format!("material {:?}: the fit has no {:?} model", m.name, f.model),
+        )
+    })?;
+    let fresnel: Vec<f32> = (0..FRESNEL_NODES)
+        .flat_map(|j| {
+            let theta_d = j as f64 / (FRESNEL_NODES - 1) as f64 * std::f64::consts::FRAC_PI_2;
+            brdf.fresnel.eval(theta_d.cos()).map(|v| v as f32)
+        })
+        .collect();
+    gpu.diffuse = [
+        brdf.diffuse[0] as f32,
+        brdf.diffuse[1] as f32,
+        brdf.diffuse[2] as f32,
+        0.0,
+    ];
+    let mut tabulated = None;
+    match &brdf.ndf {
+        Ndf::Analytic(a) => {
+            gpu.kind = MaterialKind::Analytic as u32;
+            gpu.ndf_kind = match a.kind {
+                NdfKind::Ggx => 0,
+                NdfKind::Beckmann => 1,
+            };
+            (gpu.alpha_x, gpu.alpha_y) = (a.alpha_x as f32, a.alpha_y as f32);
+            gpu.rotation = a.rotation as f32;
+            gpu.roughness = (a.alpha_x * a.alpha_y).sqrt() as f32;
+            gpu.queue = Queue::Analytic.index();
+        }
+        Ndf::Tabulated(tab) => {
+            // The ray cone widens by the fit's GGX α where there is one.
+            let cone_alpha = f
+                .fit
+                .record
+                .ggx
+                .as_ref()
+                .map_or(0.3, |p| (p.alpha_x * p.alpha_y).sqrt() as f32);
+            gpu.kind = MaterialKind::Tabulated as u32;
+            let s = &tab.stretch;
+            (gpu.alpha_x, gpu.alpha_y) = (s.alpha_x as f32, s.alpha_y as f32);
+            gpu.rotation = s.rotation as f32;
+            gpu.roughness = cone_alpha * (s.alpha_x * s.alpha_y).sqrt() as f32;
+            gpu.queue = Queue::Tabulated.index();
+            tabulated = Some(tab.as_ref());
+        }
+    }
+    let glint = match (f.glint, &brdf.ndf) {
+        (None, _) => None,
+        (Some(g), Ndf::Analytic(a)) => {
+            gpu.kind = MaterialKind::Glint as u32;
+            Some((*a, g))
+        }
+        (Some(_), Ndf::Tabulated(_)) => {
+            return Err(RenderError::input(
+                &f.source,
+                format!(
+                    "material {:?}: glints need the fit's GGX or Beckmann model, not the tabulated one",
+                    m.name
+                ),
+            ));
+        }
+    };
+    Ok(MaterialPlan {
+        gpu,
+        fresnel: Some(fresnel),
+        tabulated,
+        glint,
+    })
+}

@@ -1,0 +1,411 @@
+//! What the renderer builds on the GPU for one scene, and the record of it.
+//!
+//! Only what the scene uses is made: a shading pipeline per material class present, a DPF
+//! pyramid (two levels) per glint material, the environment's tables only with an environment,
+//! the per-triangle light index only when a triangle emits. [`Built`] records each of them so
+//! callers (and tests) can see what a scene cost.
+
+mod environment;
+mod glints;
+mod lights;
+pub mod materials;
+mod tables;
+mod textures;
+
+pub use materials::FRESNEL_NODES;
+
+use crate::bvh::{Bvh, BvhConfig, GpuBvh};
+use crate::error::RenderError;
+use crate::gpu_types::{GpuLight, GpuMaterial};
+use crate::limits::{DeviceLimits, Planned, product};
+use crate::queues::Queue;
+use crate::scene::{Environment, Scene};
+use facet_glint::dpf::DpfConfig;
+use facet_glint::gpu::GpuDpf;
+use facet_gpu::{Gpu, buffer};
+use lights::LightSet;
+use tables::Tables;
+
+/// The record of what was built for a scene.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Built {
+    /// Material classes with a shading pipeline, by name ("diffuse", "analytic", "tabulated",
+    /// "glint").
+    pub classes: Vec<&'static str>,
+    /// DPF pyramids (one per glint material) and their levels in degrees.
+    pub glint_pyramids: Vec<Vec<f64>>,
+    pub textures: usize,
+    pub environment_map: bool,
+    pub tabulated_tables: usize,
+    pub emissive_triangles: usize,
+    pub lights: usize,
+    pub bvh_nodes: usize,
+    pub bvh_build_ms: f64,
+    pub glint_build_ms: f64,
+}
+
+/// One glint material's GPU resources (bind group 2 of its shading stage).
+pub struct GlintResources {
+    pub material: u32,
+    pub dpf: GpuDpf,
+    pub field: wgpu::Buffer,
+    pub params: wgpu::Buffer,
+    pub level0: wgpu::TextureView,
+    pub level1: wgpu::TextureView,
+}
+
+/// The scene on the GPU (bind group 1 of every stage).
+pub struct SceneResources {
+    pub bvh: GpuBvh,
+    pub vertices: wgpu::Buffer,
+    pub triangles: wgpu::Buffer,
+    pub materials: wgpu::Buffer,
+    pub textures: wgpu::Buffer,
+    pub lights: wgpu::Buffer,
+    pub tables: wgpu::Buffer,
+    pub triangle_light: wgpu::Buffer,
+    pub glints: Vec<GlintResources>,
+    /// Which shading queues have hits routed to them.
+    pub queues_used: Vec<Queue>,
+    pub n_vertices: u32,
+    pub n_lights: u32,
+    pub light_cdf: u32,
+    pub env_kind: u32,
+    pub env_size: (u32, u32),
+    pub env_offsets: (u32, u32, u32),
+    pub env_color: [f32; 4],
+    pub scene_radius: f32,
+    pub built: Built,
+    /// The materials as uploaded (for [`SceneResources::update_material`]).
+    pub material_data: Vec<GpuMaterial>,
+}
+
+/// Settings of the resources that are not in the scene file.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ResourceConfig {
+    pub bvh: BvhConfig,
+    /// DPF table resolution of glint materials.
+    pub dpf: DpfConfig,
+    /// Whether the glint count may be replaced by its mean above the threshold.
+    pub glint_filter: bool,
+}
+
+impl ResourceConfig {
+    pub const fn standard() -> Self {
+        ResourceConfig {
+            bvh: BvhConfig::medium(),
+            dpf: DpfConfig::standard(),
+            glint_filter: true,
+        }
+    }
+}
+
+impl SceneResources {
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        environment: Option<&Environment>,
+        config: ResourceConfig,
+    ) -> Result<Self, RenderError> {
+        validate(scene)?;
+        let d = &gpu.device;
+        let limits = DeviceLimits::of(d);
+        let mut built = Built::default();
+        let mut tables = Tables::default();
+
+        let t = std::time::Instant::now();
+        let bvh = Bvh::build(&scene.positions, &scene.indices, config.bvh);
+        built.bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
+        built.bvh_nodes = bvh.cwbvh.nodes.len();
+        let bvh_set_by = format!("the scene ({} triangles)", scene.indices.len());
+        limits.check(&[
+            Planned::storage(
+                "the BVH nodes",
+                product(&[bvh.cwbvh.nodes.len() as u64, 80]),
+                &bvh_set_by,
+            ),
+            Planned::storage(
+                "the BVH primitives",
+                product(&[bvh.cwbvh.primitive_indices.len() as u64, 4]),
+                &bvh_set_by,
+            ),
+            Planned::storage(
+                "the BVH triangles",
+                product(&[bvh.cwbvh.primitive_indices.len() as u64, 48]),
+                &bvh_set_by,
+            ),
+        ])?;
+        let gpu_bvh = GpuBvh::upload(d, &bvh)?;
+
+        // Vertices: four regions of n vectors (position, normal, tangent, uv).
+        let n = scene.positions.len();
+        let mut vertices: Vec<[f32; 4]> = Vec::with_capacity(4 * n);
+        vertices.extend(scene.positions.iter().map(|p| p.extend(1.0).to_array()));
+        vertices.extend(scene.normals.iter().map(|p| p.extend(0.0).to_array()));
+        vertices.extend(scene.tangents.iter().map(|t| t.to_array()));
+        vertices.extend(scene.uvs.iter().map(|u| [u.x, u.y, 0.0, 0.0]));
+        let triangles: Vec<[u32; 4]> = scene
+            .indices
+            .iter()
+            .zip(&scene.triangle_material)
+            .map(|(i, m)| [i[0], i[1], i[2], *m])
+            .collect();
+
+        // Materials, their Fresnel and NDF tables; glint materials get a queue each.
+        let mut materials = Vec::with_capacity(scene.materials.len());
+        let mut glint_specs = Vec::new();
+        for (mi, m) in scene.materials.iter().enumerate() {
+            let mut plan = materials::plan(m)?;
+            if let Some(f) = &m.facet {
+                plan.place_tables(
+                    &mut tables,
+                    &format!("the fit {} of material `{}`", f.source.display(), m.name),
+                );
+            }
+            if plan.tabulated.is_some() {
+                built.tabulated_tables += 1;
+            }
+            if let Some((ndf, spec)) = plan.glint {
+                plan.gpu.queue = Queue::Glint(glint_specs.len() as u32).index();
+                glint_specs.push((mi as u32, ndf, spec));
+            }
+            materials.push(plan.gpu);
+        }
+        // Only materials some triangle uses decide which pipelines and pyramids are built.
+        let mut used = vec![false; materials.len()];
+        for &m in &scene.triangle_material {
+            used[m as usize] = true;
+        }
+        let mut queues_used: Vec<Queue> = materials
+            .iter()
+            .zip(&used)
+            .filter(|(_, u)| **u)
+            .map(|(m, _)| Queue::from_index(m.queue))
+            .collect();
+        queues_used.sort_by_key(|q| q.index());
+        queues_used.dedup();
+        built.classes = queues_used.iter().map(|q| q.class_name()).collect();
+        built.classes.dedup();
+
+        let t = std::time::Instant::now();
+        let mut glints = Vec::new();
+        for (mi, ndf, spec) in glint_specs {
+            if used[mi as usize] {
+                let (g, levels) = glints::build(gpu, &limits, &config, mi, ndf, spec)?;
+                glints.push(g);
+                built.glint_pyramids.push(levels);
+            }
+        }
+        built.glint_build_ms = t.elapsed().as_secs_f64() * 1e3;
+
+        let tex_words = textures::texture_words(&scene.textures);
+        built.textures = scene.textures.len();
+
+        let (lo, hi) = scene.bounds();
+        let radius = (0.5 * (hi - lo).length()).max(1e-3);
+        let mut light_set = LightSet::new(scene, &materials, radius);
+        built.emissive_triangles = light_set.emissive_triangles();
+        let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
+        built.environment_map = env.kind == crate::tags::EnvKind::Map;
+        let light_cdf = light_set.place_cdf(&mut tables);
+        let LightSet {
+            mut lights,
+            triangle_light,
+            ..
+        } = light_set;
+        built.lights = lights.len();
+        if lights.is_empty() {
+            lights.push(GpuLight::default());
+        }
+        if tables.words.is_empty() {
+            tables.words.push(0.0);
+        }
+        let size_of = |n: usize, each: usize| product(&[n as u64, each as u64]);
+        let n_tri = scene.indices.len();
+        let largest = scene
+            .textures
+            .iter()
+            .max_by_key(|t| u64::from(t.width) * u64::from(t.height))
+            .map_or(String::new(), |t| {
+                format!("; the largest, {}, is {}×{}", t.name, t.width, t.height)
+            });
+        limits.check(&[
+            Planned::storage(
+                "the vertex buffer",
+                size_of(vertices.len(), 16),
+                format!("the scene ({n} vertices)"),
+            ),
+            Planned::storage(
+                "the triangle buffer",
+                size_of(triangles.len(), 16),
+                format!("the scene ({n_tri} triangles)"),
+            ),
+            Planned::storage(
+                "the material buffer",
+                size_of(materials.len(), std::mem::size_of::<GpuMaterial>()),
+                format!("the scene ({} materials)", materials.len()),
+            ),
+            Planned::storage(
+                "the texture buffer",
+                size_of(tex_words.len(), 4),
+                format!("the scene's {} textures{largest}", scene.textures.len()),
+            ),
+            Planned::storage(
+                "the light buffer",
+                size_of(lights.len(), std::mem::size_of::<GpuLight>()),
+                format!(
+                    "the scene ({} punctual lights, {} emissive triangles)",
+                    scene.lights.len(),
+                    built.emissive_triangles
+                ),
+            ),
+            Planned::storage(
+                "the scene tables",
+                size_of(tables.words.len(), 4),
+                tables.described(),
+            ),
+            Planned::storage(
+                "the per-triangle light index",
+                size_of(triangle_light.len(), 4),
+                format!("the scene ({n_tri} triangles)"),
+            ),
+        ])?;
+
+        let res = gpu.scoped(|| SceneResources {
+            vertices: buffer::storage(d, "vertices", &vertices),
+            triangles: buffer::storage(d, "triangles", &triangles),
+            materials: buffer::storage(d, "materials", &materials),
+            material_data: materials.clone(),
+            textures: buffer::storage(d, "textures", &tex_words),
+            lights: buffer::storage(d, "lights", &lights),
+            tables: buffer::storage(d, "tables", &tables.words),
+            triangle_light: buffer::storage(d, "triangle lights", &triangle_light),
+            bvh: gpu_bvh,
+            glints,
+            queues_used,
+            n_vertices: n as u32,
+            n_lights: built.lights as u32,
+            light_cdf,
+            env_kind: env.kind as u32,
+            env_size: env.size,
+            env_offsets: env.offsets,
+            env_color: env.color,
+            scene_radius: radius,
+            built,
+        })?;
+        Ok(res)
+    }
+}
+
+impl SceneResources {
+    /// Rewrites material `index` in place from `scene.materials[index]`: its α, rotation,
+    /// Fresnel table and diffuse albedo, at the offsets it already has. Edits that change
+    /// the material's class, its NDF kind, its tables or its glint pyramids (another fit,
+    /// glints on or off, a glint material's α or γ) return `Err`: those need new resources.
+    pub fn update_material(
+        &mut self,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        index: usize,
+    ) -> Result<(), RenderError> {
+        let rebuild = |why: &str| Err(RenderError::Scene(format!("material {index}: {why}")));
+        let (Some(m), Some(old)) = (scene.materials.get(index), self.material_data.get(index))
+        else {
+            return rebuild("no such material");
+        };
+        let plan = materials::plan(m)?;
+        if let Err(why) = plan.fits_in_place_of(old) {
+            return rebuild(why);
+        }
+        // The new values at the old offsets, in the old queue.
+        let g = GpuMaterial {
+            fresnel_offset: old.fresnel_offset,
+            fresnel_count: old.fresnel_count,
+            tab_offset: old.tab_offset,
+            queue: old.queue,
+            ..plan.gpu
+        };
+        let fres = plan.fresnel.expect("checked by fits_in_place_of");
+        queue.write_buffer(
+            &self.tables,
+            4 * g.fresnel_offset as u64,
+            bytemuck::cast_slice(&fres),
+        );
+        queue.write_buffer(
+            &self.materials,
+            (index * std::mem::size_of::<GpuMaterial>()) as u64,
+            bytemuck::bytes_of(&g),
+        );
+        self.material_data[index] = g;
+        Ok(())
+    }
+}
+
+/// The invariants the GPU code relies on; a scene from the loader always meets them, one built in
+/// code might not.
+pub fn validate(scene: &Scene) -> Result<(), RenderError> {
+    let n = scene.positions.len();
+    let bad = |what: String| Err(RenderError::Scene(what));
+    if scene.indices.is_empty() {
+        return bad("the scene has no triangles".into());
+    }
+    if scene.normals.len() != n || scene.uvs.len() != n || scene.tangents.len() != n {
+        return bad(format!(
+            "{n} positions but {} normals, {} uvs, {} tangents",
+            scene.normals.len(),
+            scene.uvs.len(),
+            scene.tangents.len()
+        ));
+    }
+    if scene.triangle_material.len() != scene.indices.len() {
+        return bad("one material per triangle is needed".into());
+    }
+    if let Some(i) = (0..n).find(|&i| {
+        !(scene.positions[i].is_finite()
+            && scene.normals[i].is_finite()
+            && scene.uvs[i].is_finite()
+            && scene.tangents[i].is_finite())
+    }) {
+        return bad(format!("vertex {i} is not finite"));
+    }
+    if let Some((t, _)) = scene
+        .indices
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&i| i as usize >= n))
+    {
+        return bad(format!("triangle {t} indexes past the {n} vertices"));
+    }
+    if let Some(t) = scene
+        .triangle_material
+        .iter()
+        .position(|&m| m as usize >= scene.materials.len())
+    {
+        return bad(format!("triangle {t} has no material"));
+    }
+    if let Some(m) = scene.materials.iter().find(|m| {
+        [
+            m.base_color_texture,
+            m.metallic_roughness_texture,
+            m.normal_texture,
+            m.emissive_texture,
+        ]
+        .iter()
+        .flatten()
+        .any(|&t| t as usize >= scene.textures.len())
+    }) {
+        return bad(format!("material {:?} names a missing texture", m.name));
+    }
+    let glints = scene
+        .materials
+        .iter()
+        .filter(|m| m.facet.as_ref().is_some_and(|f| f.glint.is_some()))
+        .count();
+    if glints > crate::queues::MAX_GLINT_MATERIALS as usize {
+        return bad(format!(
+            "{glints} glint materials; at most {} are supported",
+            crate::queues::MAX_GLINT_MATERIALS
+        ));
+    }
+    Ok(())
+}
