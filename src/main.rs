@@ -1,6 +1,7 @@
 //! `facet`: measured materials to microfacet models.
 
 mod args;
+mod bench_cmd;
 mod demo_cmd;
 mod dpf_cmd;
 mod fit_cmd;
@@ -30,6 +31,8 @@ enum Command {
     Render(render_cmd::RenderArgs),
     /// Fit the embedded default material and render the demo scene with it (the default).
     Demo(demo_cmd::DemoArgs),
+    /// Measure the fitter, ray tracing, the integrator, glints and the preview on this adapter.
+    Bench(bench_cmd::BenchArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -41,6 +44,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),
+        Some(Command::Bench(args)) => bench_cmd::run(&args),
         None => demo_cmd::run(&demo_cmd::DemoArgs::defaults()),
     };
     match result {

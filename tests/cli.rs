@@ -707,3 +707,72 @@ fn demo_runs_and_writes_what_the_readme_says() {
     let mean: f64 = px.iter().map(|p| p[1] as f64).sum::<f64>() / px.len() as f64;
     assert!(mean > 0.02 && mean.is_finite(), "mean green {mean}");
 }
+
+/// `facet bench --smoke`: every section of the report is there, with finite positive figures,
+/// the adapter, the commit and the date.
+#[test]
+fn bench_smoke_reports_every_section() {
+    if facet_gpu::gpu_for_tests("bench_smoke_reports_every_section").is_none() {
+        return;
+    }
+    let dir = common::scratch("cli_bench");
+    let json = dir.join("bench.json");
+    let (ok, stdout, err) = facet(&["bench", "--smoke", "--json", json.to_str().unwrap()]);
+    assert!(ok, "{stdout}\n{err}");
+    println!("{stdout}");
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let positive = |v: &serde_json::Value, what: &str| {
+        let x = v.as_f64().unwrap_or_else(|| panic!("{what}: {v}"));
+        assert!(x.is_finite() && x > 0.0, "{what}: {x}");
+    };
+    assert_eq!(r["mode"], "smoke");
+    assert!(r["commit"].as_str().is_some_and(|c| !c.is_empty()));
+    assert!(
+        r["date"]
+            .as_str()
+            .is_some_and(|d| d.len() == 20 && d.starts_with("20")),
+        "{}",
+        r["date"]
+    );
+    assert!(r["adapter"]["name"].as_str().is_some_and(|n| !n.is_empty()));
+    let fit = r["fit"].as_array().unwrap();
+    assert_eq!(fit.len(), 6, "3 cases × CPU and GPU");
+    for row in fit {
+        positive(&row["median_ms"], "fit ms");
+    }
+    let trace = r["trace"].as_array().unwrap();
+    assert_eq!(trace.len(), 4, "camera and random rays × closest and any");
+    for row in trace {
+        positive(&row["mrays_per_s"], "Mrays/s");
+    }
+    let integrator = r["integrator"].as_array().unwrap();
+    assert_eq!(integrator.len(), 2);
+    for row in integrator {
+        positive(&row["msamples_per_s"], "Msamples/s");
+    }
+    let stages: Vec<&str> = r["stages"]["with_glints"]["stages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["stage"].as_str().unwrap())
+        .collect();
+    for s in [
+        "logic",
+        "generate",
+        "extend",
+        "shade glint 0",
+        "connect",
+        "close shade",
+    ] {
+        assert!(stages.contains(&s), "{s} missing from {stages:?}");
+    }
+    assert!(
+        r["glint"]["overhead_percent"]
+            .as_f64()
+            .is_some_and(f64::is_finite)
+    );
+    positive(&r["glint"]["dpf_build_ms"], "DPF build");
+    positive(&r["viewer"]["frames_per_s"], "viewer frames/s");
+    positive(&r["viewer"]["msamples_per_s"], "viewer Msamples/s");
+}

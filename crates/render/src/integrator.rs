@@ -233,6 +233,19 @@ impl Integrator {
         wf: &Wavefront,
         all_slots: (u32, u32),
     ) {
+        self.iteration_by_stage(wf, all_slots, &mut |_, encode| encode(pass));
+    }
+
+    /// One iteration, stage by stage: `each(name, encode)` gets every stage (the queue closes
+    /// too) in order and encodes it into a pass of its choice — one shared pass, or one pass
+    /// per stage for timing. Names: "logic", "generate", "extend", "shade <class>", "connect",
+    /// and "close <queue>" for the queue closes.
+    pub(crate) fn iteration_by_stage(
+        &self,
+        wf: &Wavefront,
+        all_slots: (u32, u32),
+        each: &mut dyn FnMut(&str, &mut dyn FnMut(&mut wgpu::ComputePass)),
+    ) {
         let (frame_group, scene_group, glint_groups) =
             (&wf.frame_group, &wf.scene_group, &wf.glint_groups);
         let (args_group, args) = (&wf.args_group, wf.args());
@@ -255,16 +268,21 @@ impl Integrator {
                 None => pass.dispatch_workgroups(all_slots.0, all_slots.1, 1),
             }
         };
-        run(pass, &self.logic);
-        close(pass, &self.close_gen);
-        run(pass, &self.generate);
-        close(pass, &self.close_extend);
-        run(pass, &self.extend);
-        close(pass, &self.close_shade);
+        each("logic", &mut |p| run(p, &self.logic));
+        each("close generate", &mut |p| close(p, &self.close_gen));
+        each("generate", &mut |p| run(p, &self.generate));
+        each("close extend", &mut |p| close(p, &self.close_extend));
+        each("extend", &mut |p| run(p, &self.extend));
+        each("close shade", &mut |p| close(p, &self.close_shade));
         for s in &self.shade {
-            run(pass, s);
+            let name = match s.queue {
+                Some(Queue::Glint(k)) => format!("shade glint {k}"),
+                Some(q) => format!("shade {}", q.class_name()),
+                None => s.name.to_string(),
+            };
+            each(&name, &mut |p| run(p, s));
         }
-        close(pass, &self.close_shadow);
-        run(pass, &self.connect);
+        each("close shadow", &mut |p| close(p, &self.close_shadow));
+        each("connect", &mut |p| run(p, &self.connect));
     }
 }

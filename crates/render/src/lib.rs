@@ -46,4 +46,4 @@ pub use integrator::{Integrator, RenderConfig, RenderStats, Strategy};
 pub use obvhs;
 pub use resources::{Built, ResourceConfig, SceneResources};
 pub use trace::{GpuHit, GpuRay, RayTracer};
-pub use wavefront::Wavefront;
+pub use wavefront::{StageClock, StageTime, Wavefront};

@@ -12,6 +12,7 @@ use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::resources::SceneResources;
 use crate::tonemap::ToneMap;
+use facet_gpu::timer::GpuTimer;
 use facet_gpu::{Gpu, buffer};
 use std::time::Instant;
 
@@ -39,6 +40,36 @@ pub struct Wavefront {
     spp: u32,
     /// The tone-mapping pass, made on first use.
     tone_map: Option<ToneMap>,
+}
+
+/// The time one batch of a progressive preview aims at, ms (a frame at 60 Hz).
+pub const FRAME_MS: f64 = 16.0;
+/// The most samples per pixel in one preview batch.
+pub const MAX_SPP_PER_FRAME: u32 = 64;
+
+/// The next preview batch (spp): the last one, which took `ms`, scaled toward FRAME_MS, at
+/// most doubling or halving, within 1 … MAX_SPP_PER_FRAME.
+pub fn next_batch(spp: u32, ms: f64) -> u32 {
+    let scale = (FRAME_MS / ms.max(1e-3)).clamp(0.5, 2.0);
+    ((spp as f64 * scale).floor() as u32).clamp(1, MAX_SPP_PER_FRAME)
+}
+
+/// One stage's share of one iteration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StageTime {
+    /// "logic", "generate", "extend", "shade <class>", "connect", "close <queue>".
+    pub stage: String,
+    pub ms: f64,
+}
+
+/// How [`Wavefront::profile_iteration`] timed the stages.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StageClock {
+    /// GPU timestamps at the boundaries of one pass per stage.
+    Timestamps,
+    /// The wall clock around one submission per stage (no timestamp queries): includes the
+    /// submission and the wait, an upper bound.
+    Wall,
 }
 
 /// The frame uniform, assembled here only: the camera, the image, the scene's lights and
@@ -351,5 +382,82 @@ impl Wavefront {
         }
         let t = self.tone_map.as_ref().expect("made above");
         t.run(gpu, exposure)
+    }
+
+    /// Times each stage of one iteration in the middle of a render of the first tile: `warm`
+    /// iterations fill the queues, then one runs with every stage in its own pass, timed by GPU
+    /// timestamps where the device has them, else by the wall clock. The film is cleared after.
+    pub fn profile_iteration(
+        &mut self,
+        gpu: &Gpu,
+        integrator: &Integrator,
+        scene: &SceneResources,
+        camera: &CameraFrame,
+        config: &RenderConfig,
+        warm: u32,
+    ) -> Result<(Vec<StageTime>, StageClock), RenderError> {
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let pixels = self.width as u64 * self.height as u64;
+        let mut frame = frame_uniform(scene, camera, config, self.slots);
+        frame.tile_pixels = pixels.min(self.slots as u64) as u32;
+        frame.sample_end = config.spp.max(1);
+        q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
+        let start: Vec<[u32; 4]> = vec![[0, 0, 0, 0]; frame.tile_pixels as usize];
+        q.write_buffer(&self.info, 0, bytemuck::cast_slice(&start));
+        q.write_buffer(&self.counters, 0, &vec![0u8; self.n_queues as usize * 4]);
+        let all_slots = facet_gpu::dispatch::workgroups(self.slots, integrator.workgroup());
+        let mut enc = d.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            for _ in 0..warm {
+                integrator.iteration(&mut pass, self, all_slots);
+            }
+        }
+        q.submit([enc.finish()]);
+        let mut names = Vec::new();
+        let result = match GpuTimer::new(d, q, 64) {
+            Some(mut timer) => {
+                let mut enc = d.create_command_encoder(&Default::default());
+                integrator.iteration_by_stage(self, all_slots, &mut |name, encode| {
+                    names.push(name.to_string());
+                    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                        label: None,
+                        timestamp_writes: timer.pass(),
+                    });
+                    encode(&mut pass);
+                });
+                q.submit([enc.finish()]);
+                (timer.read_ms(d, q)?, StageClock::Timestamps)
+            }
+            None => {
+                d.poll(wgpu::PollType::wait_indefinitely())
+                    .map_err(|e| RenderError::Scene(format!("GPU wait: {e}")))?;
+                let mut ms = Vec::new();
+                let mut failed = None;
+                integrator.iteration_by_stage(self, all_slots, &mut |name, encode| {
+                    names.push(name.to_string());
+                    let t = Instant::now();
+                    let mut enc = d.create_command_encoder(&Default::default());
+                    encode(&mut enc.begin_compute_pass(&Default::default()));
+                    q.submit([enc.finish()]);
+                    if let Err(e) = d.poll(wgpu::PollType::wait_indefinitely()) {
+                        failed = Some(e);
+                    }
+                    ms.push(t.elapsed().as_secs_f64() * 1e3);
+                });
+                if let Some(e) = failed {
+                    return Err(RenderError::Scene(format!("GPU wait: {e}")));
+                }
+                (ms, StageClock::Wall)
+            }
+        };
+        gpu.check_lost()?;
+        self.clear(gpu);
+        let times = names
+            .into_iter()
+            .zip(result.0)
+            .map(|(stage, ms)| StageTime { stage, ms })
+            .collect();
+        Ok((times, result.1))
     }
 }

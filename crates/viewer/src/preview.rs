@@ -13,7 +13,7 @@ use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
 use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
@@ -22,10 +22,7 @@ use std::time::Instant;
 pub const SPHERE: usize = 1;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
-/// The time one batch of samples aims at, ms (a frame at 60 Hz).
-pub const FRAME_MS: f64 = 16.0;
-/// The most samples per pixel in one batch.
-pub const MAX_SPP_PER_FRAME: u32 = 64;
+pub use facet_render::wavefront::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
 
 /// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -195,25 +192,10 @@ impl Drop for Preview {
     }
 }
 
-/// The preview scene: a unit sphere (material [`SPHERE`]) on a grey plane.
+/// The preview scene: a unit sphere (material [`SPHERE`]) on a grey plane, seen by the default
+/// orbit.
 pub fn preview_scene(sphere: Material) -> Scene {
-    let mut scene = Scene::default();
-    scene.materials.push(Material {
-        name: "floor".into(),
-        base_color: Vec4::new(0.45, 0.45, 0.45, 1.0),
-        roughness: 0.8,
-        metallic: 0.0,
-        ..Material::default()
-    });
-    scene.materials.push(sphere);
-    scene.add_quad(
-        Vec3::new(-8.0, -1.0, 8.0),
-        Vec3::new(16.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -16.0),
-        4.0,
-        0,
-    );
-    scene.add_uv_sphere(Vec3::ZERO, 1.0, 96, 48, SPHERE as u32);
+    let mut scene = facet_render::scene::shapes::preview_scene(sphere);
     scene.camera = Orbit::default().camera();
     scene
 }
@@ -287,12 +269,6 @@ fn build(gpu: &Gpu, scene: &Scene, env: &Environment, size: (u32, u32)) -> Resul
         integrator,
         wavefront,
     })
-}
-
-/// The next batch size: the last one scaled toward FRAME_MS, at most doubling or halving.
-fn next_batch(spp: u32, ms: f64) -> u32 {
-    let scale = (FRAME_MS / ms.max(1e-3)).clamp(0.5, 2.0);
-    ((spp as f64 * scale).floor() as u32).clamp(1, MAX_SPP_PER_FRAME)
 }
 
 fn worker(

@@ -1,0 +1,487 @@
+//! `facet bench`: every speed figure of Facet in one process, on the adapter chosen as
+//! elsewhere (FACET_BACKEND, FACET_ADAPTER): the fitter (CPU and GPU backends), ray tracing,
+//! the integrator with and without glints and its stages, the DPF build, the viewer's preview
+//! path. Prints a table and writes JSON (`--json FILE`). Timings are medians of repeated runs
+//! after a warm-up, measured side by side in this one process.
+
+use crate::demo_cmd::demo_assets;
+use crate::fit_cmd::DEFAULT_MATERIAL;
+use anyhow::{Context, Result, bail};
+use clap::{Parser, ValueEnum};
+use facet_fit::extract::ExtractConfig;
+use facet_fit::fit::{Backend, FitConfig, Models, fit_material_on};
+use facet_fit::gpu::GpuFitter;
+use facet_fit::merl::{MerlBrdf, MerlTable};
+use facet_gpu::Gpu;
+use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
+use facet_render::camera::CameraFrame;
+use facet_render::procedural::{self, Rng};
+use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf};
+use facet_render::trace::{GpuHit, RayTracer};
+use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
+use glam::Vec3;
+use serde_json::{Value, json};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Instant;
+
+#[derive(Parser, Clone, Debug)]
+pub struct BenchArgs {
+    /// Also write the results as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// How much to measure (quick: within 5 minutes on lavapipe; default: the full sizes, for a
+    /// GPU; full: also 10^7 triangles; smoke: tiny sizes, what the test suite runs).
+    #[arg(long, value_enum, default_value_t = Mode::Default)]
+    pub mode: Mode,
+    /// Same as --mode quick.
+    #[arg(long, conflicts_with = "mode")]
+    pub quick: bool,
+    /// Same as --mode full.
+    #[arg(long, conflicts_with_all = ["mode", "quick"])]
+    pub full: bool,
+    /// Same as --mode smoke.
+    #[arg(long, conflicts_with_all = ["mode", "quick", "full"])]
+    pub smoke: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    Smoke,
+    Quick,
+    Default,
+    Full,
+}
+
+/// The sizes of one mode.
+#[derive(Clone, Copy, Debug)]
+struct Sizes {
+    /// Timed runs after one warm-up (1: no warm-up).
+    runs: usize,
+    fit_resolution: usize,
+    aniso: (usize, usize),
+    triangles: &'static [usize],
+    rays: u32,
+    render: (u32, u32, u32),
+    stage_warm: u32,
+    viewer: (u32, u32),
+}
+
+impl Mode {
+    const fn sizes(self) -> Sizes {
+        match self {
+            Mode::Smoke => Sizes {
+                runs: 1,
+                fit_resolution: 24,
+                aniso: (8, 16),
+                triangles: &[1_000],
+                rays: 1 << 12,
+                render: (64, 36, 1),
+                stage_warm: 2,
+                viewer: (64, 3),
+            },
+            Mode::Quick => Sizes {
+                runs: 5,
+                fit_resolution: 90,
+                aniso: (32, 64),
+                triangles: &[10_000, 100_000, 1_000_000],
+                rays: 1 << 17,
+                render: (480, 270, 2),
+                stage_warm: 4,
+                viewer: (512, 5),
+            },
+            Mode::Default => Sizes {
+                runs: 5,
+                fit_resolution: 90,
+                aniso: (128, 256),
+                triangles: &[10_000, 100_000, 1_000_000],
+                rays: 1 << 21,
+                render: (1920, 1080, 8),
+                stage_warm: 6,
+                viewer: (512, 60),
+            },
+            Mode::Full => Sizes {
+                triangles: &[10_000, 100_000, 1_000_000, 10_000_000],
+                ..Mode::Default.sizes()
+            },
+        }
+    }
+}
+
+/// Median of `runs` timed calls of `f` (ms) after one untimed call when runs > 1.
+fn median_ms(runs: usize, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
+    if runs > 1 {
+        f()?;
+    }
+    let mut t: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let s = Instant::now();
+            f().map(|_| s.elapsed().as_secs_f64() * 1e3)
+        })
+        .collect::<Result<_>>()?;
+    t.sort_by(f64::total_cmp);
+    Ok(t[t.len() / 2])
+}
+
+/// Now as ISO 8601 UTC (days to civil date: Hinnant's algorithm).
+fn utc_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs()) as i64;
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem / 60 % 60,
+        rem % 60
+    )
+}
+
+pub fn run(args: &BenchArgs) -> Result<ExitCode> {
+    let mode = match (args.quick, args.full, args.smoke) {
+        (true, _, _) => Mode::Quick,
+        (_, true, _) => Mode::Full,
+        (_, _, true) => Mode::Smoke,
+        _ => args.mode,
+    };
+    if let Some(path) = &args.json
+        && let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty())
+    {
+        crate::output::folder(dir, "--json")?;
+    }
+    let sizes = mode.sizes();
+    let t0 = Instant::now();
+    let gpu = match Gpu::new() {
+        Ok(g) => Some(g),
+        Err(e) => {
+            eprintln!("notice: no GPU adapter ({e}): only the CPU fits are measured");
+            None
+        }
+    };
+    let mut report = json!({
+        "facet_bench": 1,
+        "mode": format!("{mode:?}").to_lowercase(),
+        "commit": env!("FACET_COMMIT"),
+        "date": utc_now(),
+    });
+    println!(
+        "facet bench ({}), commit {}, {}",
+        report["mode"].as_str().unwrap_or(""),
+        env!("FACET_COMMIT"),
+        report["date"].as_str().unwrap_or("")
+    );
+    if let Some(g) = &gpu {
+        let info = g.adapter.get_info();
+        let l = g.device.limits();
+        report["adapter"] = json!({
+            "name": info.name, "backend": format!("{:?}", info.backend),
+            "device_type": format!("{:?}", info.device_type),
+            "driver": info.driver, "driver_info": info.driver_info,
+            "timestamps": g.device.features().contains(wgpu::Features::TIMESTAMP_QUERY),
+        });
+        report["limits_requested"] = json!({
+            "max_storage_buffer_binding_size": l.max_storage_buffer_binding_size,
+            "max_buffer_size": l.max_buffer_size,
+            "max_compute_workgroups_per_dimension": l.max_compute_workgroups_per_dimension,
+            "max_compute_invocations_per_workgroup": l.max_compute_invocations_per_workgroup,
+            "max_texture_dimension_3d": l.max_texture_dimension_3d,
+        });
+        println!(
+            "adapter: {} ({:?}, {:?}), driver {} {}",
+            info.name, info.backend, info.device_type, info.driver, info.driver_info
+        );
+    }
+    report["fit"] = fit(gpu.as_ref(), &sizes)?;
+    if let Some(g) = &gpu {
+        report["trace"] = trace(g, &sizes)?;
+        let (integrator, stages, glint) = integrator(g, &sizes)?;
+        report["integrator"] = integrator;
+        report["stages"] = stages;
+        report["glint"] = glint;
+        report["viewer"] = viewer(g, &sizes)?;
+    }
+    report["total_s"] = json!(t0.elapsed().as_secs_f64());
+    println!("bench total {:.1} s", t0.elapsed().as_secs_f64());
+    if let Some(path) = &args.json {
+        std::fs::write(path, serde_json::to_string_pretty(&report)? + "\n")
+            .with_context(|| format!("{}: writing the bench JSON", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The default material (a gold GGX conductor) as an in-memory MERL table.
+fn fit_source() -> Result<MerlBrdf> {
+    let model = facet_fit::analytic::parse_analytic(DEFAULT_MATERIAL)
+        .map_err(|e| anyhow::anyhow!("{DEFAULT_MATERIAL}: {e}"))?;
+    MerlBrdf::from_table(DEFAULT_MATERIAL, MerlTable::sample(&model))
+        .map_err(|e| anyhow::anyhow!("{DEFAULT_MATERIAL}: {e}"))
+}
+
+fn fit(gpu: Option<&Gpu>, sizes: &Sizes) -> Result<Value> {
+    let src = fit_source()?;
+    let fitter = gpu
+        .map(GpuFitter::new)
+        .transpose()
+        .context("GPU fit pipelines")?;
+    let iso = FitConfig {
+        extract: ExtractConfig {
+            resolution: sizes.fit_resolution,
+            ..ExtractConfig::isotropic()
+        },
+        ..FitConfig::isotropic()
+    };
+    let tabulated_only = FitConfig {
+        models: Models {
+            tabulated: true,
+            ggx: false,
+            beckmann: false,
+        },
+        ..iso
+    };
+    let (nt, np) = sizes.aniso;
+    let aniso = FitConfig {
+        extract: ExtractConfig {
+            resolution: nt,
+            phi_resolution: np,
+            ..ExtractConfig::anisotropic()
+        },
+        models: Models::NONE,
+        ..FitConfig::anisotropic()
+    };
+    let n = sizes.fit_resolution;
+    let cases = [
+        (format!("isotropic N = {n}, all models"), iso),
+        (format!("isotropic N = {n}, tabulated only"), tabulated_only),
+        (format!("anisotropic {nt} × {np} extraction"), aniso),
+    ];
+    let mut rows = Vec::new();
+    println!(
+        "\nfit ({DEFAULT_MATERIAL} as a MERL table), ms per material, median of {}",
+        sizes.runs
+    );
+    for (label, cfg) in &cases {
+        let mut backends = vec![("cpu", Backend::Cpu)];
+        if let Some(f) = &fitter {
+            backends.push(("gpu", Backend::Gpu(f)));
+        }
+        for (name, backend) in backends {
+            let mut used = String::new();
+            let ms = median_ms(sizes.runs, || {
+                let m = fit_material_on(&src, DEFAULT_MATERIAL, cfg, backend)?;
+                used = m.record.backend.clone();
+                Ok(())
+            })?;
+            println!("  {label:<40} {name:<4} {ms:>10.1} ms   ({used})");
+            rows.push(json!({"case": label, "backend": name, "median_ms": ms, "runs": sizes.runs, "record_backend": used}));
+        }
+    }
+    Ok(Value::Array(rows))
+}
+
+fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let tracer = RayTracer::new(d)?;
+    let n = sizes.rays.min(RayTracer::max_rays_per_dispatch(d) as u32);
+    let hits = facet_gpu::buffer::storage_zeroed(d, "hits", n as u64 * size_of::<GpuHit>() as u64);
+    let occluded = facet_gpu::buffer::storage_zeroed(d, "occluded", n as u64 * 4);
+    let mut rows = Vec::new();
+    println!(
+        "\ntrace: Mrays/s, {n} rays a dispatch, median of {}",
+        sizes.runs
+    );
+    for &tris in sizes.triangles {
+        let mesh = procedural::test_scene(tris, 1);
+        let bvh = Bvh::build(&mesh.positions, &mesh.indices, BvhConfig::medium());
+        let gpu_bvh = GpuBvh::upload(d, &bvh)?;
+        let (w, h) = (1024, n.div_ceil(1024));
+        let camera = procedural::camera_rays(
+            Vec3::new(-8.0, 6.0, 9.0),
+            Vec3::new(2.0, 2.0, -3.0),
+            60f32.to_radians(),
+            w,
+            h,
+        );
+        let random = procedural::random_rays(
+            n as usize,
+            Vec3::new(-9.9, 0.1, -9.9),
+            Vec3::new(9.9, 9.9, 9.9),
+            &mut Rng::new(5),
+        );
+        for (set, rays) in [("camera", camera), ("random", random)] {
+            let rays = facet_gpu::buffer::storage(d, "rays", &rays[..n as usize]);
+            for query in ["closest", "any"] {
+                let ms = median_ms(sizes.runs, || {
+                    let mut enc = d.create_command_encoder(&Default::default());
+                    if query == "closest" {
+                        tracer.encode_closest(d, &mut enc, &gpu_bvh, &rays, &hits, n);
+                    } else {
+                        tracer.encode_any(d, &mut enc, &gpu_bvh, &rays, &occluded, n);
+                    }
+                    q.submit([enc.finish()]);
+                    d.poll(wgpu::PollType::wait_indefinitely())?;
+                    Ok(())
+                })?;
+                let mrays = n as f64 / (ms * 1e3);
+                println!(
+                    "  {:>9} triangles {set:<7} {query:<8} {mrays:>10.1} Mrays/s   (BVH {} nodes, built in {:.0} ms)",
+                    tris,
+                    bvh.cwbvh.nodes.len(),
+                    bvh.build_ms
+                );
+                rows.push(json!({"triangles": tris, "rays": set, "query": query, "mrays_per_s": mrays, "ms": ms, "bvh_nodes": bvh.cwbvh.nodes.len(), "bvh_build_ms": bvh.build_ms}));
+            }
+        }
+        gpu.check_lost()?;
+    }
+    Ok(Value::Array(rows))
+}
+
+/// The demo scene and sky; with `glints` false the glint sphere renders its smooth GGX model.
+fn demo_scene(glints: bool) -> Result<(Scene, Environment)> {
+    let (gltf, sky) = demo_assets();
+    let mut scene = load_gltf(&gltf, &LoadOptions::default())?;
+    if !glints {
+        for m in &mut scene.materials {
+            if let Some(f) = &mut m.facet {
+                f.glint = None;
+            }
+        }
+    }
+    let (map, _) = EnvironmentMap::load(&sky)?;
+    Ok((scene, Environment::Map(Arc::new(map))))
+}
+
+fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
+    let (w, h, spp) = sizes.render;
+    let config = RenderConfig {
+        width: w,
+        height: h,
+        spp,
+        max_depth: 5,
+        ..RenderConfig::standard()
+    };
+    let mut rows = Vec::new();
+    let mut stages = json!({});
+    let mut rates = [0.0; 2];
+    let mut dpf_ms = 0.0;
+    println!(
+        "\nintegrator: the demo scene at {w} × {h}, depth 5, {spp} spp a render, median of {}",
+        sizes.runs
+    );
+    for (k, glints) in [false, true].into_iter().enumerate() {
+        let (scene, env) = demo_scene(glints)?;
+        let res = SceneResources::new(gpu, &scene, Some(&env), ResourceConfig::standard())?;
+        if glints {
+            dpf_ms = res.built.glint_build_ms;
+        }
+        let integrator = Integrator::new(&gpu.device, &res)?;
+        let camera = CameraFrame::new(&scene.camera)?;
+        let mut wf = Wavefront::new(gpu, &integrator, &res, w, h, config.wavefront)?;
+        let ms = median_ms(sizes.runs, || {
+            wf.clear(gpu);
+            wf.render_more(gpu, &integrator, &res, &camera, &config, &mut |_| {})?;
+            Ok(())
+        })?;
+        let msps = w as f64 * h as f64 * spp as f64 / (ms * 1e3);
+        rates[k] = msps;
+        let label = if glints {
+            "with glints"
+        } else {
+            "without glints"
+        };
+        println!(
+            "  {label:<16} {msps:>10.2} Msamples/s   ({ms:.0} ms a render, {} paths in flight)",
+            wf.slots()
+        );
+        rows.push(json!({"scene": "demo", "glints": glints, "width": w, "height": h, "spp": spp, "depth": 5, "msamples_per_s": msps, "ms": ms, "slots": wf.slots()}));
+        let (times, clock) =
+            wf.profile_iteration(gpu, &integrator, &res, &camera, &config, sizes.stage_warm)?;
+        let total: f64 = times.iter().map(|t| t.ms).sum();
+        println!("    one iteration by stage ({clock:?}), {total:.3} ms:");
+        for t in &times {
+            println!(
+                "      {:<18} {:>9.3} ms {:>5.1} %",
+                t.stage,
+                t.ms,
+                100.0 * t.ms / total.max(1e-12)
+            );
+        }
+        stages[label.replace(' ', "_")] = json!({
+            "clock": format!("{clock:?}").to_lowercase(),
+            "iteration_ms": total,
+            "stages": times.iter().map(|t| json!({"stage": t.stage, "ms": t.ms})).collect::<Vec<_>>(),
+        });
+    }
+    let overhead = 100.0 * (rates[0] / rates[1] - 1.0);
+    println!("  glint overhead at equal spp {overhead:+.1} %; DPF pyramid built in {dpf_ms:.0} ms");
+    let glint = json!({"overhead_percent": overhead, "dpf_build_ms": dpf_ms});
+    Ok((Value::Array(rows), stages, glint))
+}
+
+fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
+    let (side, frames) = sizes.viewer;
+    let fit = facet_fit::FittedMaterial::load(&demo_assets().0.with_file_name("default_fit.json"))?;
+    let sphere = Material {
+        name: "preview".into(),
+        facet: Some(facet_render::scene::FacetMaterial {
+            source: "default_fit.json".into(),
+            fit: Arc::new(fit),
+            model: facet_render::scene::FacetModel::Ggx,
+            glint: None,
+        }),
+        ..Default::default()
+    };
+    let scene = facet_render::scene::shapes::preview_scene(sphere);
+    let (_, env) = demo_scene(false)?;
+    let res = SceneResources::new(gpu, &scene, Some(&env), ResourceConfig::standard())?;
+    let integrator = Integrator::new(&gpu.device, &res)?;
+    let camera = CameraFrame::new(&scene.camera)?;
+    let mut wf = Wavefront::new(gpu, &integrator, &res, side, side, side * side)?;
+    let (mut batch, mut ms_all, mut spp_all) = (1u32, Vec::new(), Vec::new());
+    for _ in 0..frames {
+        let cfg = RenderConfig {
+            width: side,
+            height: side,
+            spp: batch,
+            spp_per_pass: facet_render::wavefront::MAX_SPP_PER_FRAME,
+            ..RenderConfig::preview()
+        };
+        let t = Instant::now();
+        wf.render_more(gpu, &integrator, &res, &camera, &cfg, &mut |_| {})?;
+        let rgba = wf.tone_mapped(gpu, 0.0)?;
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        if rgba.len() != (side * side) as usize {
+            bail!("the preview read back {} pixels", rgba.len());
+        }
+        ms_all.push(ms);
+        spp_all.push(batch);
+        batch = facet_render::wavefront::next_batch(batch, ms);
+    }
+    // Steady state: the second half of the frames.
+    let half = frames as usize / 2;
+    let mut steady: Vec<f64> = ms_all[half..].to_vec();
+    steady.sort_by(f64::total_cmp);
+    let median = steady[steady.len() / 2];
+    let spp_steady: u32 = spp_all[half..].iter().sum();
+    let secs: f64 = ms_all[half..].iter().sum::<f64>() / 1e3;
+    let msps = (side * side) as f64 * spp_steady as f64 / secs / 1e6;
+    let fps = 1e3 / median;
+    println!(
+        "\nviewer preview path: {side} × {side}, {frames} frames: {median:.1} ms a frame ({fps:.1} frames/s), {} spp a frame at the end, {msps:.2} Msamples/s",
+        spp_all.last().copied().unwrap_or(0)
+    );
+    Ok(
+        json!({"width": side, "height": side, "frames": frames, "median_frame_ms": median, "frames_per_s": fps, "spp_per_frame": spp_all.last(), "msamples_per_s": msps, "frame_ms": ms_all}),
+    )
+}
