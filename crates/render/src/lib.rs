@@ -3,7 +3,10 @@
 //! glTF scenes ([`scene::load_gltf`]), an obvhs CWBVH traversed in WGSL ([`bvh`]), and a
 //! wavefront integrator ([`Integrator`]) whose stages — logic, generate, extend, shade per
 //! material class (glTF metallic-roughness, fitted analytic or tabulated microfacet, glints),
-//! connect — are separate compute passes over queues.
+//! connect — are separate compute passes over queues. A [`Wavefront`] holds the GPU state of one
+//! image size (path state, queues, film) for reuse: `render_more` accumulates samples on the
+//! GPU, `tone_mapped` reads back the PNG tone map; `profile_iteration` times each stage. The
+//! closed sets shared with WGSL are in [`tags`].
 //!
 //! ```no_run
 //! use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, camera::CameraFrame};
