@@ -20,6 +20,9 @@ use std::time::Instant;
 
 pub use crate::tags::Strategy;
 
+/// Encodes one stage into the pass it is given.
+pub(crate) type EncodeStage<'a> = dyn FnMut(&mut wgpu::ComputePass) + 'a;
+
 /// Settings of one render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderConfig {
@@ -244,7 +247,7 @@ impl Integrator {
         &self,
         wf: &Wavefront,
         all_slots: (u32, u32),
-        each: &mut dyn FnMut(&str, &mut dyn FnMut(&mut wgpu::ComputePass)),
+        each: &mut dyn FnMut(&str, &mut EncodeStage),
     ) {
         let (frame_group, scene_group, glint_groups) =
             (&wf.frame_group, &wf.scene_group, &wf.glint_groups);
