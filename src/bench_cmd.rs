@@ -68,6 +68,8 @@ struct Sizes {
     render: (u32, u32, u32),
     stage_warm: u32,
     viewer: (u32, u32),
+    /// Side and spp of the noise renders.
+    noise: (u32, u32),
 }
 
 impl Mode {
@@ -83,6 +85,7 @@ impl Mode {
                 render: (64, 36, 1),
                 stage_warm: 2,
                 viewer: (64, 3),
+                noise: (32, 2),
             },
             Mode::Quick => Sizes {
                 runs: 5,
@@ -94,6 +97,7 @@ impl Mode {
                 render: (480, 270, 2),
                 stage_warm: 4,
                 viewer: (512, 5),
+                noise: (128, 16),
             },
             Mode::Default => Sizes {
                 runs: 5,
@@ -105,6 +109,7 @@ impl Mode {
                 render: (1920, 1080, 8),
                 stage_warm: 6,
                 viewer: (512, 60),
+                noise: (256, 64),
             },
             Mode::Full => Sizes {
                 triangles: &[10_000, 100_000, 1_000_000, 10_000_000],
@@ -214,6 +219,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         report["stages"] = stages;
         report["glint"] = glint;
         report["viewer"] = viewer(g, &sizes)?;
+        report["noise"] = noise(g, &sizes)?;
     }
     report["total_s"] = json!(t0.elapsed().as_secs_f64());
     println!("bench total {:.1} s", t0.elapsed().as_secs_f64());
@@ -496,4 +502,141 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     Ok(
         json!({"width": side, "height": side, "frames": frames, "median_frame_ms": median, "frames_per_s": fps, "spp_per_frame": spp_all.last(), "msamples_per_s": msps, "frame_ms": ms_all}),
     )
+}
+
+/// A fit of an analytic GGX gold conductor, as a Facet material rendering its GGX model.
+fn gold_ggx(alpha: f64) -> Result<Material> {
+    let spec = format!("ggx?alpha={alpha}&conductor=gold");
+    let model = facet_fit::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let src = MerlBrdf::from_table(&spec, MerlTable::sample(&model))
+        .map_err(|e| anyhow::anyhow!("{spec}: {e}"))?;
+    let fit = facet_fit::fit_material(&src, &spec, &FitConfig::isotropic())?;
+    Ok(Material {
+        name: spec.clone(),
+        facet: Some(facet_render::scene::FacetMaterial {
+            source: spec.into(),
+            fit: Arc::new(fit),
+            model: facet_render::scene::FacetModel::Ggx,
+            glint: None,
+        }),
+        ..Default::default()
+    })
+}
+
+/// Issue 12's gold scene: a GGX gold sphere (α = 0.3) on a 20 × 20 grey Lambertian floor, a
+/// constant sky of 0.5 and a 40 W/sr point light.
+fn gold_scene() -> Result<(Scene, Environment)> {
+    let mut scene = Scene {
+        materials: vec![
+            Material {
+                name: "floor".into(),
+                base_color: glam::Vec4::new(0.5, 0.5, 0.5, 1.0),
+                specular: 0.0,
+                ..Default::default()
+            },
+            gold_ggx(0.3)?,
+        ],
+        lights: vec![facet_render::scene::Light::Point {
+            position: Vec3::new(2.0, 3.0, 2.0),
+            intensity: Vec3::splat(40.0),
+        }],
+        camera: facet_render::scene::Camera {
+            position: Vec3::new(0.0, 1.5, 5.0),
+            forward: Vec3::new(0.0, -1.5, -5.0).normalize(),
+            up: Vec3::Y,
+            yfov: 40f32.to_radians(),
+        },
+        ..Default::default()
+    };
+    scene.add_quad(
+        Vec3::new(-10.0, -1.0, 10.0),
+        Vec3::new(20.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -20.0),
+        1.0,
+        0,
+    );
+    scene.add_uv_sphere(Vec3::ZERO, 1.0, 128, 64, 1);
+    Ok((scene, Environment::Constant(Vec3::splat(0.5))))
+}
+
+/// Noise at equal spp and time per sample, before (D cos θh sampling, selection by flux) and
+/// after (visible normals, robust selection), and each change alone, on the gold scene, the
+/// demo and a glossy (α = 0.05) sphere under the sky. The variance of a pixel is estimated from
+/// two renders with different seeds: E[(a − b)²] / 2, averaged over pixels and channels.
+fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
+    use facet_render::{LightSelection, NdfSampling};
+    let (side, spp) = sizes.noise;
+    let (demo, sky) = demo_scene(true)?;
+    let glossy = facet_render::scene::shapes::preview_scene(gold_ggx(0.05)?);
+    let scenes = [
+        ("gold sphere, sky and point light", gold_scene()?),
+        ("demo", (demo, sky.clone())),
+        ("glossy GGX α = 0.05 sphere under the sky", (glossy, sky)),
+    ];
+    let configs = [
+        ("before", NdfSampling::DCos, LightSelection::Power),
+        (
+            "visible normals only",
+            NdfSampling::Visible,
+            LightSelection::Power,
+        ),
+        (
+            "robust selection only",
+            NdfSampling::DCos,
+            LightSelection::Robust,
+        ),
+        ("after", NdfSampling::Visible, LightSelection::Robust),
+    ];
+    println!("\nnoise: variance per pixel at {spp} spp ({side} × {side}) and time per sample");
+    let mut rows = Vec::new();
+    for (name, (scene, env)) in &scenes {
+        let camera = CameraFrame::new(&scene.camera)?;
+        let mut base: Option<(f64, f64)> = None;
+        for (label, ndf_sampling, light_selection) in configs {
+            let rc = ResourceConfig {
+                light_selection,
+                ..ResourceConfig::standard()
+            };
+            let res = SceneResources::new(gpu, scene, Some(env), rc)?;
+            let integrator = Integrator::new(&gpu.device, &res)?;
+            let mut wf = Wavefront::new(gpu, &integrator, &res, side, side, side * side)?;
+            let mut images = Vec::new();
+            let mut ms = 0.0;
+            for seed in [0, 1] {
+                let cfg = RenderConfig {
+                    width: side,
+                    height: side,
+                    spp,
+                    max_depth: 5,
+                    seed,
+                    ndf_sampling,
+                    ..RenderConfig::standard()
+                };
+                wf.clear(gpu);
+                ms += wf
+                    .render_more(gpu, &integrator, &res, &camera, &cfg, &mut |_| {})?
+                    .ms;
+                images.push(wf.image(gpu)?);
+            }
+            let n = images[0].pixels.len() * 3;
+            let var = images[0]
+                .pixels
+                .iter()
+                .flatten()
+                .zip(images[1].pixels.iter().flatten())
+                .map(|(a, b)| 0.5 * (*a as f64 - *b as f64).powi(2))
+                .sum::<f64>()
+                / n as f64;
+            let ns = ms * 1e6 / (2.0 * (side * side) as f64 * spp as f64);
+            let (v0, t0) = *base.get_or_insert((var, ns));
+            println!(
+                "  {name:<42} {label:<22} variance {var:.3e} ({:.2}× before), {ns:.0} ns a sample ({:.2}×), time × variance {:.2}× before",
+                var / v0,
+                ns / t0,
+                var * ns / (v0 * t0)
+            );
+            rows.push(json!({"scene": name, "config": label, "spp": spp, "side": side, "variance": var, "ns_per_sample": ns, "variance_vs_before": var / v0, "time_vs_before": ns / t0, "time_variance_vs_before": var * ns / (v0 * t0)}));
+        }
+    }
+    Ok(Value::Array(rows))
 }

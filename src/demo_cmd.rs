@@ -69,6 +69,7 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
         wavefront: 1 << 20,
         bvh: render_cmd::PresetArg::Medium,
         no_glint_filter: false,
+        variance: false,
     };
     println!(
         "rendering {} (tabulated | GGX | glints), {}×{} at {} spp",

@@ -6,7 +6,7 @@ use facet_fit::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -61,6 +61,9 @@ pub struct RenderArgs {
     /// Count flakes everywhere (no mean above the glint threshold): slow, for comparison.
     #[arg(long)]
     pub no_glint_filter: bool,
+    /// Also write each pixel's variance (of its mean, linear RGB) as STEM.variance.exr.
+    #[arg(long)]
+    pub variance: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -108,12 +111,19 @@ pub fn outputs(out: &Path) -> (PathBuf, PathBuf) {
     (out.with_extension("png"), out.with_extension("exr"))
 }
 
+/// The variance output of `--out --variance`: STEM.variance.exr.
+pub fn variance_output(out: &Path) -> PathBuf {
+    out.with_extension("variance.exr")
+}
+
 /// Everything a render needs, loaded and checked before the GPU is touched.
 pub struct Job {
     pub scene: facet_render::scene::Scene,
     pub environment: Option<Environment>,
     pub config: RenderConfig,
     pub resources: ResourceConfig,
+    /// Write STEM.variance.exr too.
+    pub variance: bool,
 }
 
 pub fn prepare(args: &RenderArgs) -> Result<Job> {
@@ -149,7 +159,11 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
     if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
         crate::output::folder(dir, "--out")?;
     }
-    for o in [&png, &exr] {
+    let variance = args.variance.then(|| variance_output(&args.out));
+    for o in [Some(&png), Some(&exr), variance.as_ref()]
+        .into_iter()
+        .flatten()
+    {
         if let Some(i) = inputs.iter().find(|i| same_file(i, o)) {
             bail!(
                 "{}: the output would replace the input {}; choose another --out",
@@ -194,6 +208,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         environment,
         config,
         resources,
+        variance: args.variance,
     })
 }
 
@@ -229,14 +244,33 @@ pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) ->
         ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed} (eta {eta})")
             .expect("static template"),
     );
-    let (image, stats) = integrator.render(gpu, &res, &camera, &job.config, &mut |f| {
+    let c = &job.config;
+    let mut wf = if job.variance {
+        Wavefront::with_variance(gpu, &integrator, &res, c.width, c.height, c.wavefront)?
+    } else {
+        Wavefront::new(gpu, &integrator, &res, c.width, c.height, c.wavefront)?
+    };
+    let stats = wf.render_more(gpu, &integrator, &res, &camera, c, &mut |f| {
         bar.set_position((f * 1000.0) as u64)
     })?;
+    let image = wf.image(gpu)?;
     bar.finish_and_clear();
     let (png, exr) = outputs(out);
     image.write_png(&png, exposure)?;
     image.write_exr(&exr)?;
     println!("wrote {} and {}", png.display(), exr.display());
+    if let Some(var) = wf.variance(gpu)? {
+        let path = variance_output(out);
+        var.write_exr(&path)?;
+        let mean = var.mean();
+        println!(
+            "wrote {} (mean variance of a pixel {:.3e} {:.3e} {:.3e})",
+            path.display(),
+            mean[0],
+            mean[1],
+            mean[2]
+        );
+    }
     Ok(Timings {
         resources,
         pipelines,

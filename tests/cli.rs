@@ -776,3 +776,23 @@ fn bench_smoke_reports_every_section() {
     positive(&r["viewer"]["frames_per_s"], "viewer frames/s");
     positive(&r["viewer"]["msamples_per_s"], "viewer Msamples/s");
 }
+
+/// `--variance` writes STEM.variance.exr beside the image: the same size, finite, non-negative,
+/// not all zero; without the flag there is none.
+#[test]
+fn variance_flag_writes_the_variance_image() {
+    if facet_gpu::gpu_for_tests("variance_flag_writes_the_variance_image").is_none() {
+        return;
+    }
+    let dir = common::scratch("cli_variance");
+    let demo = demo_copy(&dir);
+    let out = dir.join("v.png");
+    let stdout = render_small(demo.to_str().unwrap(), &out, &["--variance"]);
+    assert!(stdout.contains("v.variance.exr"), "{stdout}");
+    let (w, h, var) = read_exr(&dir.join("v.variance.exr"));
+    assert_eq!((w, h), (40, 24));
+    assert!(var.iter().flatten().all(|v| v.is_finite() && *v >= 0.0));
+    assert!(var.iter().flatten().any(|v| *v > 0.0));
+    render_small(demo.to_str().unwrap(), &dir.join("plain.png"), &[]);
+    assert!(!dir.join("plain.variance.exr").exists());
+}

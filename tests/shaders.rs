@@ -208,7 +208,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         layout_check!(GpuFrame, "render/extend.wgsl", "Frame", {
             width, height, tile_base, tile_pixels, wavefront, sample_end, max_depth, seed,
             rr_depth, n_vertices, n_lights, light_cdf, env_kind, env_width, env_height,
-            env_texels, env_marginal, env_conditional, scene_radius, ray_epsilon, strategy, pad => [pad0, pad1, pad2],
+            env_texels, env_marginal, env_conditional, scene_radius, ray_epsilon, strategy, ndf_sampling, moments, pad => [pad1],
             env_color,
             cam_pos, cam_forward, cam_up, cam_right,
         }),

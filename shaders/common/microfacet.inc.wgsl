@@ -1,5 +1,6 @@
 // Include-only. Analytic microfacet NDFs (Rust twin: facet_fit::microfacet::AnalyticNdf):
-// D, Smith Λ and sampling of GGX (kind 0) and Beckmann (kind 1), αx, αy and a rotation.
+// D, Smith Λ and sampling of GGX (kind 0) and Beckmann (kind 1), αx, αy and a rotation: of
+// D cos θh, and of the normals visible from ωo (facet_fit::visible_normals).
 
 struct AnalyticNdf {
     kind: u32,
@@ -71,4 +72,93 @@ fn ndf_sample(n: AnalyticNdf, u: vec2<f32>) -> vec3<f32> {
     let c = cos(n.rotation);
     let s = sin(n.rotation);
     return vec3<f32>(c * h.x - s * h.y, s * h.x + c * h.y, h.z);
+}
+
+// Inverse error function: Giles (2010), single precision (facet_fit::visible_normals::erfinv_giles).
+fn erfinv_f32(y: f32) -> f32 {
+    var w = -log(max((1.0 - y) * (1.0 + y), 1e-30));
+    var p: f32;
+    if (w < 5.0) {
+        w = w - 2.5;
+        p = 2.81022636e-08;
+        p = 3.43273939e-07 + p * w;
+        p = -3.5233877e-06 + p * w;
+        p = -4.39150654e-06 + p * w;
+        p = 0.00021858087 + p * w;
+        p = -0.00125372503 + p * w;
+        p = -0.00417768164 + p * w;
+        p = 0.246640727 + p * w;
+        p = 1.50140941 + p * w;
+    } else {
+        w = sqrt(w) - 3.0;
+        p = -0.000200214257;
+        p = 0.000100950558 + p * w;
+        p = 0.00134934322 + p * w;
+        p = -0.00367342844 + p * w;
+        p = 0.00573950773 + p * w;
+        p = -0.0076224613 + p * w;
+        p = 0.00943887047 + p * w;
+        p = 1.00167406 + p * w;
+        p = 2.83297682 + p * w;
+    }
+    return p * y;
+}
+
+fn ndf_rotate(n: AnalyticNdf, v: vec3<f32>) -> vec3<f32> {
+    let c = cos(n.rotation);
+    let s = sin(n.rotation);
+    return vec3<f32>(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
+}
+
+// Visible slopes of the unit Beckmann NDF seen from cos θ in the x–z plane: Newton's method on
+// the CDF in the erf domain, x = erf(x̃) ∈ (−1, erf(cot θ)), CDF ∝ 1 + x + tan θ exp(−x̃²)/√π.
+fn beckmann_visible_slopes_11(cos_theta: f32, u_in: vec2<f32>) -> vec2<f32> {
+    let tan_theta = max(sqrt(max(1.0 - cos_theta * cos_theta, 0.0)) / cos_theta, 1e-6);
+    let cot_theta = 1.0 / tan_theta;
+    let max_x = erf_approx(cot_theta);
+    let u = clamp(u_in, vec2<f32>(1e-6), vec2<f32>(1.0 - 1e-6));
+    var x = max_x - (max_x + 1.0) * erf_approx(sqrt(-log(u.x)));
+    let target_cdf = u.x * (1.0 + max_x + tan_theta * exp(-cot_theta * cot_theta) / sqrt(MF_PI));
+    for (var i = 0u; i < 6u; i++) {
+        let slope = erfinv_f32(x);
+        let value = 1.0 + x + tan_theta * exp(-slope * slope) / sqrt(MF_PI) - target_cdf;
+        let derivative = 1.0 - slope * tan_theta;
+        x = clamp(x - value / derivative, -1.0 + 1e-6, min(max_x, 1.0 - 1e-6));
+    }
+    return vec2<f32>(erfinv_f32(x), erfinv_f32(2.0 * u.y - 1.0));
+}
+
+// A normal from the distribution of normals visible from wo (wo.z > 0), density
+// ndf_pdf_visible: GGX by spherical caps (Dupuy & Benyoub 2023), Beckmann by visible slopes.
+fn ndf_sample_visible(n: AnalyticNdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
+    let o = ndf_to_local(n, wo);
+    let v = normalize(vec3<f32>(n.alpha_x * o.x, n.alpha_y * o.y, max(o.z, 1e-7)));
+    var h: vec3<f32>;
+    if (n.kind == 0u) {
+        let phi = 2.0 * MF_PI * u.x;
+        let z = (1.0 - u.y) * (1.0 + v.z) - v.z;
+        let r = sqrt(max(1.0 - z * z, 0.0));
+        let hs = vec3<f32>(r * cos(phi), r * sin(phi), z) + v;
+        h = vec3<f32>(n.alpha_x * hs.x, n.alpha_y * hs.y, max(hs.z, 0.0));
+    } else {
+        let s = beckmann_visible_slopes_11(v.z, u);
+        let l = length(v.xy);
+        var sin_phi = 0.0;
+        var cos_phi = 1.0;
+        if (l > 1e-7) {
+            sin_phi = v.y / l;
+            cos_phi = v.x / l;
+        }
+        let slope = vec2<f32>((cos_phi * s.x - sin_phi * s.y) * n.alpha_x, (sin_phi * s.x + cos_phi * s.y) * n.alpha_y);
+        h = vec3<f32>(-slope.x, -slope.y, 1.0);
+    }
+    return ndf_rotate(n, normalize(h));
+}
+
+// D_wo(h) = G1(wo) max(0, wo·h) D(h) / wo.z, G1 = 1 / (1 + Λ(wo)).
+fn ndf_pdf_visible(n: AnalyticNdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
+    if (wo.z <= 0.0 || h.z <= 0.0) {
+        return 0.0;
+    }
+    return max(dot(wo, h), 0.0) * ndf_d(n, h) / ((1.0 + ndf_lambda(n, wo)) * wo.z);
 }

@@ -1,6 +1,6 @@
 // Samples ωi for given ωo from the glint BRDF's smooth lobe, with its pdf (the twin of
-// facet_glint::glint_brdf::glint_sample): h from the NDF, ωo reflected about it,
-// pdf = D(h) cos θh / (4 |ωo·h|); pdf 0 marks a sample below the horizon.
+// facet_glint::glint_brdf::glint_sample): h from the normals visible from ωo, ωo reflected
+// about it, pdf = D_ωo(h) / (4 |ωo·h|); pdf 0 marks a sample below the horizon.
 
 #include "common/microfacet.inc.wgsl"
 
@@ -20,12 +20,12 @@ fn glint_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_work
     let a = inputs[2u * i];
     let b = inputs[2u * i + 1u];
     let wo = a.xyz;
-    let h = ndf_sample(ndf, vec2<f32>(a.w, b.x));
+    let h = ndf_sample_visible(ndf, wo, vec2<f32>(a.w, b.x));
     let c = dot(wo, h);
     let wi = 2.0 * c * h - wo;
     if (c <= 0.0 || wi.z <= 0.0) {
         samples[i] = vec4<f32>(wi, 0.0);
         return;
     }
-    samples[i] = vec4<f32>(wi, ndf_d(ndf, h) * h.z / (4.0 * abs(c)));
+    samples[i] = vec4<f32>(wi, ndf_pdf_visible(ndf, wo, h) / (4.0 * abs(c)));
 }

@@ -39,9 +39,11 @@ struct Frame {
     ray_epsilon: f32,
     // STRATEGY_*
     strategy: u32,
-    pad0: u32,
+    // NDF_SAMPLING_*
+    ndf_sampling: u32,
+    // 1: also accumulate squared radiance into film_sq (per-pixel variance)
+    moments: u32,
     pad1: u32,
-    pad2: u32,
     // Constant environment radiance (env_kind 1); w: 1 / Σ weights of the map (env_kind 2).
     env_color: vec4<f32>,
     // xyz position, w tan(yfov / 2)
@@ -61,6 +63,8 @@ struct Frame {
 @group(0) @binding(4) var<storage, read> sizes: array<u32>;
 @group(0) @binding(5) var<storage, read_write> queues: array<u32>;
 @group(0) @binding(6) var<storage, read_write> film: array<vec4<f32>>;
+// Σ L² per pixel (rgb) when frame.moments is 1; a single texel otherwise.
+@group(0) @binding(7) var<storage, read_write> film_sq: array<vec4<f32>>;
 
 fn path_get(region: u32, slot: u32) -> vec4<f32> {
     return paths[region * frame.wavefront + slot];

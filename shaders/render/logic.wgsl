@@ -11,7 +11,11 @@ fn finish(slot: u32) {
     let px = slot_pixel(slot);
     // A non-finite sample is dropped (counted, not added) rather than poisoning the pixel.
     let ok = all(l == l) && all(abs(l) < vec3<f32>(3.0e38));
-    film[px] += vec4<f32>(select(vec3<f32>(0.0), l, ok), 1.0);
+    let v = select(vec3<f32>(0.0), l, ok);
+    film[px] += vec4<f32>(v, 1.0);
+    if (frame.moments != 0u) {
+        film_sq[px] += vec4<f32>(v * v, 0.0);
+    }
 }
 
 @compute @workgroup_size(WG)

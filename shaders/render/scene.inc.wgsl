@@ -3,6 +3,7 @@
 // the environment map and its CDFs, the Fresnel tables and the tabulated NDFs at offsets.
 
 #include "render/tags.inc.wgsl"
+#include "common/microfacet.inc.wgsl"
 
 const PI: f32 = 3.14159265358979;
 const NONE: u32 = 0xffffffffu;
@@ -431,6 +432,21 @@ fn env_light_pmf() -> f32 {
         }
     }
     return 0.0;
+}
+
+// A normal for reflecting wo off an analytic lobe, by frame.ndf_sampling, and its pdf.
+fn lobe_sample_h(n: AnalyticNdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
+    if (frame.ndf_sampling == NDF_SAMPLING_D_COS) {
+        return ndf_sample(n, u);
+    }
+    return ndf_sample_visible(n, wo, u);
+}
+
+fn lobe_pdf_h(n: AnalyticNdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
+    if (frame.ndf_sampling == NDF_SAMPLING_D_COS) {
+        return ndf_d(n, h) * max(h.z, 0.0);
+    }
+    return ndf_pdf_visible(n, wo, h);
 }
 
 // Power heuristic, β = 2.

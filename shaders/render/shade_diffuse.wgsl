@@ -69,14 +69,14 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
         return 0.0;
     }
     let h = normalize(wi + wo);
-    let spec = ndf_d(b.ndf, h) * h.z / (4.0 * abs(dot(wo, h)));
+    let spec = lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
     return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
 }
 
 fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
     var wi: vec3<f32>;
     if (u.z < b.p_spec) {
-        let h = ndf_sample(b.ndf, u.xy);
+        let h = lobe_sample_h(b.ndf, wo, u.xy);
         wi = 2.0 * dot(wo, h) * h - wo;
     } else {
         wi = sample_cosine(u.xy);

@@ -2,7 +2,7 @@
 // per glint material with its own DPF pyramid levels:
 //   f = F(θd) G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo)   (glint/glint_brdf.inc.wgsl),
 // the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
-// N a P once that exceeds the threshold. Sampling: the smooth lobe, D cos θh.
+// N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals.
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -95,11 +95,11 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
         return 0.0;
     }
     let h = normalize(wi + wo);
-    return ndf_d(b.ndf, h) * h.z / (4.0 * abs(dot(wo, h)));
+    return lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
 }
 
 fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
-    let h = ndf_sample(b.ndf, u.xy);
+    let h = lobe_sample_h(b.ndf, wo, u.xy);
     let wi = 2.0 * dot(wo, h) * h - wo;
     return BsdfSample(wi, bsdf_eval(b, wi, wo), bsdf_pdf(b, wi, wo));
 }

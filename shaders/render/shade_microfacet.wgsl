@@ -1,8 +1,9 @@
 // Shading stage of fitted microfacet materials (facet_fit::microfacet::MicrofacetBrdf):
 //   f = F(θd) D(h) G2(ωi, ωo) / (4 cos θi cos θo) + ρd / π,
 // F the fit's Fresnel table, D and Λ analytic (GGX / Beckmann, TABULATED = 0) or the fit's
-// tables (TABULATED = 1), the correlated G2. Sampling: D cos θh with probability p_spec, else
-// the cosine lobe when the fit has a diffuse term.
+// tables (TABULATED = 1), the correlated G2. Sampling, with probability p_spec: the normals
+// visible from ωo (analytic NDFs) or the table's D cos θh (tabulated); else the cosine lobe
+// when the fit has a diffuse term.
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -52,19 +53,19 @@ fn mf_lambda(b: Bsdf, w: vec3<f32>) -> f32 {
     return ndf_lambda(b.analytic, w);
 }
 
-// pdf of the sampled normal over solid angle (D cos θh for analytic NDFs).
-fn mf_pdf_h(b: Bsdf, h: vec3<f32>) -> f32 {
+// pdf of the sampled normal over solid angle (visible normals for analytic NDFs).
+fn mf_pdf_h(b: Bsdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
     if (TABULATED) {
         return tab_pdf(b.tab, h);
     }
-    return ndf_d(b.analytic, h) * max(h.z, 0.0);
+    return lobe_pdf_h(b.analytic, wo, h);
 }
 
-fn mf_sample_h(b: Bsdf, u: vec2<f32>) -> vec3<f32> {
+fn mf_sample_h(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
     if (TABULATED) {
         return tab_sample(b.tab, u);
     }
-    return ndf_sample(b.analytic, u);
+    return lobe_sample_h(b.analytic, wo, u);
 }
 
 fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
@@ -83,14 +84,14 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     }
     let h = normalize(wi + wo);
     // Reflection Jacobian: p(ωi) = p(h) / (4 |ωo·h|).
-    let spec = mf_pdf_h(b, h) / (4.0 * abs(dot(wo, h)));
+    let spec = mf_pdf_h(b, wo, h) / (4.0 * abs(dot(wo, h)));
     return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
 }
 
 fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
     var wi: vec3<f32>;
     if (u.z < b.p_spec) {
-        let h = mf_sample_h(b, u.xy);
+        let h = mf_sample_h(b, wo, u.xy);
         wi = 2.0 * dot(wo, h) * h - wo;
     } else {
         wi = sample_cosine(u.xy);

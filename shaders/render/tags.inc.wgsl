@@ -24,6 +24,10 @@ const STRATEGY_MIS: u32 = 0u; // light and BSDF sampling combined by the power h
 const STRATEGY_LIGHT: u32 = 1u; // light sampling alone: emission a BSDF ray finds counts only if light sampling cannot
 const STRATEGY_BSDF: u32 = 2u; // BSDF sampling alone: only delta lights (point, spot, directional) are sampled
 
+// facet_render::tags::NdfSampling
+const NDF_SAMPLING_VISIBLE: u32 = 0u; // the normals visible from ωo (Heitz 2018): the default
+const NDF_SAMPLING_D_COS: u32 = 1u; // D(h) cos θh, the older choice, kept to measure against
+
 // facet_render::tags::Region
 const R_ORIGIN: u32 = 0u; // xyz origin, w cone width at the origin
 const R_DIR: u32 = 1u; // xyz direction, w cone spread angle

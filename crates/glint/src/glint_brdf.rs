@@ -83,11 +83,11 @@ pub fn glint_eval(
     f.map(|c| c * scale)
 }
 
-/// Samples ωi for a given ωo from the smooth lobe (a normal from the NDF, ωo reflected about
+/// Samples ωi for a given ωo from the smooth lobe (a normal visible from ωo, ωo reflected about
 /// it); `None` below the horizon. The returned pdf is over solid angle of ωi:
-/// pdf_h(h) / (4 |ωo·h|).
+/// pdf_h(h | ωo) / (4 |ωo·h|).
 pub fn glint_sample(model: &MicrofacetBrdf, wo: DVec3, u: [f64; 2]) -> Option<(DVec3, f64)> {
-    let h = model.ndf.sample(u);
+    let h = model.ndf.sample_visible(wo, u);
     let cos = wo.dot(h);
     if cos <= 0.0 {
         return None;
@@ -102,5 +102,5 @@ pub fn glint_pdf(model: &MicrofacetBrdf, wi: DVec3, wo: DVec3) -> f64 {
         return 0.0;
     }
     let h = (wi + wo).normalize();
-    model.ndf.pdf(h) / (4.0 * wo.dot(h).abs())
+    model.ndf.pdf_visible(wo, h) / (4.0 * wo.dot(h).abs())
 }

@@ -38,7 +38,11 @@ pub struct GpuFrame {
     pub ray_epsilon: f32,
     /// [`Strategy`](crate::tags::Strategy) as `u32`.
     pub strategy: u32,
-    pub pad: [u32; 3],
+    /// [`NdfSampling`](crate::tags::NdfSampling) as `u32`.
+    pub ndf_sampling: u32,
+    /// 1: the film's squares are accumulated too (`Wavefront::with_variance`).
+    pub moments: u32,
+    pub pad: u32,
     pub env_color: [f32; 4],
     pub cam_pos: [f32; 4],
     pub cam_forward: [f32; 4],

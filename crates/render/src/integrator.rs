@@ -18,7 +18,7 @@ use crate::wavefront::Wavefront;
 use facet_gpu::{Gpu, shader};
 use std::time::Instant;
 
-pub use crate::tags::Strategy;
+pub use crate::tags::{NdfSampling, Strategy};
 
 /// Encodes one stage into the pass it is given.
 pub(crate) type EncodeStage<'a> = dyn FnMut(&mut wgpu::ComputePass) + 'a;
@@ -44,6 +44,7 @@ pub struct RenderConfig {
     /// Iterations submitted between checks for completion.
     pub iterations_per_check: u32,
     pub strategy: Strategy,
+    pub ndf_sampling: NdfSampling,
 }
 
 impl RenderConfig {
@@ -61,6 +62,7 @@ impl RenderConfig {
             time_limit: None,
             iterations_per_check: 8,
             strategy: Strategy::Mis,
+            ndf_sampling: NdfSampling::Visible,
         }
     }
 
@@ -78,6 +80,7 @@ impl RenderConfig {
             time_limit: None,
             iterations_per_check: 8,
             strategy: Strategy::Mis,
+            ndf_sampling: NdfSampling::Visible,
         }
     }
 }

@@ -44,9 +44,9 @@ pub mod wavefront;
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use error::RenderError;
 pub use film::Image;
-pub use integrator::{Integrator, RenderConfig, RenderStats, Strategy};
+pub use integrator::{Integrator, NdfSampling, RenderConfig, RenderStats, Strategy};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
-pub use resources::{Built, ResourceConfig, SceneResources};
+pub use resources::{Built, LightSelection, ResourceConfig, SceneResources};
 pub use trace::{GpuHit, GpuRay, RayTracer};
 pub use wavefront::{StageClock, StageTime, Wavefront};

@@ -71,6 +71,7 @@ impl Layouts {
                     storage(4, true),
                     storage(5, false),
                     storage(6, false),
+                    storage(7, false),
                 ],
             ),
             scene: layout(

@@ -104,6 +104,24 @@ impl Default for Strategy {
 }
 
 tags!(
+    /// How microfacet lobes pick their normals (`Frame.ndf_sampling`).
+    NdfSampling, "NDF_SAMPLING_" {
+        /// the normals visible from ωo (Heitz 2018): the default
+        Visible = 0 => "VISIBLE",
+        /// D(h) cos θh, the older choice, kept to measure against
+        DCos = 1 => "D_COS",
+    }
+);
+
+// By hand: `tags!` takes doc attributes only on variants.
+#[allow(clippy::derivable_impls)]
+impl Default for NdfSampling {
+    fn default() -> Self {
+        NdfSampling::Visible
+    }
+}
+
+tags!(
     /// Regions of the path state: one vec4 per slot each, region r of slot s at
     /// `paths[r · wavefront + s]`.
     Region, "R_" {
@@ -166,6 +184,7 @@ pub fn all() -> Vec<TagSet> {
         set!(LightKind),
         set!(EnvKind),
         set!(Strategy),
+        set!(NdfSampling),
         set!(Region),
         set!(SlotState),
     ]

@@ -29,6 +29,9 @@ pub struct Wavefront {
     sizes: wgpu::Buffer,
     args: wgpu::Buffer,
     film: wgpu::Buffer,
+    /// Σ L² per pixel when `moments`, else one texel.
+    film_sq: wgpu::Buffer,
+    moments: bool,
     // Bound by the groups below; kept so that their owner is plain.
     _paths: wgpu::Buffer,
     _queues: wgpu::Buffer,
@@ -106,7 +109,9 @@ pub fn frame_uniform(
         scene_radius: scene.scene_radius,
         ray_epsilon: 1e-5,
         strategy: config.strategy as u32,
-        pad: [0; 3],
+        ndf_sampling: config.ndf_sampling as u32,
+        moments: 0,
+        pad: 0,
         env_color: scene.env_color,
         cam_pos: camera.position.extend(tan_half).to_array(),
         cam_forward: camera.forward.extend(aspect).to_array(),
@@ -126,6 +131,30 @@ impl Wavefront {
         width: u32,
         height: u32,
         wavefront: u32,
+    ) -> Result<Self, RenderError> {
+        Self::build(gpu, integrator, scene, (width, height), wavefront, false)
+    }
+
+    /// [`Wavefront::new`] whose film also keeps Σ L² per pixel, for [`Wavefront::variance`]
+    /// (16 more bytes a pixel, one more add per sample).
+    pub fn with_variance(
+        gpu: &Gpu,
+        integrator: &Integrator,
+        scene: &SceneResources,
+        width: u32,
+        height: u32,
+        wavefront: u32,
+    ) -> Result<Self, RenderError> {
+        Self::build(gpu, integrator, scene, (width, height), wavefront, true)
+    }
+
+    fn build(
+        gpu: &Gpu,
+        integrator: &Integrator,
+        scene: &SceneResources,
+        (width, height): (u32, u32),
+        wavefront: u32,
+        moments: bool,
     ) -> Result<Self, RenderError> {
         let d = &gpu.device;
         if width == 0 || height == 0 {
@@ -151,23 +180,26 @@ impl Wavefront {
             Planned::storage("the film", film_bytes, &render_size),
             Planned::buffer("the film read-back", film_bytes, &render_size),
         ])?;
-        let (frame_buf, paths, info, counters, sizes, args, queues, film) = gpu.scoped(|| {
-            (
-                buffer::uniform(d, "frame", &GpuFrame::default()),
-                buffer::storage_zeroed(d, "paths", PATH_REGIONS * w * 16),
-                buffer::storage_zeroed(d, "path info", w * 16),
-                buffer::storage_zeroed(d, "queue counters", nq * 4),
-                buffer::storage_zeroed(d, "queue sizes", nq * 4),
-                d.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("queue dispatch args"),
-                    size: nq * 12,
-                    usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-                    mapped_at_creation: false,
-                }),
-                buffer::storage_zeroed(d, "queues", nq * w * 4),
-                buffer::storage_zeroed(d, "film", pixels * 16),
-            )
-        })?;
+        let film_sq_bytes = if moments { pixels * 16 } else { 16 };
+        let (frame_buf, paths, info, counters, sizes, args, queues, film, film_sq) =
+            gpu.scoped(|| {
+                (
+                    buffer::uniform(d, "frame", &GpuFrame::default()),
+                    buffer::storage_zeroed(d, "paths", PATH_REGIONS * w * 16),
+                    buffer::storage_zeroed(d, "path info", w * 16),
+                    buffer::storage_zeroed(d, "queue counters", nq * 4),
+                    buffer::storage_zeroed(d, "queue sizes", nq * 4),
+                    d.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("queue dispatch args"),
+                        size: nq * 12,
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+                        mapped_at_creation: false,
+                    }),
+                    buffer::storage_zeroed(d, "queues", nq * w * 4),
+                    buffer::storage_zeroed(d, "film", pixels * 16),
+                    buffer::storage_zeroed(d, "film squares", film_sq_bytes),
+                )
+            })?;
         let layouts = integrator.layouts();
         let group = |layout: &wgpu::BindGroupLayout, label, res: &[wgpu::BindingResource]| {
             let entries: Vec<wgpu::BindGroupEntry> = res
@@ -195,6 +227,7 @@ impl Wavefront {
                 sizes.as_entire_binding(),
                 queues.as_entire_binding(),
                 film.as_entire_binding(),
+                film_sq.as_entire_binding(),
             ],
         );
         let scene_group = group(
@@ -249,6 +282,8 @@ impl Wavefront {
             sizes,
             args,
             film,
+            film_sq,
+            moments,
             _paths: paths,
             _queues: queues,
             frame_group,
@@ -283,6 +318,7 @@ impl Wavefront {
     pub fn clear(&mut self, gpu: &Gpu) {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.film, 0, None);
+        enc.clear_buffer(&self.film_sq, 0, None);
         gpu.queue.submit([enc.finish()]);
         self.spp = 0;
     }
@@ -312,6 +348,7 @@ impl Wavefront {
         let w = self.slots as u64;
         let nq = self.n_queues as u64;
         let mut frame = frame_uniform(scene, camera, config, self.slots);
+        frame.moments = self.moments as u32;
         let tiles = pixels.div_ceil(w);
         let per_pass = config.spp_per_pass.max(1);
         let (first, last) = (self.spp, self.spp.saturating_add(config.spp));
@@ -372,6 +409,39 @@ impl Wavefront {
         let film: Vec<[f32; 4]> = buffer::read(&gpu.device, &gpu.queue, &self.film, pixels)?;
         gpu.check_lost()?;
         Ok(Image::from_film(self.width, self.height, &film))
+    }
+
+    /// Per pixel, the variance of its mean (the estimate the image shows): the samples' unbiased
+    /// variance over n, (Σ L² − n m²) / (n (n − 1)), 0 with fewer than two samples. `None`
+    /// unless made [`Wavefront::with_variance`].
+    pub fn variance(&self, gpu: &Gpu) -> Result<Option<Image>, RenderError> {
+        if !self.moments {
+            return Ok(None);
+        }
+        let pixels = self.width as usize * self.height as usize;
+        let film: Vec<[f32; 4]> = buffer::read(&gpu.device, &gpu.queue, &self.film, pixels)?;
+        let sq: Vec<[f32; 4]> = buffer::read(&gpu.device, &gpu.queue, &self.film_sq, pixels)?;
+        gpu.check_lost()?;
+        let var = film
+            .iter()
+            .zip(&sq)
+            .map(|(s, q)| {
+                let n = s[3] as f64;
+                std::array::from_fn(|c| {
+                    if n < 2.0 {
+                        return 0.0;
+                    }
+                    let m = s[c] as f64 / n;
+                    (((q[c] as f64 - n * m * m) / (n * (n - 1.0))).max(0.0)) as f32
+                })
+            })
+            .collect();
+        Ok(Some(Image {
+            width: self.width,
+            height: self.height,
+            pixels: var,
+            samples: film.iter().map(|s| s[3] as u32).collect(),
+        }))
     }
 
     /// The film tone mapped on the GPU (`film`'s tone map at `exposure`), RGBA8 with alpha 255:

@@ -912,3 +912,137 @@ fn rotated_anisotropic_ggx_sphere_matches_the_cpu_evaluator() {
         16,
     );
 }
+
+// ---- several lights ---------------------------------------------------------------------------
+
+/// A bright sun, a small point light and an environment light a plane and a sphere together:
+/// the render with all three is, region by region, the sum of the renders with each alone
+/// (light transport is linear; each light's share is unbiased whatever the selection gives it),
+/// within 5 standard errors of the four renders' combined noise, at depth 3.
+#[test]
+fn three_lights_together_are_the_sum_of_each_alone() {
+    let Some(gpu) = gpu_for_tests("three_lights_together_are_the_sum_of_each_alone") else {
+        return;
+    };
+    let mut base = floor_scene(3.0, 60.0);
+    base.materials.push(lambert([0.7, 0.5, 0.3]));
+    base.add_uv_sphere(Vec3::new(0.3, 0.6, -0.2), 0.6, 64, 32, 1);
+    let sun = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, 0.3).normalize(),
+        irradiance: Vec3::splat(4.0),
+    };
+    let point = Light::Point {
+        position: Vec3::new(-0.8, 0.4, 0.6),
+        intensity: Vec3::new(0.6, 0.5, 0.4),
+    };
+    let sky = Environment::Constant(Vec3::new(0.2, 0.3, 0.45));
+    let c = RenderConfig {
+        max_depth: 3,
+        ..config(32, Strategy::Mis)
+    };
+    let with = |lights: Vec<Light>, env: Option<&Environment>| {
+        let mut s = base.clone();
+        s.lights = lights;
+        render_twice(&gpu, &s, env, c)
+    };
+    let all = with(vec![sun, point], Some(&sky));
+    let alone = [
+        with(vec![sun], None),
+        with(vec![point], None),
+        with(vec![], Some(&sky)),
+    ];
+    // Per 8 × 8 block: mean and variance of the mean (from the two seeds) of each render.
+    let stats = |imgs: &[Image; 2]| {
+        let mut out = vec![(DVec3::ZERO, DVec3::ZERO, 0usize); 64];
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let i = (y * SIZE + x) as usize;
+                let k = blocks(x, y).unwrap();
+                let (a, b) = (dv(imgs[0].pixels[i]), dv(imgs[1].pixels[i]));
+                out[k].0 += 0.5 * (a + b);
+                out[k].1 += (a - b) * (a - b);
+                out[k].2 += 1;
+            }
+        }
+        out.into_iter()
+            .map(|(s, d2, n)| {
+                let n = n as f64;
+                (s / n, d2 / n / (4.0 * n))
+            })
+            .collect::<Vec<_>>()
+    };
+    let (sa, parts) = (stats(&all), alone.each_ref().map(stats));
+    let mut worst = 0.0f64;
+    for k in 0..64 {
+        let sum: DVec3 = parts.iter().map(|p| p[k].0).sum();
+        let var: DVec3 = sa[k].1 + parts.iter().map(|p| p[k].1).sum::<DVec3>();
+        for ch in 0..3 {
+            let allowed = Z * var[ch].sqrt() + 1e-3 * sum[ch] + 1e-5;
+            let r = (sa[k].0[ch] - sum[ch]).abs() / allowed;
+            worst = worst.max(r);
+            assert!(
+                r <= 1.0,
+                "block {k} channel {ch}: all lights {:.5}, sum of each alone {:.5} (se {:.5})",
+                sa[k].0[ch],
+                sum[ch],
+                var[ch].sqrt()
+            );
+        }
+    }
+    println!("three lights: worst |all − Σ alone| / allowance {worst:.3}");
+}
+
+/// The gold scene of issue 12 (a GGX sphere on a Lambertian plane, a constant sky of 0.5 and a
+/// 40 W/sr point light): the robust selection gives the point light a fair share, where the
+/// flux-based one starved it.
+#[test]
+fn light_selection_does_not_starve_a_point_light() {
+    let Some(gpu) = gpu_for_tests("light_selection_does_not_starve_a_point_light") else {
+        return;
+    };
+    let mut scene = Scene {
+        materials: vec![lambert([0.5; 3]), lambert([0.8, 0.6, 0.2])],
+        lights: vec![Light::Point {
+            position: Vec3::new(2.0, 3.0, 2.0),
+            intensity: Vec3::splat(40.0),
+        }],
+        ..floor_scene(3.0, 60.0)
+    };
+    scene.positions.clear();
+    scene.normals.clear();
+    scene.uvs.clear();
+    scene.tangents.clear();
+    scene.indices.clear();
+    scene.triangle_material.clear();
+    // A 20 × 20 floor: the bounding sphere that sized the sky's flux is large.
+    scene.add_quad(
+        Vec3::new(-10.0, -1.0, 10.0),
+        Vec3::new(20.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -20.0),
+        1.0,
+        0,
+    );
+    scene.add_uv_sphere(Vec3::ZERO, 1.0, 64, 32, 1);
+    let env = Environment::Constant(Vec3::splat(0.5));
+    let pmf = |selection| {
+        let rc = ResourceConfig {
+            light_selection: selection,
+            ..ResourceConfig::standard()
+        };
+        SceneResources::new(&gpu, &scene, Some(&env), rc)
+            .unwrap()
+            .built
+            .light_pmf
+    };
+    let (robust, power) = (
+        pmf(facet_render::LightSelection::Robust),
+        pmf(facet_render::LightSelection::Power),
+    );
+    println!("point light, environment: robust {robust:?}, by flux {power:?}");
+    assert_eq!(robust.len(), 2);
+    assert!((robust.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+    assert!(
+        robust[0] >= 0.25 && robust[0] > 2.0 * power[0],
+        "{robust:?} vs {power:?}"
+    );
+}

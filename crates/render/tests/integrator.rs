@@ -568,3 +568,66 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
         assert!(gpu_bytes.iter().all(|p| p[3] == 255));
     }
 }
+
+/// The variance output predicts the noise: the mean per-pixel variance of the mean reported at
+/// 16 spp is a quarter of that at 4 spp (σ²/n), and it matches the spread between two renders
+/// with different seeds, E[(a − b)²] / 2, to 15 % (the estimate of either over 4096 pixels).
+#[test]
+fn reported_variance_matches_the_seed_to_seed_spread() {
+    let Some(gpu) = gpu_for_tests("reported_variance_matches_the_seed_to_seed_spread") else {
+        return;
+    };
+    let mut scene = sphere_scene(facet_material(FacetModel::Ggx, None));
+    scene.lights.push(facet_render::scene::Light::Directional {
+        direction: Vec3::new(0.3, -0.4, -1.0).normalize(),
+        irradiance: Vec3::splat(2.0),
+    });
+    let env = Environment::Constant(Vec3::new(0.5, 0.4, 0.3));
+    let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
+    let integrator = Integrator::new(&gpu.device, &res).unwrap();
+    let camera = CameraFrame::new(&scene.camera).unwrap();
+    let mut wf =
+        facet_render::Wavefront::with_variance(&gpu, &integrator, &res, SIZE, SIZE, 1 << 16)
+            .unwrap();
+    let mut at = |spp: u32, seed: u32| {
+        wf.clear(&gpu);
+        let c = RenderConfig {
+            seed,
+            ..config(spp)
+        };
+        wf.render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+            .unwrap();
+        (wf.image(&gpu).unwrap(), wf.variance(&gpu).unwrap().unwrap())
+    };
+    let mean_var = |v: &Image| {
+        v.pixels.iter().flatten().map(|&x| x as f64).sum::<f64>() / (3 * v.pixels.len()) as f64
+    };
+    let (a4, v4) = at(4, 0);
+    let (a16, v16) = at(16, 0);
+    let (b16, _) = at(16, 1);
+    let spread = a16
+        .pixels
+        .iter()
+        .flatten()
+        .zip(b16.pixels.iter().flatten())
+        .map(|(a, b)| 0.5 * (*a as f64 - *b as f64).powi(2))
+        .sum::<f64>()
+        / (3 * a16.pixels.len()) as f64;
+    let (m4, m16) = (mean_var(&v4), mean_var(&v16));
+    println!(
+        "mean variance of a pixel: 4 spp {m4:.4e}, 16 spp {m16:.4e} (ratio {:.3}); seed-to-seed spread at 16 spp {spread:.4e}",
+        m4 / m16
+    );
+    assert!(
+        v16.pixels
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite() && *v >= 0.0)
+    );
+    assert!((m4 / m16 / 4.0 - 1.0).abs() < 0.15, "{m4} / {m16}");
+    assert!((m16 / spread - 1.0).abs() < 0.15, "{m16} vs {spread}");
+    assert!(a4.samples.iter().all(|&s| s == 4) && v16.samples.iter().all(|&s| s == 16));
+    // Without the moments there is no variance.
+    let plain = facet_render::Wavefront::new(&gpu, &integrator, &res, SIZE, SIZE, 1 << 16).unwrap();
+    assert!(plain.variance(&gpu).unwrap().is_none());
+}

@@ -46,7 +46,8 @@ pub fn place(
         Some(Environment::Constant(c)) => {
             rec.kind = EnvKind::Constant;
             rec.color = c.extend(0.0).to_array();
-            lights.push(light, flux(lum(*c)));
+            // What it delivers to an unoccluded surface: π L.
+            lights.push(light, flux(lum(*c)), PI * lum(*c));
         }
         Some(Environment::Map(map)) => {
             rec.kind = EnvKind::Map;
@@ -65,7 +66,16 @@ pub fn place(
             rec.offsets = (texels, marginal, conditional);
             let mean =
                 map.texels.iter().map(|t| lum(*t)).sum::<f32>() / map.texels.len().max(1) as f32;
-            lights.push(light, flux(mean));
+            // The solid-angle mean: rows weighted by sin θ at their centres.
+            let (w, h) = (map.width as usize, map.height as usize);
+            let (mut sum, mut weight) = (0.0f64, 0.0f64);
+            for (y, row) in map.texels.chunks(w.max(1)).enumerate().take(h) {
+                let s = (PI as f64 * (y as f64 + 0.5) / h as f64).sin();
+                sum += s * row.iter().map(|t| lum(*t) as f64).sum::<f64>();
+                weight += s * w as f64;
+            }
+            let solid_mean = (sum / weight.max(1e-30)) as f32;
+            lights.push(light, flux(mean), PI * solid_mean);
         }
         None => {}
     }

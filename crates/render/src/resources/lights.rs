@@ -1,6 +1,13 @@
 //! The lights next-event estimation picks from — punctual lights, emissive triangles, the
-//! environment — each with an estimate of its power; one is chosen with probability ∝ power
-//! (the CDF goes into the tables).
+//! environment — and the probability of picking each (the CDF goes into the tables).
+//!
+//! [`LightSelection::Robust`] (the default) estimates what each light delivers to the scene —
+//! irradiance averaged over up to 256 of its vertices: I·falloff / d² for punctual lights,
+//! Le A cos θl / d² for an emissive triangle, E for a directional light, π L̄ (L̄ the
+//! solid-angle mean) for the environment — and picks with half that, half uniformly, so that no
+//! light is starved by a bad estimate. [`LightSelection::Power`] is the older choice by
+//! emitted flux, the environment's through the scene's bounding sphere (kept to measure
+//! against).
 
 use super::tables::Tables;
 use crate::gpu_types::{GpuLight, GpuMaterial, LightKind, NONE};
@@ -13,11 +20,28 @@ pub fn lum(c: Vec3) -> f32 {
     c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
-/// Lights with their power estimates, and the light index of every emissive triangle.
+/// How next-event estimation picks a light.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LightSelection {
+    /// ½ uniform + ½ ∝ the irradiance each light delivers to the scene's vertices.
+    #[default]
+    Robust,
+    /// ∝ emitted flux (the environment's through the bounding sphere).
+    Power,
+}
+
+/// Up to this many scene vertices stand for the scene in the contribution estimates.
+const PROBES: usize = 256;
+
+/// Lights with their flux and contribution estimates, and the light index of every emissive
+/// triangle.
 #[derive(Default)]
 pub struct LightSet {
     pub lights: Vec<GpuLight>,
+    /// Emitted flux (the Power selection).
     pub power: Vec<f32>,
+    /// Mean irradiance delivered to the probe vertices (the Robust selection).
+    pub contribution: Vec<f32>,
     /// Per triangle, its light index or NONE; a single NONE when no triangle emits.
     pub triangle_light: Vec<u32>,
 }
@@ -27,7 +51,41 @@ impl LightSet {
     /// bounds the scene (a directional light's power is its flux through that disc).
     pub fn new(scene: &Scene, materials: &[GpuMaterial], radius: f32) -> Self {
         let mut set = LightSet::default();
+        let stride = scene.positions.len().div_ceil(PROBES).max(1);
+        let probes: Vec<Vec3> = scene.positions.iter().step_by(stride).copied().collect();
+        // Mean over the probes of g(probe − x, d²), d² kept above (r / 1000)².
+        let near = (1e-3 * radius).powi(2);
+        let mean_over = |x: Vec3, g: &dyn Fn(Vec3, f32) -> f32| {
+            probes
+                .iter()
+                .map(|p| g(*p - x, (*p - x).length_squared().max(near)))
+                .sum::<f32>()
+                / probes.len().max(1) as f32
+        };
         for l in &scene.lights {
+            let contribution = match *l {
+                Light::Point {
+                    position,
+                    intensity,
+                } => lum(intensity) * mean_over(position, &|_, d2| 1.0 / d2),
+                Light::Spot {
+                    position,
+                    direction,
+                    intensity,
+                    inner_cone,
+                    outer_cone,
+                } => {
+                    let (ci, co) = (inner_cone.cos(), outer_cone.cos());
+                    // glTF's smooth falloff t², t = (cos α − cos outer) / (cos inner − cos outer).
+                    let falloff = |v: Vec3| {
+                        let t = ((v.normalize_or_zero().dot(direction) - co) / (ci - co).max(1e-4))
+                            .clamp(0.0, 1.0);
+                        t * t
+                    };
+                    lum(intensity) * mean_over(position, &|v, d2| falloff(v) / d2)
+                }
+                Light::Directional { irradiance, .. } => lum(irradiance),
+            };
             let (g, p) = match *l {
                 Light::Point {
                     position,
@@ -72,7 +130,7 @@ impl LightSet {
                     PI * radius * radius * lum(irradiance),
                 ),
             };
-            set.push(g, p);
+            set.push(g, p, contribution);
         }
         for (ti, tri) in scene.indices.iter().enumerate() {
             let m = &materials[scene.triangle_material[ti] as usize];
@@ -81,7 +139,14 @@ impl LightSet {
                 continue;
             }
             let [a, b, c] = tri.map(|i| scene.positions[i as usize]);
-            let area = 0.5 * (b - a).cross(c - a).length();
+            let cross = (b - a).cross(c - a);
+            let area = 0.5 * cross.length();
+            let normal = cross.normalize_or_zero();
+            let centre = (a + b + c) / 3.0;
+            // One-sided: Le A cos θl / d² toward the probes in front.
+            let contribution = lum(le)
+                * area
+                * mean_over(centre, &|v, d2| (normal.dot(v) / d2.sqrt()).max(0.0) / d2);
             if set.triangle_light.is_empty() {
                 set.triangle_light = vec![NONE; scene.indices.len()];
             }
@@ -94,6 +159,7 @@ impl LightSet {
             // Flux of a Lambertian emitter: π A Le.
             set.lights.push(light);
             set.power.push(PI * area * lum(le));
+            set.contribution.push(contribution);
         }
         if set.triangle_light.is_empty() {
             set.triangle_light.push(NONE);
@@ -102,10 +168,31 @@ impl LightSet {
     }
 
     /// Adds a light if its power is positive.
-    pub fn push(&mut self, light: GpuLight, power: f32) {
+    pub fn push(&mut self, light: GpuLight, power: f32, contribution: f32) {
         if power > 0.0 {
             self.lights.push(light);
             self.power.push(power);
+            self.contribution.push(contribution.max(0.0));
+        }
+    }
+
+    /// The probability of picking each light.
+    pub fn pmf(&self, selection: LightSelection) -> Vec<f32> {
+        let n = self.lights.len();
+        let normalised = |w: &[f32]| {
+            let total: f32 = w.iter().sum();
+            if total > 0.0 && total.is_finite() {
+                w.iter().map(|x| x / total).collect()
+            } else {
+                vec![1.0 / n as f32; n]
+            }
+        };
+        match selection {
+            LightSelection::Power => normalised(&self.power),
+            LightSelection::Robust => normalised(&self.contribution)
+                .into_iter()
+                .map(|p: f32| 0.5 * p + 0.5 / n as f32)
+                .collect(),
         }
     }
 
@@ -116,13 +203,13 @@ impl LightSet {
             .count()
     }
 
-    /// Writes the selection CDF (n + 1 entries, 0 … 1) into `tables`; returns its offset.
-    pub fn place_cdf(&self, tables: &mut Tables) -> u32 {
-        let total: f32 = self.power.iter().sum();
+    /// Writes the selection CDF (n + 1 entries, 0 … 1) of `pmf` into `tables`; returns its
+    /// offset.
+    pub fn place_cdf(pmf: &[f32], tables: &mut Tables) -> u32 {
         let mut acc = 0.0;
         let mut cdf = vec![0.0f32];
-        for p in &self.power {
-            acc += p / total;
+        for p in pmf {
+            acc += p;
             cdf.push(acc);
         }
         if let Some(last) = cdf.last_mut() {

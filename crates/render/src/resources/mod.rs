@@ -23,6 +23,7 @@ use crate::scene::{Environment, Scene};
 use facet_glint::dpf::DpfConfig;
 use facet_glint::gpu::GpuDpf;
 use facet_gpu::{Gpu, buffer};
+pub use lights::LightSelection;
 use lights::LightSet;
 use tables::Tables;
 
@@ -42,6 +43,8 @@ pub struct Built {
     pub bvh_nodes: usize,
     pub bvh_build_ms: f64,
     pub glint_build_ms: f64,
+    /// The probability of picking each light (punctual, emissive triangles, environment).
+    pub light_pmf: Vec<f32>,
 }
 
 /// One glint material's GPU resources (bind group 2 of its shading stage).
@@ -88,6 +91,8 @@ pub struct ResourceConfig {
     pub dpf: DpfConfig,
     /// Whether the glint count may be replaced by its mean above the threshold.
     pub glint_filter: bool,
+    /// How next-event estimation picks a light.
+    pub light_selection: LightSelection,
 }
 
 impl ResourceConfig {
@@ -96,6 +101,7 @@ impl ResourceConfig {
             bvh: BvhConfig::medium(),
             dpf: DpfConfig::standard(),
             glint_filter: true,
+            light_selection: LightSelection::Robust,
         }
     }
 }
@@ -207,7 +213,9 @@ impl SceneResources {
         built.emissive_triangles = light_set.emissive_triangles();
         let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
         built.environment_map = env.kind == crate::tags::EnvKind::Map;
-        let light_cdf = light_set.place_cdf(&mut tables);
+        let pmf = light_set.pmf(config.light_selection);
+        let light_cdf = LightSet::place_cdf(&pmf, &mut tables);
+        built.light_pmf = pmf;
         let LightSet {
             mut lights,
             triangle_light,
