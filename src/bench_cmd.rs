@@ -44,6 +44,18 @@ pub struct BenchArgs {
     /// Same as --mode smoke.
     #[arg(long, conflicts_with_all = ["mode", "quick", "full"])]
     pub smoke: bool,
+    /// Only these sections (comma-separated; default: all).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub only: Vec<Section>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Section {
+    Fit,
+    Trace,
+    Integrator,
+    Viewer,
+    Noise,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -211,15 +223,26 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
             info.name, info.backend, info.device_type, info.driver, info.driver_info
         );
     }
-    report["fit"] = fit(gpu.as_ref(), &sizes)?;
+    let on = |s: Section| args.only.is_empty() || args.only.contains(&s);
+    if on(Section::Fit) {
+        report["fit"] = fit(gpu.as_ref(), &sizes)?;
+    }
     if let Some(g) = &gpu {
-        report["trace"] = trace(g, &sizes)?;
-        let (integrator, stages, glint) = integrator(g, &sizes)?;
-        report["integrator"] = integrator;
-        report["stages"] = stages;
-        report["glint"] = glint;
-        report["viewer"] = viewer(g, &sizes)?;
-        report["noise"] = noise(g, &sizes)?;
+        if on(Section::Trace) {
+            report["trace"] = trace(g, &sizes)?;
+        }
+        if on(Section::Integrator) {
+            let (integrator, stages, glint) = integrator(g, &sizes)?;
+            report["integrator"] = integrator;
+            report["stages"] = stages;
+            report["glint"] = glint;
+        }
+        if on(Section::Viewer) {
+            report["viewer"] = viewer(g, &sizes)?;
+        }
+        if on(Section::Noise) {
+            report["noise"] = noise(g, &sizes)?;
+        }
     }
     report["total_s"] = json!(t0.elapsed().as_secs_f64());
     println!("bench total {:.1} s", t0.elapsed().as_secs_f64());
@@ -602,6 +625,15 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
             let mut wf = Wavefront::new(gpu, &integrator, &res, side, side, side * side)?;
             let mut images = Vec::new();
             let mut ms = 0.0;
+            // An untimed render first: the first dispatches of fresh pipelines are slower.
+            let warm = RenderConfig {
+                width: side,
+                height: side,
+                spp: 1,
+                ndf_sampling,
+                ..RenderConfig::standard()
+            };
+            wf.render_more(gpu, &integrator, &res, &camera, &warm, &mut |_| {})?;
             for seed in [0, 1] {
                 let cfg = RenderConfig {
                     width: side,

@@ -1,13 +1,15 @@
 //! The environment on the GPU: its kind and colour in the frame uniform, a map's texels and
 //! sampling CDFs in the tables, and its entry among the lights.
 
-use super::lights::{LightSet, lum};
+use super::lights::{LightSet, Probe, lum};
 use super::tables::Tables;
 use crate::error::RenderError;
 use crate::gpu_types::{GpuLight, LightKind};
 use crate::limits::{DeviceLimits, Planned};
-use crate::scene::Environment;
+use crate::scene::environment::uv_to_direction;
+use crate::scene::{Environment, EnvironmentMap};
 use crate::tags::EnvKind;
+use glam::Vec2;
 use std::f32::consts::PI;
 
 /// The frame uniform's environment fields.
@@ -20,6 +22,49 @@ pub struct EnvRecord {
     pub offsets: (u32, u32, u32),
     /// A constant environment's radiance.
     pub color: [f32; 4],
+}
+
+/// The map's irradiance ∫ L max(0, n·ω) dω averaged over the probes, on a grid of at most
+/// 32 × 16 cells (each the mean of its texels, at its centre direction, with its solid angle).
+fn map_irradiance(map: &EnvironmentMap, probes: &[Probe]) -> f32 {
+    let (w, h) = (map.width as usize, map.height as usize);
+    let (cw, ch) = (w.min(32), h.min(16));
+    let mut cells = Vec::with_capacity(cw * ch);
+    for cy in 0..ch {
+        let (y0, y1) = (cy * h / ch, (cy + 1) * h / ch);
+        let (t0, t1) = (PI * y0 as f32 / h as f32, PI * y1 as f32 / h as f32);
+        for cx in 0..cw {
+            let (x0, x1) = (cx * w / cw, (cx + 1) * w / cw);
+            let mut l = 0.0;
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    l += lum(map.texels[y * w + x]);
+                }
+            }
+            l /= ((y1 - y0) * (x1 - x0)).max(1) as f32;
+            let u = Vec2::new(
+                0.5 * (x0 + x1) as f32 / w as f32,
+                0.5 * (y0 + y1) as f32 / h as f32,
+            );
+            // dω of the cell: Δφ (cos θ0 − cos θ1).
+            let omega = 2.0 * PI * (x1 - x0) as f32 / w as f32 * (t0.cos() - t1.cos());
+            cells.push((uv_to_direction(u), l * omega));
+        }
+    }
+    if probes.is_empty() {
+        // No receivers to ask: the irradiance of an upward surface.
+        return cells.iter().map(|(d, e)| d.y.max(0.0) * e).sum();
+    }
+    probes
+        .iter()
+        .map(|q| {
+            cells
+                .iter()
+                .map(|(d, e)| q.n.dot(*d).max(0.0) * e)
+                .sum::<f32>()
+        })
+        .sum::<f32>()
+        / probes.len() as f32
 }
 
 /// Places `environment` in the tables and among the lights; `radius` bounds the scene (the
@@ -46,7 +91,7 @@ pub fn place(
         Some(Environment::Constant(c)) => {
             rec.kind = EnvKind::Constant;
             rec.color = c.extend(0.0).to_array();
-            // What it delivers to an unoccluded surface: π L.
+            // What it delivers to any unoccluded surface: π L.
             lights.push(light, flux(lum(*c)), PI * lum(*c));
         }
         Some(Environment::Map(map)) => {
@@ -66,16 +111,8 @@ pub fn place(
             rec.offsets = (texels, marginal, conditional);
             let mean =
                 map.texels.iter().map(|t| lum(*t)).sum::<f32>() / map.texels.len().max(1) as f32;
-            // The solid-angle mean: rows weighted by sin θ at their centres.
-            let (w, h) = (map.width as usize, map.height as usize);
-            let (mut sum, mut weight) = (0.0f64, 0.0f64);
-            for (y, row) in map.texels.chunks(w.max(1)).enumerate().take(h) {
-                let s = (PI as f64 * (y as f64 + 0.5) / h as f64).sin();
-                sum += s * row.iter().map(|t| lum(*t) as f64).sum::<f64>();
-                weight += s * w as f64;
-            }
-            let solid_mean = (sum / weight.max(1e-30)) as f32;
-            lights.push(light, flux(mean), PI * solid_mean);
+            let contribution = map_irradiance(map, &lights.probes);
+            lights.push(light, flux(mean), contribution);
         }
         None => {}
     }

@@ -2,10 +2,11 @@
 //! environment — and the probability of picking each (the CDF goes into the tables).
 //!
 //! [`LightSelection::Robust`] (the default) estimates what each light delivers to the scene —
-//! irradiance averaged over up to 256 of its vertices: I·falloff / d² for punctual lights,
-//! Le A cos θl / d² for an emissive triangle, E for a directional light, π L̄ (L̄ the
-//! solid-angle mean) for the environment — and picks with half that, half uniformly, so that no
-//! light is starved by a bad estimate. [`LightSelection::Power`] is the older choice by
+//! the irradiance on up to 256 of its vertices (probes, each with its shading normal n),
+//! averaged, occlusion ignored: I·falloff·max(0, n·l) / d² for punctual lights,
+//! E max(0, n·l) for a directional light, Le A max(0, nl·(−l)) max(0, n·l) / d² for an
+//! emissive triangle, ∫ L max(0, n·ω) dω for the environment — and picks with half that, half
+//! uniformly, so that no light is starved by a bad estimate. [`LightSelection::Power`] is the older choice by
 //! emitted flux, the environment's through the scene's bounding sphere (kept to measure
 //! against).
 
@@ -33,6 +34,13 @@ pub enum LightSelection {
 /// Up to this many scene vertices stand for the scene in the contribution estimates.
 const PROBES: usize = 256;
 
+/// A scene vertex standing for the receivers: its position and shading normal.
+#[derive(Clone, Copy, Debug)]
+pub struct Probe {
+    pub p: Vec3,
+    pub n: Vec3,
+}
+
 /// Lights with their flux and contribution estimates, and the light index of every emissive
 /// triangle.
 #[derive(Default)]
@@ -44,6 +52,8 @@ pub struct LightSet {
     pub contribution: Vec<f32>,
     /// Per triangle, its light index or NONE; a single NONE when no triangle emits.
     pub triangle_light: Vec<u32>,
+    /// The receivers the contributions are averaged over.
+    pub probes: Vec<Probe>,
 }
 
 impl LightSet {
@@ -52,13 +62,24 @@ impl LightSet {
     pub fn new(scene: &Scene, materials: &[GpuMaterial], radius: f32) -> Self {
         let mut set = LightSet::default();
         let stride = scene.positions.len().div_ceil(PROBES).max(1);
-        let probes: Vec<Vec3> = scene.positions.iter().step_by(stride).copied().collect();
-        // Mean over the probes of g(probe − x, d²), d² kept above (r / 1000)².
+        set.probes = scene
+            .positions
+            .iter()
+            .zip(&scene.normals)
+            .step_by(stride)
+            .map(|(p, n)| Probe { p: *p, n: *n })
+            .collect();
+        let probes = set.probes.clone();
+        // Mean over the probes of g(l, d², n): l the unit vector from the probe to x, d² its
+        // squared distance (kept above (r / 1000)²), n the probe's normal.
         let near = (1e-3 * radius).powi(2);
-        let mean_over = |x: Vec3, g: &dyn Fn(Vec3, f32) -> f32| {
+        let mean_over = |x: Vec3, g: &dyn Fn(Vec3, f32, Vec3) -> f32| {
             probes
                 .iter()
-                .map(|p| g(*p - x, (*p - x).length_squared().max(near)))
+                .map(|q| {
+                    let v = x - q.p;
+                    g(v.normalize_or_zero(), v.length_squared().max(near), q.n)
+                })
                 .sum::<f32>()
                 / probes.len().max(1) as f32
         };
@@ -67,7 +88,7 @@ impl LightSet {
                 Light::Point {
                     position,
                     intensity,
-                } => lum(intensity) * mean_over(position, &|_, d2| 1.0 / d2),
+                } => lum(intensity) * mean_over(position, &|l, d2, n| n.dot(l).max(0.0) / d2),
                 Light::Spot {
                     position,
                     direction,
@@ -77,14 +98,22 @@ impl LightSet {
                 } => {
                     let (ci, co) = (inner_cone.cos(), outer_cone.cos());
                     // glTF's smooth falloff t², t = (cos α − cos outer) / (cos inner − cos outer).
-                    let falloff = |v: Vec3| {
-                        let t = ((v.normalize_or_zero().dot(direction) - co) / (ci - co).max(1e-4))
-                            .clamp(0.0, 1.0);
-                        t * t
+                    // l points from the probe to the light: the light sees the probe along −l.
+                    let falloff = |l: Vec3| {
+                        let t = ((-l).dot(direction) - co) / (ci - co).max(1e-4);
+                        t.clamp(0.0, 1.0).powi(2)
                     };
-                    lum(intensity) * mean_over(position, &|v, d2| falloff(v) / d2)
+                    lum(intensity)
+                        * mean_over(position, &|l, d2, n| falloff(l) * n.dot(l).max(0.0) / d2)
                 }
-                Light::Directional { irradiance, .. } => lum(irradiance),
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => {
+                    let l = -direction.normalize_or_zero();
+                    lum(irradiance) * probes.iter().map(|q| q.n.dot(l).max(0.0)).sum::<f32>()
+                        / probes.len().max(1) as f32
+                }
             };
             let (g, p) = match *l {
                 Light::Point {
@@ -143,10 +172,12 @@ impl LightSet {
             let area = 0.5 * cross.length();
             let normal = cross.normalize_or_zero();
             let centre = (a + b + c) / 3.0;
-            // One-sided: Le A cos θl / d² toward the probes in front.
+            // One-sided: Le A cos θl cos θ / d² toward the probes in front.
             let contribution = lum(le)
                 * area
-                * mean_over(centre, &|v, d2| (normal.dot(v) / d2.sqrt()).max(0.0) / d2);
+                * mean_over(centre, &|l, d2, n| {
+                    normal.dot(-l).max(0.0) * n.dot(l).max(0.0) / d2
+                });
             if set.triangle_light.is_empty() {
                 set.triangle_light = vec![NONE; scene.indices.len()];
             }
