@@ -529,9 +529,14 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
 
 /// A fit of an analytic GGX gold conductor, as a Facet material rendering its GGX model.
 fn gold_ggx(alpha: f64) -> Result<Material> {
+    gold_fit(alpha, facet_render::scene::FacetModel::Ggx)
+}
+
+/// A fit of gold GGX(α) written as a MERL table, rendered by `model` of the fit.
+fn gold_fit(alpha: f64, model: facet_render::scene::FacetModel) -> Result<Material> {
     let spec = format!("ggx?alpha={alpha}&conductor=gold");
-    let model = facet_fit::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let src = MerlBrdf::from_table(&spec, MerlTable::sample(&model))
+    let truth = facet_fit::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let src = MerlBrdf::from_table(&spec, MerlTable::sample(&truth))
         .map_err(|e| anyhow::anyhow!("{spec}: {e}"))?;
     let fit = facet_fit::fit_material(&src, &spec, &FitConfig::isotropic())?;
     Ok(Material {
@@ -539,7 +544,7 @@ fn gold_ggx(alpha: f64) -> Result<Material> {
         facet: Some(facet_render::scene::FacetMaterial {
             source: spec.into(),
             fit: Arc::new(fit),
-            model: facet_render::scene::FacetModel::Ggx,
+            model,
             glint: None,
         }),
         ..Default::default()
@@ -548,7 +553,7 @@ fn gold_ggx(alpha: f64) -> Result<Material> {
 
 /// Issue 12's gold scene: a GGX gold sphere (α = 0.3) on a 20 × 20 grey Lambertian floor, a
 /// constant sky of 0.5 and a 40 W/sr point light.
-fn gold_scene() -> Result<(Scene, Environment)> {
+fn gold_scene(sphere: Material) -> Result<(Scene, Environment)> {
     let mut scene = Scene {
         materials: vec![
             Material {
@@ -557,7 +562,7 @@ fn gold_scene() -> Result<(Scene, Environment)> {
                 specular: 0.0,
                 ..Default::default()
             },
-            gold_ggx(0.3)?,
+            sphere,
         ],
         lights: vec![facet_render::scene::Light::Point {
             position: Vec3::new(2.0, 3.0, 2.0),
@@ -583,16 +588,18 @@ fn gold_scene() -> Result<(Scene, Environment)> {
 }
 
 /// Noise at equal spp and time per sample, before (D cos θh sampling, selection by flux) and
-/// after (visible normals, robust selection), and each change alone, on the gold scene, the
-/// demo and a glossy (α = 0.05) sphere under the sky. The variance of a pixel is estimated from
+/// after (visible normals, robust selection), and each change alone, on the gold scene (GGX and
+/// the fit's tabulated NDF), the demo and a glossy (α = 0.05) sphere under the sky. The variance of a pixel is estimated from
 /// two renders with different seeds: E[(a − b)²] / 2, averaged over pixels and channels.
 fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     use facet_render::{LightSelection, NdfSampling};
     let (side, spp) = sizes.noise;
     let (demo, sky) = demo_scene(true)?;
     let glossy = facet_render::scene::shapes::preview_scene(gold_ggx(0.05)?);
+    let tabulated = gold_fit(0.3, facet_render::scene::FacetModel::Tabulated)?;
     let scenes = [
-        ("gold sphere, sky and point light", gold_scene()?),
+        ("gold sphere, sky and point light", gold_scene(gold_ggx(0.3)?)?),
+        ("the same, the fit's tabulated NDF", gold_scene(tabulated)?),
         ("demo", (demo, sky.clone())),
         ("glossy GGX α = 0.05 sphere under the sky", (glossy, sky)),
     ];

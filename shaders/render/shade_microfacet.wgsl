@@ -2,8 +2,8 @@
 //   f = F(θd) D(h) G2(ωi, ωo) / (4 cos θi cos θo) + ρd / π,
 // F the fit's Fresnel table, D and Λ analytic (GGX / Beckmann, TABULATED = 0) or the fit's
 // tables (TABULATED = 1), the correlated G2. Sampling, with probability p_spec: the normals
-// visible from ωo (analytic NDFs) or the table's D cos θh (tabulated); else the cosine lobe
-// when the fit has a diffuse term.
+// visible from ωo (by frame.ndf_sampling: analytic in closed form, tabulated by the table's
+// visible slices); else the cosine lobe when the fit has a diffuse term.
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -29,7 +29,7 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     b.material = s.material;
     b.analytic = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
     if (TABULATED) {
-        b.tab = tab_ndf(m);
+        b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
     }
     b.diffuse = m.diffuse.xyz;
     // Lobe choice by albedo: the specular lobe's is at most ~F(0); compare with ρd.
@@ -56,14 +56,20 @@ fn mf_lambda(b: Bsdf, w: vec3<f32>) -> f32 {
 // pdf of the sampled normal over solid angle (visible normals for analytic NDFs).
 fn mf_pdf_h(b: Bsdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
     if (TABULATED) {
-        return tab_pdf(b.tab, h);
+        if (frame.ndf_sampling == NDF_SAMPLING_D_COS) {
+            return tab_pdf(b.tab, h);
+        }
+        return tab_pdf_visible(b.tab, wo, h);
     }
     return lobe_pdf_h(b.analytic, wo, h);
 }
 
 fn mf_sample_h(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
     if (TABULATED) {
-        return tab_sample(b.tab, u);
+        if (frame.ndf_sampling == NDF_SAMPLING_D_COS) {
+            return tab_sample(b.tab, u);
+        }
+        return tab_sample_visible(b.tab, wo, u);
     }
     return lobe_sample_h(b.analytic, wo, u);
 }

@@ -32,6 +32,7 @@
 pub mod albedo;
 pub mod analytic;
 pub mod brdf;
+pub mod chi2;
 pub mod error;
 pub mod extract;
 pub mod fit;
@@ -49,6 +50,7 @@ pub mod quadrature;
 pub mod source;
 pub mod tabulated;
 pub mod visible_normals;
+pub mod visible_tables;
 
 pub use brdf::{Brdf, Rgb};
 pub use error::FitError;

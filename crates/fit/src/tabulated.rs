@@ -7,9 +7,11 @@
 //! Λ(w) = Λ₀(w₀), w₀ ∝ (αx wx, αy wy, wz) (Heitz 2014, shape invariance of Smith Λ).
 
 use crate::geometry::{phi_of, spherical, theta_of, theta_to_u};
+use crate::visible_tables::{ANISO_ROWS, VisibleTables};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
+use std::sync::{Arc, OnceLock};
 
 /// Stretch and rotation applied to a tabulated NDF (1, 1, 0: the NDF as extracted).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -95,6 +97,9 @@ pub struct TabulatedNdf {
     cdf: Vec<f64>,
     /// Mass of each cell divided by its solid angle: the sampling pdf inside it.
     cell_pdf: Vec<f64>,
+    /// The base table's visible-normal sampling tables, built on first use and shared by
+    /// every stretch of the same table.
+    visible: Arc<OnceLock<VisibleTables>>,
 }
 
 impl TabulatedNdf {
@@ -143,6 +148,7 @@ impl TabulatedNdf {
             stretch,
             cdf,
             cell_pdf,
+            visible: Arc::default(),
         })
     }
 
@@ -154,6 +160,40 @@ impl TabulatedNdf {
     /// cells: what a GPU twin of [`Self::sample`] and [`Self::pdf`] needs.
     pub fn sampling_tables(&self) -> (&[f64], &[f64]) {
         (&self.cdf, &self.cell_pdf)
+    }
+
+    /// The visible-normal sampling tables of the base table (built on the first call).
+    pub fn visible_tables(&self) -> &VisibleTables {
+        self.visible.get_or_init(|| {
+            let t = &self.tables;
+            let rows = if t.nphi == 1 { t.nu - 1 } else { ANISO_ROWS };
+            VisibleTables::new(|theta, phi| self.base_d(theta, phi), t.nphi == 1, rows)
+        })
+    }
+
+    /// Samples a normal visible from `wo` (upper hemisphere) from two uniform numbers; its
+    /// density is [`Self::pdf_visible`]. The base table's visible distribution is sampled for
+    /// the base view w₀ ∝ (αx wx, αy wy, wz), and the normal stretched.
+    pub fn sample_visible(&self, wo: DVec3, u: [f64; 2]) -> DVec3 {
+        let s = self.stretch;
+        let l = self.to_local(wo);
+        let w0 = DVec3::new(l.x * s.alpha_x, l.y * s.alpha_y, l.z.max(0.0)).normalize();
+        let h0 = self.visible_tables().sample(w0, u);
+        let hl = DVec3::new(h0.x * s.alpha_x, h0.y * s.alpha_y, h0.z).normalize();
+        self.to_world(hl)
+    }
+
+    /// Density over solid angle of [`Self::sample_visible`]:
+    /// q_w₀(h₀) cos³θ₀ / (αx αy cos³θh), q_w₀ the base slices' density.
+    pub fn pdf_visible(&self, wo: DVec3, h: DVec3) -> f64 {
+        if h.z <= 0.0 {
+            return 0.0;
+        }
+        let s = self.stretch;
+        let (lo, lh) = (self.to_local(wo), self.to_local(h));
+        let w0 = DVec3::new(lo.x * s.alpha_x, lo.y * s.alpha_y, lo.z.max(0.0)).normalize();
+        let h0 = DVec3::new(lh.x / s.alpha_x, lh.y / s.alpha_y, lh.z).normalize();
+        self.visible_tables().pdf(w0, h0) * (h0.z / lh.z).powi(3) / (s.alpha_x * s.alpha_y)
     }
 
     /// The same tables under another stretch.

@@ -47,16 +47,33 @@ impl MaterialPlan<'_> {
             self.gpu.fresnel_count = FRESNEL_NODES as u32;
         }
         if let Some(tab) = self.tabulated {
-            let tt = tab.tables();
-            let (cdf, cell_pdf) = tab.sampling_tables();
-            let header = [tt.nu as f32, tt.nphi as f32, tt.ng as f32, 0.0];
-            self.gpu.tab_offset = tables.push(source, header);
-            tables.push(source, tt.d.iter().map(|v| *v as f32));
-            tables.push(source, tt.g1.iter().map(|v| *v as f32));
-            tables.push(source, cdf.iter().map(|v| *v as f32));
-            tables.push(source, cell_pdf.iter().map(|v| *v as f32));
+            self.gpu.tab_offset = tables.push(source, tabulated_block(tab));
         }
     }
+}
+
+/// A tabulated NDF's block in the `tables` buffer, as shaders/render/tabulated.inc.wgsl reads
+/// it: [nu, nphi, ng, n_theta_v, n_phi_v, rows, columns, 0], then D₀, G1₀, the D cos θ cells'
+/// CDF and pdf, and the visible-normal slices' CDF and pdf.
+pub fn tabulated_block(tab: &TabulatedNdf) -> Vec<f32> {
+    let tt = tab.tables();
+    let (cdf, cell_pdf) = tab.sampling_tables();
+    let vis = tab.visible_tables();
+    let header = [
+        tt.nu,
+        tt.nphi,
+        tt.ng,
+        vis.n_theta_v,
+        vis.n_phi_v,
+        vis.rows,
+        vis.columns,
+        0,
+    ];
+    let mut block: Vec<f32> = header.iter().map(|&n| n as f32).collect();
+    for t in [&tt.d, &tt.g1, cdf, cell_pdf, &vis.cdf, &vis.cell_pdf] {
+        block.extend(t.iter().map(|&v| v as f32));
+    }
+    block
 }
 
 fn texture(t: Option<u32>) -> u32 {
