@@ -598,7 +598,10 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let glossy = facet_render::scene::shapes::preview_scene(gold_ggx(0.05)?);
     let tabulated = gold_fit(0.3, facet_render::scene::FacetModel::Tabulated)?;
     let scenes = [
-        ("gold sphere, sky and point light", gold_scene(gold_ggx(0.3)?)?),
+        (
+            "gold sphere, sky and point light",
+            gold_scene(gold_ggx(0.3)?)?,
+        ),
         ("the same, the fit's tabulated NDF", gold_scene(tabulated)?),
         ("demo", (demo, sky.clone())),
         ("glossy GGX α = 0.05 sphere under the sky", (glossy, sky)),
@@ -621,7 +624,7 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let mut rows = Vec::new();
     for (name, (scene, env)) in &scenes {
         let camera = CameraFrame::new(&scene.camera)?;
-        let mut base: Option<(f64, f64)> = None;
+        let mut base: Option<(f64, f64, f64, f64)> = None;
         for (label, ndf_sampling, light_selection) in configs {
             let rc = ResourceConfig {
                 light_selection,
@@ -667,14 +670,24 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
                 .sum::<f64>()
                 / n as f64;
             let ns = ms * 1e6 / (2.0 * (side * side) as f64 * spp as f64);
-            let (v0, t0) = *base.get_or_insert((var, ns));
+            // The image mean of both renders and its standard error (pixels independent).
+            let mean = images
+                .iter()
+                .flat_map(|im| im.pixels.iter().flatten())
+                .map(|v| *v as f64)
+                .sum::<f64>()
+                / (2 * n) as f64;
+            let se2 = var / (2 * n) as f64;
+            let (v0, t0, m0, s0) = *base.get_or_insert((var, ns, mean, se2));
+            // The expected image is the same: the means differ by a few standard errors at most.
+            let z = (mean - m0) / (se2 + s0).sqrt().max(1e-30);
             println!(
-                "  {name:<42} {label:<22} variance {var:.3e} ({:.2}× before), {ns:.0} ns a sample ({:.2}×), time × variance {:.2}× before",
+                "  {name:<42} {label:<22} variance {var:.3e} ({:.2}× before), {ns:.0} ns a sample ({:.2}×), time × variance {:.2}× before; mean {mean:.4} ({z:+.1} σ from before)",
                 var / v0,
                 ns / t0,
                 var * ns / (v0 * t0)
             );
-            rows.push(json!({"scene": name, "config": label, "spp": spp, "side": side, "variance": var, "ns_per_sample": ns, "variance_vs_before": var / v0, "time_vs_before": ns / t0, "time_variance_vs_before": var * ns / (v0 * t0)}));
+            rows.push(json!({"scene": name, "config": label, "spp": spp, "side": side, "variance": var, "ns_per_sample": ns, "variance_vs_before": var / v0, "time_vs_before": ns / t0, "time_variance_vs_before": var * ns / (v0 * t0), "mean": mean, "mean_z_vs_before": z}));
         }
     }
     Ok(Value::Array(rows))

@@ -1046,3 +1046,42 @@ fn light_selection_does_not_starve_a_point_light() {
         "{robust:?} vs {power:?}"
     );
 }
+
+/// The robust selection asks what the camera sees: of two equal point lights, each 2 above a
+/// floor, one over the floor in view and one over a floor 40 away that no camera ray reaches,
+/// the first gets ½ (its share of the irradiance at the camera's hits, 1 − O(10⁻⁴): the far
+/// light reaches them at grazing incidence from 40 away) + ¼ (the uniform half), the second
+/// only its uniform ¼.
+#[test]
+fn light_selection_weighs_what_the_camera_sees() {
+    let Some(gpu) = gpu_for_tests("light_selection_weighs_what_the_camera_sees") else {
+        return;
+    };
+    let mut scene = Scene {
+        lights: vec![
+            Light::Point {
+                position: Vec3::new(0.0, 2.0, 0.0),
+                intensity: Vec3::splat(10.0),
+            },
+            Light::Point {
+                position: Vec3::new(43.0, 2.0, 0.0),
+                intensity: Vec3::splat(10.0),
+            },
+        ],
+        ..floor_scene(3.0, 60.0)
+    };
+    scene.add_quad(
+        Vec3::new(40.0, 0.0, 3.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, -6.0),
+        1.0,
+        0,
+    );
+    let pmf = SceneResources::new(&gpu, &scene, None, ResourceConfig::standard())
+        .unwrap()
+        .built
+        .light_pmf;
+    println!("light in view, light out of view: {pmf:?}");
+    assert!((pmf[0] - 0.75).abs() < 1e-3, "{pmf:?}");
+    assert!((pmf[1] - 0.25).abs() < 1e-3, "{pmf:?}");
+}

@@ -91,8 +91,11 @@ pub fn place(
         Some(Environment::Constant(c)) => {
             rec.kind = EnvKind::Constant;
             rec.color = c.extend(0.0).to_array();
-            // What it delivers to any unoccluded surface: π L.
-            lights.push(light, flux(lum(*c)), PI * lum(*c));
+            // Its light samples, uniform over the sphere, are never better than BSDF samples
+            // (cosine or visible normals) at finding a uniform sky: it gets only the robust
+            // selection's uniform share. (MIS compensation, Karlík et al. 2019: what light
+            // sampling adds is the part of L above its mean, nothing for a constant.)
+            lights.push(light, flux(lum(*c)), 0.0);
         }
         Some(Environment::Map(map)) => {
             rec.kind = EnvKind::Map;

@@ -1,16 +1,20 @@
 //! The lights next-event estimation picks from — punctual lights, emissive triangles, the
 //! environment — and the probability of picking each (the CDF goes into the tables).
 //!
-//! [`LightSelection::Robust`] (the default) estimates what each light delivers to the scene —
-//! the irradiance on up to 256 of its vertices (probes, each with its shading normal n),
-//! averaged, occlusion ignored: I·falloff·max(0, n·l) / d² for punctual lights,
+//! [`LightSelection::Robust`] (the default) estimates what each light delivers to what the
+//! camera sees — the irradiance at the first hits of 256 camera rays (probes, each with its
+//! shading normal n; the scene's vertices when the camera sees nothing), averaged, occlusion
+//! ignored: I·falloff·max(0, n·l) / d² for punctual lights,
 //! E max(0, n·l) for a directional light, Le A max(0, nl·(−l)) max(0, n·l) / d² for an
-//! emissive triangle, ∫ L max(0, n·ω) dω for the environment — and picks with half that, half
+//! emissive triangle, ∫ L max(0, n·ω) dω for an environment map (nothing for a constant one,
+//! which BSDF samples find as well as light samples do) — and picks with half that, half
 //! uniformly, so that no light is starved by a bad estimate. [`LightSelection::Power`] is the older choice by
 //! emitted flux, the environment's through the scene's bounding sphere (kept to measure
 //! against).
 
 use super::tables::Tables;
+use crate::bvh::Bvh;
+use crate::camera::CameraFrame;
 use crate::gpu_types::{GpuLight, GpuMaterial, LightKind, NONE};
 use crate::scene::{Light, Scene};
 use glam::Vec3;
@@ -24,15 +28,50 @@ pub fn lum(c: Vec3) -> f32 {
 /// How next-event estimation picks a light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LightSelection {
-    /// ½ uniform + ½ ∝ the irradiance each light delivers to the scene's vertices.
+    /// ½ uniform + ½ ∝ the irradiance each light delivers to what the camera sees.
     #[default]
     Robust,
     /// ∝ emitted flux (the environment's through the bounding sphere).
     Power,
 }
 
-/// Up to this many scene vertices stand for the scene in the contribution estimates.
+/// Up to this many points stand for the receivers in the contribution estimates.
 const PROBES: usize = 256;
+/// Camera rays per side of the probe grid (PROBES of them).
+const PROBE_GRID: usize = 16;
+/// The aspect ratio assumed for the probe grid (the image's is not known yet).
+const PROBE_ASPECT: f32 = 1.5;
+
+/// What the camera sees: the first hits of a 16 × 16 grid of rays through pixel centres of a
+/// 3:2 image with the camera's vertical field of view, with their shading normals turned to
+/// the camera. Empty when the camera is degenerate or sees nothing.
+fn camera_probes(scene: &Scene, bvh: &Bvh) -> Vec<Probe> {
+    let Ok(cam) = CameraFrame::new(&scene.camera) else {
+        return Vec::new();
+    };
+    let ty = (0.5 * cam.yfov).tan();
+    let mut probes = Vec::with_capacity(PROBES);
+    for j in 0..PROBE_GRID {
+        for i in 0..PROBE_GRID {
+            let sx = ((i as f32 + 0.5) / PROBE_GRID as f32 * 2.0 - 1.0) * ty * PROBE_ASPECT;
+            let sy = (1.0 - (j as f32 + 0.5) / PROBE_GRID as f32 * 2.0) * ty;
+            let dir = (cam.forward + sx * cam.right + sy * cam.up).normalize();
+            let Some(hit) = bvh.closest_hit(cam.position, dir, f32::INFINITY) else {
+                continue;
+            };
+            let [a, b, c] = scene.indices[hit.prim as usize].map(|k| k as usize);
+            let w = 1.0 - hit.u - hit.v;
+            let n = (w * scene.normals[a] + hit.u * scene.normals[b] + hit.v * scene.normals[c])
+                .normalize_or_zero();
+            let n = if n.dot(dir) > 0.0 { -n } else { n };
+            probes.push(Probe {
+                p: cam.position + hit.t * dir,
+                n,
+            });
+        }
+    }
+    probes
+}
 
 /// A scene vertex standing for the receivers: its position and shading normal.
 #[derive(Clone, Copy, Debug)]
@@ -59,16 +98,19 @@ pub struct LightSet {
 impl LightSet {
     /// The scene's punctual lights (with positive power) and emissive triangles; `radius`
     /// bounds the scene (a directional light's power is its flux through that disc).
-    pub fn new(scene: &Scene, materials: &[GpuMaterial], radius: f32) -> Self {
+    pub fn new(scene: &Scene, bvh: &Bvh, materials: &[GpuMaterial], radius: f32) -> Self {
         let mut set = LightSet::default();
-        let stride = scene.positions.len().div_ceil(PROBES).max(1);
-        set.probes = scene
-            .positions
-            .iter()
-            .zip(&scene.normals)
-            .step_by(stride)
-            .map(|(p, n)| Probe { p: *p, n: *n })
-            .collect();
+        set.probes = camera_probes(scene, bvh);
+        if set.probes.is_empty() {
+            let stride = scene.positions.len().div_ceil(PROBES).max(1);
+            set.probes = scene
+                .positions
+                .iter()
+                .zip(&scene.normals)
+                .step_by(stride)
+                .map(|(p, n)| Probe { p: *p, n: *n })
+                .collect();
+        }
         let probes = set.probes.clone();
         // Mean over the probes of g(l, d², n): l the unit vector from the probe to x, d² its
         // squared distance (kept above (r / 1000)²), n the probe's normal.

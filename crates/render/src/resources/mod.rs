@@ -209,7 +209,7 @@ impl SceneResources {
 
         let (lo, hi) = scene.bounds();
         let radius = (0.5 * (hi - lo).length()).max(1e-3);
-        let mut light_set = LightSet::new(scene, &materials, radius);
+        let mut light_set = LightSet::new(scene, &bvh, &materials, radius);
         built.emissive_triangles = light_set.emissive_triangles();
         let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
         built.environment_map = env.kind == crate::tags::EnvKind::Map;
