@@ -44,8 +44,16 @@ pub struct VisibleTables {
     pub cell_pdf: Vec<f64>,
 }
 
-/// A slice and its mixture weight.
+/// A slice node and its mixture weight.
 type Pick = (usize, f64);
+
+/// The view slices around a view: two θv nodes and two φv nodes with their weights, and the
+/// azimuth the slices' columns start from (φv when isotropic, else 0).
+struct Slices {
+    theta: (Pick, Pick),
+    phi: (Pick, Pick),
+    phi_ref: f64,
+}
 
 impl VisibleTables {
     /// Tabulates the visible distribution of `d0` (D₀(θ, φ) of the base table); `isotropic` when
@@ -100,9 +108,9 @@ impl VisibleTables {
 
     /// Samples h₀ visible from the base view `v` (unit, v.z ≥ 0) from two uniform numbers.
     pub fn sample(&self, v: DVec3, u: [f64; 2]) -> DVec3 {
-        let (picks, phi_ref) = self.slices(v);
-        let (s, u0) = choose(picks.0, u[0]);
-        let (p, u1) = choose(picks.1, u[1]);
+        let q = self.slices(v);
+        let (s, u0) = choose(q.theta, u[0]);
+        let (p, u1) = choose(q.phi, u[1]);
         let slice = s * self.n_phi_v + p;
         let cells = self.rows * self.columns;
         let cdf = &self.cdf[slice * cells..(slice + 1) * cells];
@@ -112,7 +120,7 @@ impl VisibleTables {
         let (r, col) = (c / self.columns, c % self.columns);
         let (ca, cb) = row_cos(r, self.rows);
         let cos_t = (ca + rest * (cb - ca)).clamp(-1.0, 1.0);
-        let phi = phi_ref + (col as f64 + u1) * column_width(self.columns);
+        let phi = q.phi_ref + (col as f64 + u1) * column_width(self.columns);
         spherical(cos_t.acos(), phi)
     }
 
@@ -121,15 +129,15 @@ impl VisibleTables {
         if h.z <= 0.0 {
             return 0.0;
         }
-        let (picks, phi_ref) = self.slices(v);
+        let q = self.slices(v);
         let r = ((theta_to_u(theta_of(h)) * self.rows as f64) as usize).min(self.rows - 1);
-        let dphi = (phi_of(h) - phi_ref).rem_euclid(2.0 * PI);
+        let dphi = (phi_of(h) - q.phi_ref).rem_euclid(2.0 * PI);
         let col = ((dphi / column_width(self.columns)) as usize).min(self.columns - 1);
         let cell = r * self.columns + col;
         let cells = self.rows * self.columns;
         let mut pdf = 0.0;
-        for (s, ws) in [picks.0.0, picks.0.1] {
-            for (p, wp) in [picks.1.0, picks.1.1] {
+        for (s, ws) in [q.theta.0, q.theta.1] {
+            for (p, wp) in [q.phi.0, q.phi.1] {
                 let w = ws * wp;
                 if w > 0.0 {
                     pdf += w * self.cell_pdf[(s * self.n_phi_v + p) * cells + cell];
@@ -139,20 +147,28 @@ impl VisibleTables {
         pdf
     }
 
-    /// The slices around `v` in θv and φv with their weights, and the azimuth the columns
-    /// start from.
-    fn slices(&self, v: DVec3) -> (((Pick, Pick), (Pick, Pick)), f64) {
+    /// The slices around `v` in θv and φv with their weights.
+    fn slices(&self, v: DVec3) -> Slices {
         let x = (theta_of(v) / FRAC_PI_2).clamp(0.0, 1.0) * (self.n_theta_v - 1) as f64;
         let j = (x as usize).min(self.n_theta_v - 2);
         let t = x - j as f64;
         let theta = ((j, 1.0 - t), (j + 1, t));
         if self.n_phi_v == 1 {
-            return ((theta, ((0, 1.0), (0, 0.0))), phi_of(v));
+            let phi = ((0, 1.0), (0, 0.0));
+            return Slices {
+                theta,
+                phi,
+                phi_ref: phi_of(v),
+            };
         }
         let y = phi_of(v) / (2.0 * PI) * self.n_phi_v as f64;
         let p = (y as usize).min(self.n_phi_v - 1);
         let s = y - p as f64;
-        ((theta, ((p, 1.0 - s), ((p + 1) % self.n_phi_v, s))), 0.0)
+        Slices {
+            theta,
+            phi: ((p, 1.0 - s), ((p + 1) % self.n_phi_v, s)),
+            phi_ref: 0.0,
+        }
     }
 }
 

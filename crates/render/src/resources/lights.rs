@@ -99,8 +99,10 @@ impl LightSet {
     /// The scene's punctual lights (with positive power) and emissive triangles; `radius`
     /// bounds the scene (a directional light's power is its flux through that disc).
     pub fn new(scene: &Scene, bvh: &Bvh, materials: &[GpuMaterial], radius: f32) -> Self {
-        let mut set = LightSet::default();
-        set.probes = camera_probes(scene, bvh);
+        let mut set = LightSet {
+            probes: camera_probes(scene, bvh),
+            ..LightSet::default()
+        };
         if set.probes.is_empty() {
             let stride = scene.positions.len().div_ceil(PROBES).max(1);
             set.probes = scene
