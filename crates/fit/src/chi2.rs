@@ -19,6 +19,7 @@ pub const N_PHI: usize = 32;
 pub struct Chi2 {
     /// ∫ pdf over the hemisphere by the same midpoint rule (1 for a normalised pdf).
     pub integral: f64,
+    /// Σ (observed − expected)² / expected over the compared cells.
     pub chi2: f64,
     /// Degrees of freedom: cells compared, less one.
     pub dof: f64,

@@ -31,11 +31,13 @@ const QUAD: usize = 3;
 /// The sampling tables of the visible distribution of a base NDF table.
 #[derive(Clone, Debug)]
 pub struct VisibleTables {
-    /// View slices in θv and in φv (1 when isotropic: columns are then relative to φv).
+    /// View slices in θv.
     pub n_theta_v: usize,
+    /// View slices in φv (1 when isotropic: columns are then relative to φv).
     pub n_phi_v: usize,
-    /// Cells of a slice: rows in u, columns in φ.
+    /// Rows of a slice's cells, uniform in u = √(θh / (π/2)).
     pub rows: usize,
+    /// Columns of a slice's cells, uniform in φh.
     pub columns: usize,
     /// Per slice (index j · n_phi_v + p), per cell (index r · columns + c): cumulative mass
     /// normalised to 1 at the slice's end.
