@@ -20,6 +20,7 @@ pub enum FitError {
     Material { path: PathBuf, problem: String },
     #[error("input `{spec}`: {problem}")]
     Spec { spec: String, problem: String },
+    #[cfg(feature = "gpu")]
     #[error("{name}: on the GPU: {source}")]
     Gpu {
         name: String,

@@ -4,7 +4,9 @@ use crate::brdf::Brdf;
 use crate::error::FitError;
 use crate::extract::{CpuSolver, ExtractConfig, Solver, extract_with};
 use crate::fresnel::{Fresnel, FresnelTable};
+#[cfg(feature = "gpu")]
 use crate::gpu::{GpuFitter, gpu_error};
+#[cfg(feature = "gpu")]
 use crate::grid::IsoTables;
 use crate::grid::{GridSamples, fresnel_average, microfacet_error};
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
@@ -77,11 +79,19 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// Without the `gpu` feature there is no GPU fitter: an uninhabited stand-in keeps one body of
+/// `fit_with` for both builds.
+#[cfg(not(feature = "gpu"))]
+enum GpuFitter {}
+
 /// Where the extraction and the Fresnel averages run. The parameter searches and the error
-/// metric always run on the CPU.
+/// metric always run on the CPU. (With the `gpu` feature only.)
+#[cfg(feature = "gpu")]
 #[derive(Clone, Copy)]
 pub enum Backend<'a, 'g> {
+    /// The f64 reference path.
     Cpu,
+    /// WGSL compute passes on the fitter's adapter (f32).
     Gpu(&'a GpuFitter<'g>),
 }
 
@@ -91,11 +101,12 @@ pub fn fit_material(
     source: &str,
     cfg: &FitConfig,
 ) -> Result<FittedMaterial, FitError> {
-    fit_material_on(src, source, cfg, Backend::Cpu)
+    fit_with(src, source, cfg, None)
 }
 
 /// Fits one source on a backend. A GPU failure falls back to the CPU, and the record's
-/// `backend` says so: the answer is never silently different.
+/// `backend` says so: the answer is never silently different. (With the `gpu` feature only.)
+#[cfg(feature = "gpu")]
 pub fn fit_material_on(
     src: &dyn Brdf,
     source: &str,
@@ -124,7 +135,10 @@ fn fit_with(
     let start = Instant::now();
     let t = Instant::now();
     let solver: &dyn Solver = match gpu {
+        #[cfg(feature = "gpu")]
         Some(g) => g,
+        #[cfg(not(feature = "gpu"))]
+        Some(g) => match *g {},
         None => &CpuSolver,
     };
     let ex = extract_with(src, &cfg.extract, cfg.anisotropic, solver)?;
@@ -154,6 +168,7 @@ fn fit_with(
         });
     }
     // The GPU averages Fresnel over isotropic sample sets, uploaded once for all models.
+    #[cfg(feature = "gpu")]
     let uploaded = match gpu {
         Some(g) if set.rotations.len() == 1 => Some((
             g,
@@ -164,13 +179,14 @@ fn fit_with(
         _ => None,
     };
     let average = |model: &MicrofacetBrdf| -> Result<Vec<crate::brdf::Rgb>, FitError> {
-        match (&uploaded, IsoTables::new(model)) {
-            (Some((g, samples)), Some(tables)) => g
+        #[cfg(feature = "gpu")]
+        if let (Some((g, samples)), Some(tables)) = (&uploaded, IsoTables::new(model)) {
+            return g
                 .fresnel
                 .average(g.gpu, samples, &tables)
-                .map_err(|e| gpu_error(src.name(), e)),
-            _ => Ok(fresnel_average(model, &set)),
+                .map_err(|e| gpu_error(src.name(), e));
         }
+        Ok(fresnel_average(model, &set))
     };
     let mut tabulated = MicrofacetBrdf {
         name: format!("{}-tabulated", src.name()),
