@@ -14,6 +14,8 @@
 //! # Ok::<(), String>(())
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod app;
 pub mod material;
 pub mod panels;
@@ -22,8 +24,17 @@ pub mod preview;
 
 pub use app::ViewerApp;
 
-/// `assets/demo` of the workspace.
+/// `assets/demo` of the workspace: the crate's `demo/`, a link to it in the repository that
+/// `cargo package` turns into a copy, so a packaged viewer finds its default fit and sky; the
+/// workspace folder itself where the link did not survive a checkout (a text file on Windows
+/// without `core.symlinks`).
 pub fn demo_dir() -> std::path::PathBuf {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/demo");
+    let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let linked = manifest.join("demo");
+    let dir = if linked.is_dir() {
+        linked
+    } else {
+        manifest.join("../../assets/demo")
+    };
     dir.canonicalize().unwrap_or(dir)
 }
