@@ -12,6 +12,8 @@
 //! # Ok::<(), facet_gpu::GpuError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod buffer;
 pub mod context;
 pub mod dispatch;

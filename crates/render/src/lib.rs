@@ -21,6 +21,8 @@
 //! # Ok::<(), facet_render::RenderError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
@@ -43,7 +45,10 @@ pub mod wavefront;
 
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use error::RenderError;
+pub use facet_gpu::{Gpu, GpuError};
 pub use film::Image;
+/// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
+pub use glam;
 pub use integrator::{Integrator, NdfSampling, RenderConfig, RenderStats, Strategy};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
