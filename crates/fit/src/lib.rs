@@ -59,7 +59,7 @@ pub mod params;
 pub mod quadrature;
 pub mod source;
 pub mod tabulated;
-pub mod visible_normals;
+pub(crate) mod visible_normals;
 
 pub use brdf::{Brdf, Rgb};
 pub use error::FitError;

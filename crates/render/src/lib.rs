@@ -28,16 +28,16 @@
 
 pub mod bvh;
 pub mod camera;
-pub mod error;
+mod error;
 pub mod film;
 pub mod gpu_types;
-pub mod integrator;
-pub mod limits;
+mod integrator;
+pub(crate) mod limits;
 pub mod procedural;
-pub mod queues;
+pub(crate) mod queues;
 pub mod resources;
 pub mod scene;
-pub mod stages;
+pub(crate) mod stages;
 pub mod tags;
 pub mod tonemap;
 pub mod trace;

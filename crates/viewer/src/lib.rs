@@ -1,8 +1,8 @@
 //! # facet-viewer: interactive roughness and stretch on a live path-traced preview
 //!
 //! [`app::ViewerApp`] is the UI state (material, edits, errors); [`preview`] owns the GPU work
-//! on a worker thread that shares eframe's device; [`plots`] draws the NDF slice, the Fresnel
-//! curves and the fit errors with egui's painter; [`panels`] lays the window out.
+//! on a worker thread that shares eframe's device; `plots` draws the NDF slice, the Fresnel
+//! curves and the fit errors with egui's painter; `panels` lays the window out (both internal).
 //!
 //! ```no_run
 //! use facet_viewer::{ViewerApp, material::Shown};
@@ -18,8 +18,8 @@
 
 pub mod app;
 pub mod material;
-pub mod panels;
-pub mod plots;
+pub(crate) mod panels;
+pub(crate) mod plots;
 pub mod preview;
 
 pub use app::ViewerApp;
