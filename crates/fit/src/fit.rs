@@ -18,8 +18,11 @@ use std::time::Instant;
 /// Which models to fit and report.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Models {
+    /// Report the tabulated model's error.
     pub tabulated: bool,
+    /// Fit GGX.
     pub ggx: bool,
+    /// Fit Beckmann.
     pub beckmann: bool,
 }
 
@@ -30,6 +33,7 @@ impl Models {
         ggx: false,
         beckmann: false,
     };
+    /// The tabulated model, GGX and Beckmann.
     pub const ALL: Models = Models {
         tabulated: true,
         ggx: true,
@@ -40,9 +44,11 @@ impl Models {
 /// Fit settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitConfig {
+    /// The power iteration's settings.
     pub extract: ExtractConfig,
     /// Extract on a (θ, φ) grid and fit αx, αy and rotation.
     pub anisotropic: bool,
+    /// Which models to fit and report.
     pub models: Models,
     /// The least-squares searches run on every `search_stride`-th grid sample; the reported
     /// errors use every sample.
@@ -50,6 +56,7 @@ pub struct FitConfig {
 }
 
 impl FitConfig {
+    /// Isotropic extraction ([`ExtractConfig::isotropic`]), every model.
     pub const fn isotropic() -> Self {
         FitConfig {
             extract: ExtractConfig::isotropic(),
@@ -59,6 +66,7 @@ impl FitConfig {
         }
     }
 
+    /// Anisotropic extraction ([`ExtractConfig::anisotropic`]), every model.
     pub const fn anisotropic() -> Self {
         FitConfig {
             extract: ExtractConfig::anisotropic(),

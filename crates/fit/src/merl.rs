@@ -16,8 +16,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::io::Write;
 use std::path::Path;
 
+/// θh bins of a MERL file.
 pub const THETA_H_RES: usize = 90;
+/// θd bins of a MERL file.
 pub const THETA_D_RES: usize = 90;
+/// φd bins of a MERL file (over [0, π): reciprocity gives the rest).
 pub const PHI_D_RES: usize = 180;
 /// Samples per channel.
 pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
@@ -240,6 +243,7 @@ impl MerlTable {
         }
     }
 
+    /// The number of samples that hold no valid value.
     pub fn missing_count(&self) -> usize {
         (0..SAMPLES).filter(|&s| self.value_at(s).is_none()).count()
     }
@@ -300,6 +304,7 @@ pub struct MerlBrdf {
 }
 
 impl MerlBrdf {
+    /// Reads a MERL `.binary` file.
     pub fn open(path: &Path) -> Result<Self, FitError> {
         let table = MerlTable::read(path)?;
         let name = path
@@ -333,6 +338,7 @@ impl MerlBrdf {
         })
     }
 
+    /// The table read.
     pub fn table(&self) -> &MerlTable {
         &self.table
     }

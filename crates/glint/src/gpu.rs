@@ -9,6 +9,7 @@ use facet_fit::quadrature::gauss_legendre;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Uniforms of the build (WGSL `Params`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct DpfParams {
@@ -181,6 +182,7 @@ pub fn build_levels(
 }
 
 /// The flake field as `shaders/glint/glint_count.wgsl` takes it (WGSL `Field`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintField {
@@ -193,6 +195,7 @@ pub struct GlintField {
 }
 
 /// One glint query (WGSL `Query`): the footprint, P, and the direction cell.
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintQuery {
@@ -300,6 +303,7 @@ impl GlintCounter {
 }
 
 /// Uniforms of `shaders/glint/glint_eval.wgsl` (WGSL `EvalParams`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintEvalParams {
@@ -319,6 +323,7 @@ pub struct GlintEvalParams {
 }
 
 /// One evaluation (WGSL `EvalQuery`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintEvalQuery {

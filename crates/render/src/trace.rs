@@ -9,6 +9,7 @@ use facet_gpu::{GpuError, buffer, dispatch, shader};
 const SHADER: &str = "render/trace.wgsl";
 
 /// One ray (WGSL `Ray`, 32 bytes). `dir` need not be unit length: t is in units of `dir`.
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuRay {
@@ -32,6 +33,7 @@ impl GpuRay {
 }
 
 /// One closest hit (WGSL `Hit`, 16 bytes).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuHit {
