@@ -28,6 +28,7 @@ pub struct ToneMap {
 }
 
 impl ToneMap {
+    /// The tone-map pass over `film` (`width` × `height` pixels).
     pub fn new(
         gpu: &Gpu,
         film: &wgpu::Buffer,

@@ -22,6 +22,7 @@ pub struct GpuRay {
 }
 
 impl GpuRay {
+    /// A ray from `origin` along `dir`, up to distance `tmax`.
     pub fn new(origin: glam::Vec3, dir: glam::Vec3, tmax: f32) -> Self {
         GpuRay {
             origin: origin.into(),
@@ -47,8 +48,10 @@ pub struct GpuHit {
 }
 
 impl GpuHit {
+    /// `prim` of a ray that hit nothing.
     pub const MISS: u32 = u32::MAX;
 
+    /// Whether the ray hit a triangle.
     pub fn is_hit(&self) -> bool {
         self.prim != Self::MISS
     }
@@ -66,6 +69,7 @@ pub struct RayTracer {
 }
 
 impl RayTracer {
+    /// Builds the traversal pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         Ok(RayTracer {
             closest: shader::compute_pipeline(device, SHADER, "trace_closest_rays", &[])?,

@@ -62,6 +62,7 @@ pub fn next_batch(spp: u32, ms: f64) -> u32 {
 pub struct StageTime {
     /// "logic", "generate", "extend", "shade <class>", "connect", "close <queue>".
     pub stage: String,
+    /// Milliseconds.
     pub ms: f64,
 }
 
