@@ -85,7 +85,7 @@ pub struct GridSample {
 
 /// The valid samples of a source on the MERL grid.
 pub struct GridSamples {
-    /// Azimuths φh at which the grid is laid: [0] for isotropic sources.
+    /// Azimuths φh at which the grid is laid: `[0]` for isotropic sources.
     pub rotations: Vec<f64>,
     /// The valid samples, in MERL bin order for each rotation.
     pub samples: Vec<GridSample>,

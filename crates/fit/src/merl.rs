@@ -24,7 +24,7 @@ pub const THETA_D_RES: usize = 90;
 pub const PHI_D_RES: usize = 180;
 /// Samples per channel.
 pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
-/// f_r = stored value × SCALE[channel].
+/// f_r = stored value × `SCALE[channel]`.
 pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 const HEADER_BYTES: u64 = 12;
 /// The largest stored value read as a measurement (f_r ≈ 7·10⁸ sr⁻¹, past any mirror-like

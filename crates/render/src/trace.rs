@@ -79,7 +79,7 @@ impl RayTracer {
     }
 
     /// Most rays one dispatch takes: the ray binding (32 bytes a ray) within the device's
-    /// storage binding limit, rounded down to [`CHUNK_ALIGN`].
+    /// storage binding limit, rounded down to `CHUNK_ALIGN`.
     pub fn max_rays_per_dispatch(device: &wgpu::Device) -> u64 {
         let limit = device.limits().max_storage_buffer_binding_size;
         (limit / size_of::<GpuRay>() as u64 / CHUNK_ALIGN * CHUNK_ALIGN).max(CHUNK_ALIGN)
