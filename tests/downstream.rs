@@ -71,10 +71,9 @@ fn downstream_example_fits_saves_loads_and_renders() {
     );
 
     let out = common::scratch("downstream");
-    let exe = target.join("debug").join(format!(
-        "facet-downstream{}",
-        std::env::consts::EXE_SUFFIX
-    ));
+    let exe = target
+        .join("debug")
+        .join(format!("facet-downstream{}", std::env::consts::EXE_SUFFIX));
     let stdout = run(Command::new(&exe).arg(&out), "facet-downstream");
     assert!(stdout.contains("rendered 64×64"), "{stdout}");
 

@@ -34,7 +34,10 @@ fn readme_rust_blocks_are_tested_code() {
     let read = |p: &str| std::fs::read_to_string(root.join(p)).unwrap();
     let readme = read("README.md");
     let tested = [
-        ("crates/fit/README.md", normalised(&read("crates/fit/README.md"))),
+        (
+            "crates/fit/README.md",
+            normalised(&read("crates/fit/README.md")),
+        ),
         (
             "examples/downstream/src/main.rs",
             normalised(&read("examples/downstream/src/main.rs")),

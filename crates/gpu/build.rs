@@ -42,7 +42,10 @@ fn main() {
     println!("cargo:rerun-if-changed={}", root.display());
     let mut files = Vec::new();
     if let Err(e) = collect(root, root, &mut files) {
-        panic!("facet-gpu: reading the shaders under {}: {e}", root.display());
+        panic!(
+            "facet-gpu: reading the shaders under {}: {e}",
+            root.display()
+        );
     }
     if files.is_empty() {
         panic!(

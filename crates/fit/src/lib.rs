@@ -33,9 +33,7 @@
     doc = "With it, [`gpu`] holds the passes and [`fit::fit_material_on`] with \
            [`fit::Backend::Gpu`] runs a fit on them."
 )]
-
 #![warn(missing_docs)]
-
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 

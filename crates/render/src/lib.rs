@@ -22,7 +22,6 @@
 //! ```
 
 #![warn(missing_docs)]
-
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 

@@ -17,7 +17,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let out = PathBuf::from(std::env::args().nth(1).ok_or("usage: facet-downstream OUT_DIR")?);
+    let out = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .ok_or("usage: facet-downstream OUT_DIR")?,
+    );
     std::fs::create_dir_all(&out)?;
 
     // Fit: a neural proxy of a MERL measurement is a BRDF source like a MERL file.
@@ -33,7 +37,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Glints: the DPF of the loaded GGX lobe, the probability that a flake reflects ωo into the
     // 1° cone around ωi (here both at 20° from the normal, in the plane of incidence).
-    let model = loaded.model(ModelChoice::Ggx).ok_or("the loaded fit has no GGX model")?;
+    let model = loaded
+        .model(ModelChoice::Ggx)
+        .ok_or("the loaded fit has no GGX model")?;
     let (wi, wo) = query_directions(20f64.to_radians(), 20f64.to_radians(), 0.0);
     let p = dpf(&model.ndf, wi, wo, 1f64.to_radians());
     println!("glint DPF at 20°/20°, γ = 1°: {p:.3e}");
