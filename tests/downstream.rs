@@ -6,11 +6,15 @@
 //! It renders on the default adapter, so without one it skips with a visible `SKIPPED` line
 //! (`facet_gpu::gpu_for_tests`), unless FACET_REQUIRE_GPU=1, and skips before building.
 //!
-//! The example builds into `target/downstream/` (`FACET_DOWNSTREAM_TARGET` names another
-//! folder). Not the workspace's own `target/`: `cargo test` holds that folder's lock while the
-//! tests run, so a nested build there would wait for ever. A first run compiles the dependency
-//! tree once (minutes on 2 cores); later runs rebuild only what changed. The workspace's
-//! `Cargo.lock` is copied next to the example first, so that both build the same versions.
+//! The example builds into the workspace's own target folder (`FACET_DOWNSTREAM_TARGET` names
+//! another), so that it reuses what the workspace built where the two resolve a dependency to
+//! the same package and features. That is safe: `cargo test` has released the folder's lock by
+//! the time the tests run (the nested build takes it), and facet-fit, facet-gpu, ... have the
+//! same package ids from both sides (the same paths), so their build scripts and outputs are
+//! shared, never stale. Dependencies whose features unify differently outside the workspace
+//! (naga, serde_derive, ...) build once more; a first run takes minutes on 2 cores, later runs
+//! seconds. The workspace's `Cargo.lock` is copied next to the example first, so that both
+//! resolve the same versions.
 
 mod common;
 
@@ -30,7 +34,7 @@ fn downstream_target() -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR"))
         .parent()
         .expect("CARGO_TARGET_TMPDIR has a parent")
-        .join("downstream")
+        .to_path_buf()
 }
 
 fn run(cmd: &mut Command, what: &str) -> String {
