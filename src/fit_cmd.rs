@@ -114,7 +114,7 @@ pub struct FitArgs {
     quadrature: QuadratureArg,
     #[arg(long, value_enum, default_value = "auto")]
     backend: BackendArg,
-    /// Output folder for <name>.json and the tables.
+    /// Output folder for NAME.json and the tables.
     #[arg(long, default_value = "out")]
     out: PathBuf,
     /// Neural proxy file for `nbrdf:` inputs (default: `$FACET_NBRDF`, else the MERL-100

@@ -2,31 +2,70 @@
 
 use std::path::PathBuf;
 
+/// Why a source could not be read or fitted.
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
     /// A file that is not a regular file, too large for its kind, or unreadable.
     #[error(transparent)]
     Input(#[from] crate::input::InputError),
+    /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {
+        /// The file.
         path: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
+    /// A file that is not a MERL `.binary` BRDF (wrong size, bad dimensions, bad values).
     #[error("{path}: not a MERL BRDF file: {problem}")]
-    Merl { path: PathBuf, problem: String },
+    Merl {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A neural-proxy file (or an entry of it) of the wrong shape, or a name it does not hold.
     #[error("{path}: neural BRDF file: {problem}")]
-    Nbrdf { path: PathBuf, problem: String },
+    Nbrdf {
+        /// The file (the embedded one has a label in its place).
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A fit JSON that does not parse or does not describe a usable material.
     #[error("{path}: fit file: {problem}")]
-    Material { path: PathBuf, problem: String },
+    Material {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// An input specification (`nbrdf:NAME`, `analytic:...`) that cannot be used.
     #[error("input `{spec}`: {problem}")]
-    Spec { spec: String, problem: String },
+    Spec {
+        /// The specification as given.
+        spec: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// A GPU failure during a fit (`fit::fit_material_on` falls back to the CPU on it).
+    #[cfg(feature = "gpu")]
     #[error("{name}: on the GPU: {source}")]
     Gpu {
+        /// The source being fitted.
         name: String,
+        /// The GPU layer's error.
         source: facet_gpu::GpuError,
     },
+    /// The extraction or the fit failed for this source (no valid sample on the MERL grid,
+    /// values out of range, a diverging power iteration, tables that make no material).
     #[error("{name}: cannot extract an NDF: {problem}")]
-    Extraction { name: String, problem: String },
+    Extraction {
+        /// The source being fitted.
+        name: String,
+        /// What is wrong.
+        problem: String,
+    },
 }
 
 impl FitError {

@@ -25,7 +25,9 @@ pub enum Stopping {
     /// Until the L1 change of the normalised NDF (in the measure cos θ dω, so 2 is the
     /// largest possible) falls below `tolerance`, at most `max_iterations`.
     Converge {
+        /// Stop when the L1 change falls below this.
         tolerance: f64,
+        /// Stop after this many iterations in any case.
         max_iterations: usize,
     },
     /// Exactly this many iterations (the paper uses 4).
@@ -39,7 +41,9 @@ pub struct ExtractConfig {
     pub resolution: usize,
     /// Azimuthal nodes of an anisotropic extraction (N = resolution × phi_resolution unknowns).
     pub phi_resolution: usize,
+    /// How the polar nodes are placed and weighted.
     pub quadrature: Quadrature,
+    /// When the power iteration stops.
     pub stopping: Stopping,
 }
 
@@ -86,9 +90,11 @@ impl Default for ExtractConfig {
 /// What an extraction produced.
 #[derive(Clone, Debug)]
 pub struct Extraction {
+    /// The extracted NDF with its G1 table.
     pub ndf: TabulatedNdf,
     /// λ: the normal-incidence Fresnel of the backscattering slice (mean of RGB).
     pub eigenvalue: f64,
+    /// Power iterations run.
     pub iterations: usize,
     /// L1 change of the normalised NDF in the last iteration.
     pub residual: f64,
@@ -146,6 +152,7 @@ fn backscatter_slice(src: &dyn Brdf, dirs: &[(f64, f64)]) -> Result<Vec<f64>, Fi
 pub struct Problem {
     /// Isotropic: the azimuth of `<o,h>+` integrated in closed form, nodes at φ = 0.
     pub isotropic: bool,
+    /// The unit direction of each node.
     pub dirs: Vec<[f64; 3]>,
     /// 4 f(o,o) cos θo of each node (the mean of RGB).
     pub row: Vec<f64>,
@@ -177,8 +184,11 @@ fn azimuthal(q: &[f64; 3], h: &[f64; 3]) -> f64 {
 pub struct Eigen {
     /// The normalised eigenvector (D at the nodes).
     pub v: Vec<f64>,
+    /// The eigenvalue λ.
     pub lambda: f64,
+    /// Iterations run.
     pub iterations: usize,
+    /// L1 change of the normalised vector in the last iteration.
     pub residual: f64,
 }
 

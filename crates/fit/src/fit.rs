@@ -4,7 +4,9 @@ use crate::brdf::Brdf;
 use crate::error::FitError;
 use crate::extract::{CpuSolver, ExtractConfig, Solver, extract_with};
 use crate::fresnel::{Fresnel, FresnelTable};
+#[cfg(feature = "gpu")]
 use crate::gpu::{GpuFitter, gpu_error};
+#[cfg(feature = "gpu")]
 use crate::grid::IsoTables;
 use crate::grid::{GridSamples, fresnel_average, microfacet_error};
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
@@ -16,8 +18,11 @@ use std::time::Instant;
 /// Which models to fit and report.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Models {
+    /// Report the tabulated model's error.
     pub tabulated: bool,
+    /// Fit GGX.
     pub ggx: bool,
+    /// Fit Beckmann.
     pub beckmann: bool,
 }
 
@@ -28,6 +33,7 @@ impl Models {
         ggx: false,
         beckmann: false,
     };
+    /// The tabulated model, GGX and Beckmann.
     pub const ALL: Models = Models {
         tabulated: true,
         ggx: true,
@@ -38,9 +44,11 @@ impl Models {
 /// Fit settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitConfig {
+    /// The power iteration's settings.
     pub extract: ExtractConfig,
     /// Extract on a (θ, φ) grid and fit αx, αy and rotation.
     pub anisotropic: bool,
+    /// Which models to fit and report.
     pub models: Models,
     /// The least-squares searches run on every `search_stride`-th grid sample; the reported
     /// errors use every sample.
@@ -48,6 +56,7 @@ pub struct FitConfig {
 }
 
 impl FitConfig {
+    /// Isotropic extraction ([`ExtractConfig::isotropic`]), every model.
     pub const fn isotropic() -> Self {
         FitConfig {
             extract: ExtractConfig::isotropic(),
@@ -57,6 +66,7 @@ impl FitConfig {
         }
     }
 
+    /// Anisotropic extraction ([`ExtractConfig::anisotropic`]), every model.
     pub const fn anisotropic() -> Self {
         FitConfig {
             extract: ExtractConfig::anisotropic(),
@@ -77,11 +87,19 @@ fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// Without the `gpu` feature there is no GPU fitter: an uninhabited stand-in keeps one body of
+/// `fit_with` for both builds.
+#[cfg(not(feature = "gpu"))]
+enum GpuFitter {}
+
 /// Where the extraction and the Fresnel averages run. The parameter searches and the error
-/// metric always run on the CPU.
+/// metric always run on the CPU. (With the `gpu` feature only.)
+#[cfg(feature = "gpu")]
 #[derive(Clone, Copy)]
 pub enum Backend<'a, 'g> {
+    /// The f64 reference path.
     Cpu,
+    /// WGSL compute passes on the fitter's adapter (f32).
     Gpu(&'a GpuFitter<'g>),
 }
 
@@ -91,11 +109,12 @@ pub fn fit_material(
     source: &str,
     cfg: &FitConfig,
 ) -> Result<FittedMaterial, FitError> {
-    fit_material_on(src, source, cfg, Backend::Cpu)
+    fit_with(src, source, cfg, None)
 }
 
 /// Fits one source on a backend. A GPU failure falls back to the CPU, and the record's
-/// `backend` says so: the answer is never silently different.
+/// `backend` says so: the answer is never silently different. (With the `gpu` feature only.)
+#[cfg(feature = "gpu")]
 pub fn fit_material_on(
     src: &dyn Brdf,
     source: &str,
@@ -124,7 +143,10 @@ fn fit_with(
     let start = Instant::now();
     let t = Instant::now();
     let solver: &dyn Solver = match gpu {
+        #[cfg(feature = "gpu")]
         Some(g) => g,
+        #[cfg(not(feature = "gpu"))]
+        Some(g) => match *g {},
         None => &CpuSolver,
     };
     let ex = extract_with(src, &cfg.extract, cfg.anisotropic, solver)?;
@@ -154,6 +176,7 @@ fn fit_with(
         });
     }
     // The GPU averages Fresnel over isotropic sample sets, uploaded once for all models.
+    #[cfg(feature = "gpu")]
     let uploaded = match gpu {
         Some(g) if set.rotations.len() == 1 => Some((
             g,
@@ -164,13 +187,14 @@ fn fit_with(
         _ => None,
     };
     let average = |model: &MicrofacetBrdf| -> Result<Vec<crate::brdf::Rgb>, FitError> {
-        match (&uploaded, IsoTables::new(model)) {
-            (Some((g, samples)), Some(tables)) => g
+        #[cfg(feature = "gpu")]
+        if let (Some((g, samples)), Some(tables)) = (&uploaded, IsoTables::new(model)) {
+            return g
                 .fresnel
                 .average(g.gpu, samples, &tables)
-                .map_err(|e| gpu_error(src.name(), e)),
-            _ => Ok(fresnel_average(model, &set)),
+                .map_err(|e| gpu_error(src.name(), e));
         }
+        Ok(fresnel_average(model, &set))
     };
     let mut tabulated = MicrofacetBrdf {
         name: format!("{}-tabulated", src.name()),

@@ -9,11 +9,22 @@ use std::f64::consts::FRAC_PI_2;
 #[derive(Clone, Debug, PartialEq)]
 pub enum Fresnel {
     /// F = F0 + (1 − F0)(1 − cos θd)^5 per channel.
-    Schlick { f0: Rgb },
+    Schlick {
+        /// F at normal incidence.
+        f0: Rgb,
+    },
     /// Exact unpolarised Fresnel of a conductor of complex index η + i k per channel.
-    Conductor { eta: Rgb, k: Rgb },
+    Conductor {
+        /// Real part η of the index.
+        eta: Rgb,
+        /// Imaginary part k (extinction) of the index.
+        k: Rgb,
+    },
     /// Exact unpolarised Fresnel of a dielectric of relative index η (same for all channels).
-    Dielectric { eta: f64 },
+    Dielectric {
+        /// The relative index η.
+        eta: f64,
+    },
     /// A table over θd, as extracted from data.
     Table(FresnelTable),
 }
@@ -25,6 +36,7 @@ impl Fresnel {
         k: [3.983, 2.385, 1.603],
     };
 
+    /// F at cos θd, per channel.
     pub fn eval(&self, cos_d: f64) -> Rgb {
         let c = cos_d.clamp(0.0, 1.0);
         match self {
@@ -84,6 +96,7 @@ pub fn dielectric(cos_i: f64, eta: f64) -> f64 {
 pub struct FresnelTable {
     /// θd of each entry, radians, increasing and evenly spaced from 0.
     pub theta_d: Vec<f64>,
+    /// F per channel at each `theta_d`.
     pub rgb: Vec<Rgb>,
 }
 
@@ -95,6 +108,7 @@ impl FresnelTable {
         FresnelTable { theta_d, rgb }
     }
 
+    /// F at θd (radians), interpolated linearly and clamped to the table's ends.
     pub fn eval(&self, theta_d: f64) -> Rgb {
         let n = self.rgb.len();
         if n == 1 {

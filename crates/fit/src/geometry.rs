@@ -27,9 +27,13 @@ pub fn phi_of(w: DVec3) -> f64 {
 /// Rusinkiewicz coordinates of a pair of directions.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HalfDiff {
+    /// Polar angle of the half vector, radians.
     pub theta_h: f64,
+    /// Azimuth of the half vector, radians.
     pub phi_h: f64,
+    /// Polar angle of the difference vector, radians.
     pub theta_d: f64,
+    /// Azimuth of the difference vector, radians.
     pub phi_d: f64,
 }
 

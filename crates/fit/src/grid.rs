@@ -75,6 +75,7 @@ pub struct GridSample {
     pub rot: u8,
     /// θh bin and θd bin.
     pub i: u8,
+    /// θd bin (`i` above is the θh bin).
     pub j: u8,
     /// x = f_r cos θi per channel.
     pub x: [f32; 3],
@@ -84,8 +85,9 @@ pub struct GridSample {
 
 /// The valid samples of a source on the MERL grid.
 pub struct GridSamples {
-    /// Azimuths φh at which the grid is laid: [0] for isotropic sources.
+    /// Azimuths φh at which the grid is laid: `[0]` for isotropic sources.
     pub rotations: Vec<f64>,
+    /// The valid samples, in MERL bin order for each rotation.
     pub samples: Vec<GridSample>,
 }
 
@@ -178,10 +180,12 @@ impl GridSamples {
         }
     }
 
+    /// The number of valid samples.
     pub fn len(&self) -> usize {
         self.samples.len()
     }
 
+    /// Whether there is no valid sample.
     pub fn is_empty(&self) -> bool {
         self.samples.is_empty()
     }
@@ -294,11 +298,13 @@ impl IsoTables {
     }
 
     /// D per θh bin.
+    #[cfg(feature = "gpu")]
     pub(crate) fn d_table(&self) -> &[f64] {
         &self.d
     }
 
     /// Λ cos θ, uniform in θ over [0, π/2].
+    #[cfg(feature = "gpu")]
     pub(crate) fn lambda_cos_table(&self) -> &[f64] {
         &self.lambda_cos
     }
@@ -403,6 +409,7 @@ pub fn fresnel_average(model: &MicrofacetBrdf, set: &GridSamples) -> Vec<Rgb> {
 }
 
 /// For the GPU upload: (θi, θo in Λ-table steps, 1/cos θi, 1/cos θo, λ(φ)) of a sample.
+#[cfg(feature = "gpu")]
 pub(crate) fn sample_geometry(s: &GridSample) -> [f32; 5] {
     let g = &geometry()[s.bin as usize];
     [g.gi, g.go, g.inv_cos_i, g.inv_cos_o, g.corr]

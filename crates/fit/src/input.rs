@@ -12,11 +12,14 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error("{}: {problem}", path.display())]
 pub struct InputError {
+    /// The file.
     pub path: PathBuf,
+    /// What is wrong with it.
     pub problem: String,
 }
 
 impl InputError {
+    /// An error about `path`.
     pub fn new(path: impl Into<PathBuf>, problem: impl std::fmt::Display) -> Self {
         InputError {
             path: path.into(),
@@ -30,6 +33,7 @@ impl InputError {
 pub struct Cap {
     /// What the file is, for the message ("fit JSON", "glTF buffer").
     pub kind: &'static str,
+    /// The largest size read, in bytes.
     pub bytes: u64,
 }
 
@@ -51,6 +55,7 @@ impl Cap {
     /// An OpenEXR environment map.
     pub const EXR: Cap = Cap::new("OpenEXR image", 2048 * MIB);
 
+    /// A cap of `bytes` for files of `kind`.
     pub const fn new(kind: &'static str, bytes: u64) -> Self {
         Cap { kind, bytes }
     }

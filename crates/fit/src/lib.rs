@@ -22,10 +22,18 @@
 //! ([`nbrdf::NbrdfLibrary`]), analytic models ([`analytic::parse_analytic`]) and fits themselves
 //! ([`material::FittedMaterial`]). [`fit::fit_material`] runs the whole pipeline;
 //! [`extract`] holds the power iteration, [`tabulated`] the stretched tabulated NDF with its
-//! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid, [`gpu`] the
-//! same extraction and Fresnel average as WGSL compute passes
-//! ([`fit::fit_material_on`] with [`fit::Backend::Gpu`]).
-
+//! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid.
+//!
+//! ## Features
+//!
+//! `gpu` (default): the same extraction and Fresnel average as WGSL compute passes on a wgpu
+//! adapter, through facet-gpu. Without it facet-fit is CPU-only and builds no wgpu.
+#![cfg_attr(
+    feature = "gpu",
+    doc = "With it, [`gpu`] holds the passes and [`fit::fit_material_on`] with \
+           [`fit::Backend::Gpu`] runs a fit on them."
+)]
+#![warn(missing_docs)]
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
@@ -38,6 +46,7 @@ pub mod extract;
 pub mod fit;
 pub mod fresnel;
 pub mod geometry;
+#[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod grid;
 pub mod input;
@@ -49,7 +58,7 @@ pub mod params;
 pub mod quadrature;
 pub mod source;
 pub mod tabulated;
-pub mod visible_normals;
+pub(crate) mod visible_normals;
 pub mod visible_tables;
 
 pub use brdf::{Brdf, Rgb};
@@ -57,7 +66,8 @@ pub use error::FitError;
 pub use fit::{FitConfig, fit_material};
 pub use material::FittedMaterial;
 
-/// The README's Rust examples, compiled and run as doc-tests.
-#[doc = include_str!("../../../README.md")]
+/// The crate README's Rust examples, compiled and run as doc-tests (the workspace README's
+/// fitting example is the same text; `tests/readme.rs` at the workspace root checks that).
+#[doc = include_str!("../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;

@@ -14,10 +14,13 @@ use std::sync::Arc;
 /// α and rotation of a parametric fit, with its error.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Params {
+    /// α along the NDF's rotated x axis.
     pub alpha_x: f64,
+    /// α along the NDF's rotated y axis (equal to `alpha_x` in an isotropic fit).
     pub alpha_y: f64,
     /// Radians.
     pub rotation: f64,
+    /// The error metric of this model against the source.
     pub error: f64,
 }
 
@@ -26,51 +29,80 @@ pub struct Params {
 /// absolute slope moments, with the extraction's Fresnel) and its error.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ParamRecord {
+    /// α along the rotated x axis, by least squares.
     pub alpha_x: f64,
+    /// α along the rotated y axis, by least squares.
     pub alpha_y: f64,
+    /// Rotation of the α axes, radians.
     pub rotation: f64,
+    /// The error metric of the least-squares model (with its own Fresnel table).
     pub error: f64,
+    /// How `alpha_x`, `alpha_y` and `rotation` were found (`"least_squares"`).
     pub method: String,
+    /// The paper's estimate by slope moments, with its error.
     pub moments: Params,
+    /// F(θd) averaged for this model's own D and G.
     pub fresnel: FresnelTable,
 }
 
+/// The extracted (tabulated) model of a fit.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TabulatedRecord {
     /// Error metric of the tabulated model; absent when it was not asked for.
     pub error: Option<f64>,
+    /// The stretch applied to the tables (identity as extracted; edited in the viewer).
     pub stretch: Stretch,
+    /// The extracted D and G1 tables.
     pub tables: NdfTables,
 }
 
+/// Wall-clock times of a fit's phases, milliseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timings {
+    /// Reading the source (0 when the caller did not time it).
     pub load: f64,
+    /// The power iteration and the D / G1 tables.
     pub extract: f64,
+    /// The Fresnel average of the tabulated model.
     pub fresnel: f64,
+    /// The error metrics and the GGX / Beckmann fits.
     pub fit: f64,
+    /// The whole fit.
     pub total: f64,
 }
 
 /// The fit JSON.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FitRecord {
+    /// The source's name.
     pub name: String,
+    /// Where the source came from, as the caller described it (a path, `nbrdf:NAME`, ...).
     pub source: String,
+    /// What ran the extraction: `cpu`, the adapter's description, or a CPU fallback notice.
     pub backend: String,
+    /// θ samples of the extraction.
     pub resolution: usize,
+    /// φ samples of the extraction (1 when isotropic).
     pub phi_resolution: usize,
+    /// Whether αx, αy and a rotation were fitted.
     pub anisotropic: bool,
+    /// The quadrature of the power iteration.
     pub quadrature: crate::quadrature::Quadrature,
+    /// Power iterations run.
     pub iterations: usize,
+    /// Residual of the power iteration when it stopped.
     pub residual: f64,
     /// λ of the power iteration: F(0) of the backscattering slice, mean of RGB.
     pub eigenvalue: f64,
+    /// The extracted model.
     pub tabulated: TabulatedRecord,
+    /// The GGX fit, when asked for.
     pub ggx: Option<ParamRecord>,
+    /// The Beckmann fit, when asked for.
     pub beckmann: Option<ParamRecord>,
     /// F(θd) of the tabulated model.
     pub fresnel: FresnelTable,
+    /// How long each phase took.
     pub timings_ms: Timings,
 }
 
@@ -78,12 +110,16 @@ pub struct FitRecord {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ModelChoice {
+    /// The extracted NDF and G1 tables.
     Tabulated,
+    /// The GGX fit.
     Ggx,
+    /// The Beckmann fit.
     Beckmann,
 }
 
 impl ModelChoice {
+    /// `tabulated`, `ggx` or `beckmann`.
     pub fn parse(s: &str) -> Option<Self> {
         match s {
             "tabulated" => Some(ModelChoice::Tabulated),
@@ -97,13 +133,18 @@ impl ModelChoice {
 /// A fit record with its models built.
 #[derive(Clone, Debug)]
 pub struct FittedMaterial {
+    /// What is saved as JSON.
     pub record: FitRecord,
+    /// The tabulated model (with the record's stretch).
     pub tabulated: MicrofacetBrdf,
+    /// The GGX model, when fitted.
     pub ggx: Option<MicrofacetBrdf>,
+    /// The Beckmann model, when fitted.
     pub beckmann: Option<MicrofacetBrdf>,
 }
 
 impl FittedMaterial {
+    /// Builds the models of a record, checking its tables and parameters.
     pub fn from_record(record: FitRecord) -> Result<Self, String> {
         record.fresnel.validate()?;
         let st = record.tabulated.stretch;
@@ -147,6 +188,7 @@ impl FittedMaterial {
         })
     }
 
+    /// Reads a fit JSON written by [`FittedMaterial::save`].
     pub fn load(path: &Path) -> Result<Self, FitError> {
         Self::parse(
             path,

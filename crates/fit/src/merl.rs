@@ -16,12 +16,15 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::io::Write;
 use std::path::Path;
 
+/// θh bins of a MERL file.
 pub const THETA_H_RES: usize = 90;
+/// θd bins of a MERL file.
 pub const THETA_D_RES: usize = 90;
+/// φd bins of a MERL file (over [0, π): reciprocity gives the rest).
 pub const PHI_D_RES: usize = 180;
 /// Samples per channel.
 pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
-/// f_r = stored value × SCALE[channel].
+/// f_r = stored value × `SCALE[channel]`.
 pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 const HEADER_BYTES: u64 = 12;
 /// The largest stored value read as a measurement (f_r ≈ 7·10⁸ sr⁻¹, past any mirror-like
@@ -240,6 +243,7 @@ impl MerlTable {
         }
     }
 
+    /// The number of samples that hold no valid value.
     pub fn missing_count(&self) -> usize {
         (0..SAMPLES).filter(|&s| self.value_at(s).is_none()).count()
     }
@@ -300,6 +304,7 @@ pub struct MerlBrdf {
 }
 
 impl MerlBrdf {
+    /// Reads a MERL `.binary` file.
     pub fn open(path: &Path) -> Result<Self, FitError> {
         let table = MerlTable::read(path)?;
         let name = path
@@ -333,6 +338,7 @@ impl MerlBrdf {
         })
     }
 
+    /// The table read.
     pub fn table(&self) -> &MerlTable {
         &self.table
     }

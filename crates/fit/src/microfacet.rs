@@ -15,13 +15,17 @@ use std::sync::Arc;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum NdfKind {
+    /// Trowbridge–Reitz (GGX).
     Ggx,
+    /// Beckmann.
     Beckmann,
 }
 
 impl NdfKind {
+    /// Both kinds.
     pub const ALL: [NdfKind; 2] = [NdfKind::Ggx, NdfKind::Beckmann];
 
+    /// `ggx` or `beckmann`.
     pub fn name(self) -> &'static str {
         match self {
             NdfKind::Ggx => "ggx",
@@ -43,14 +47,18 @@ impl NdfKind {
 /// and αy across it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AnalyticNdf {
+    /// GGX or Beckmann.
     pub kind: NdfKind,
+    /// α along the rotated x axis.
     pub alpha_x: f64,
+    /// α along the rotated y axis.
     pub alpha_y: f64,
     /// Radians, counter-clockwise from the tangent.
     pub rotation: f64,
 }
 
 impl AnalyticNdf {
+    /// An isotropic NDF of roughness `alpha`.
     pub const fn isotropic(kind: NdfKind, alpha: f64) -> Self {
         AnalyticNdf {
             kind,
@@ -60,6 +68,7 @@ impl AnalyticNdf {
         }
     }
 
+    /// Whether αx = αy.
     pub fn is_isotropic(&self) -> bool {
         self.alpha_x == self.alpha_y
     }
@@ -137,11 +146,14 @@ fn to_local(w: DVec3, rotation: f64) -> DVec3 {
 /// An NDF: analytic or tabulated from an extraction (possibly stretched).
 #[derive(Clone, Debug)]
 pub enum Ndf {
+    /// GGX or Beckmann with its parameters.
     Analytic(AnalyticNdf),
+    /// An extracted table.
     Tabulated(Arc<TabulatedNdf>),
 }
 
 impl Ndf {
+    /// D(h).
     pub fn d(&self, h: DVec3) -> f64 {
         match self {
             Ndf::Analytic(n) => n.d(h),
@@ -149,6 +161,7 @@ impl Ndf {
         }
     }
 
+    /// Λ(ω), Smith's auxiliary function: G1(ω) = 1 / (1 + Λ(ω)).
     pub fn lambda(&self, w: DVec3) -> f64 {
         match self {
             Ndf::Analytic(n) => n.lambda(w),
@@ -156,6 +169,7 @@ impl Ndf {
         }
     }
 
+    /// Whether D is invariant under rotation about the normal.
     pub fn is_isotropic(&self) -> bool {
         match self {
             Ndf::Analytic(n) => n.is_isotropic(),
@@ -196,8 +210,11 @@ pub fn g2(lambda_i: f64, lambda_o: f64, correlation: f64) -> f64 {
 /// A microfacet BRDF with an optional Lambertian term.
 #[derive(Clone, Debug)]
 pub struct MicrofacetBrdf {
+    /// The model's name (in messages and plots).
     pub name: String,
+    /// The normal distribution.
     pub ndf: Ndf,
+    /// The Fresnel term.
     pub fresnel: Fresnel,
     /// Lambertian albedo ρd (f = ρd/π), zero for none.
     pub diffuse: Rgb,

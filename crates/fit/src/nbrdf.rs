@@ -172,6 +172,7 @@ impl NbrdfLibrary {
         }
     }
 
+    /// Reads a file of proxies in the format of the embedded one.
     pub fn open(path: &Path) -> Result<Self, FitError> {
         Self::parse(
             path,
@@ -196,10 +197,12 @@ impl NbrdfLibrary {
         })
     }
 
+    /// The names of the materials held.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.entries.keys().map(String::as_str)
     }
 
+    /// The proxy of material `name`; an unknown name is an error that lists near names.
     pub fn get(&self, name: &str) -> Result<NeuralBrdf, FitError> {
         let bad = |problem: String| FitError::Nbrdf {
             path: self.path.clone(),

@@ -9,6 +9,7 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 /// Bounds of any fitted α.
 pub const ALPHA_MIN: f64 = 1e-3;
+/// The upper bound (`ALPHA_MIN` is the lower).
 pub const ALPHA_MAX: f64 = 4.0;
 
 /// E|x~ cos ψ + y~ sin ψ| of the tabulated slope distribution for ψ = 0, 45°, 90°, 135°.

@@ -23,6 +23,7 @@ pub enum Quadrature {
 }
 
 impl Quadrature {
+    /// Every quadrature.
     pub const ALL: [Quadrature; 3] = [
         Quadrature::UniformTheta,
         Quadrature::SqrtMidpoint,

@@ -16,13 +16,16 @@ use std::sync::{Arc, OnceLock};
 /// Stretch and rotation applied to a tabulated NDF (1, 1, 0: the NDF as extracted).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Stretch {
+    /// Stretch along the rotated x axis.
     pub alpha_x: f64,
+    /// Stretch along the rotated y axis.
     pub alpha_y: f64,
     /// Radians, counter-clockwise from the tangent.
     pub rotation: f64,
 }
 
 impl Stretch {
+    /// No stretch, no rotation.
     pub const IDENTITY: Stretch = Stretch {
         alpha_x: 1.0,
         alpha_y: 1.0,
@@ -43,16 +46,20 @@ impl Default for Stretch {
 /// The tables as stored in a fit JSON.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NdfTables {
+    /// u samples of the D table.
     pub nu: usize,
+    /// φ samples of both tables (1: isotropic).
     pub nphi: usize,
     /// D₀ at (u_k, φ_l), index k · nphi + l.
     pub d: Vec<f64>,
+    /// θ samples of the G1 table.
     pub ng: usize,
     /// G1₀ at (θ_k, φ_l), index k · nphi + l.
     pub g1: Vec<f64>,
 }
 
 impl NdfTables {
+    /// Checks the table sizes and contents; `Err` says what is wrong.
     pub fn validate(&self) -> Result<(), String> {
         if self.nu < 2 || self.ng < 2 || self.nphi < 1 {
             return Err(format!(
@@ -92,6 +99,7 @@ impl NdfTables {
 #[derive(Clone, Debug)]
 pub struct TabulatedNdf {
     tables: NdfTables,
+    /// The stretch applied to the tables.
     pub stretch: Stretch,
     /// Sampling cells (nu − 1) × nphi: cumulative mass, normalised to 1 at the end.
     cdf: Vec<f64>,
@@ -103,6 +111,7 @@ pub struct TabulatedNdf {
 }
 
 impl TabulatedNdf {
+    /// The NDF of `tables` with `stretch`; `Err` says why the tables are unusable.
     pub fn new(tables: NdfTables, stretch: Stretch) -> Result<Self, String> {
         tables.validate()?;
         if !(stretch.alpha_x > 0.0 && stretch.alpha_y > 0.0 && stretch.rotation.is_finite()) {
@@ -152,6 +161,7 @@ impl TabulatedNdf {
         })
     }
 
+    /// The tables, unstretched.
     pub fn tables(&self) -> &NdfTables {
         &self.tables
     }
@@ -204,6 +214,7 @@ impl TabulatedNdf {
         }
     }
 
+    /// Whether the NDF is invariant under rotation about the normal.
     pub fn is_isotropic(&self) -> bool {
         self.tables.nphi == 1 && self.stretch.alpha_x == self.stretch.alpha_y
     }

@@ -72,7 +72,9 @@ fn frame(n: DVec3) -> (DVec3, DVec3) {
 /// Table resolution: cells over θo, θi ∈ [0°, 90°] and Δφ ∈ [0°, 180°].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DpfConfig {
+    /// θ cells of the table (θo and θi).
     pub n_theta: usize,
+    /// Δφ cells of the table.
     pub n_dphi: usize,
 }
 
@@ -99,7 +101,9 @@ impl DpfConfig {
 /// (clamped at the edges). Δφ = φo − φi folded to [0°, 180°]; 180° is the mirror configuration.
 #[derive(Clone, Debug)]
 pub struct DpfTable {
+    /// The cone half-angle γ it was built for, radians.
     pub gamma: f64,
+    /// Its resolution.
     pub config: DpfConfig,
     /// Index (θo, θi, Δφ) → values[(o · n_theta + i) · n_dphi + p].
     pub values: Vec<f32>,
@@ -183,6 +187,7 @@ impl DpfTable {
 /// only some levels ([`DpfPyramid::levels_for`] says which a γ needs).
 #[derive(Clone, Debug)]
 pub struct DpfPyramid {
+    /// One table per level of [`LEVELS_DEG`]; `None` for a level not built.
     pub levels: Vec<Option<DpfTable>>,
 }
 

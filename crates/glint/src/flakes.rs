@@ -34,12 +34,16 @@ pub struct FlakeField {
 /// An ellipse in UV: points c + s·a + t·b with s² + t² ≤ 1 (a, b conjugate semi-axes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Footprint {
+    /// Centre in UV.
     pub center: DVec2,
+    /// First half-axis in UV.
     pub a: DVec2,
+    /// Second half-axis in UV.
     pub b: DVec2,
 }
 
 impl Footprint {
+    /// Area in UV units.
     pub fn area(&self) -> f64 {
         PI * (self.a.x * self.b.y - self.a.y * self.b.x).abs()
     }
@@ -84,6 +88,7 @@ pub fn direction_cell(wi: DVec3, wo: DVec3, gamma: f64) -> (u32, u32) {
 pub struct Flake {
     /// Its identity: the same flake has the same id in every query.
     pub id: u64,
+    /// Position in UV.
     pub uv: DVec2,
 }
 

@@ -9,6 +9,7 @@ use facet_fit::quadrature::gauss_legendre;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Uniforms of the build (WGSL `Params`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct DpfParams {
@@ -73,7 +74,9 @@ fn ndf_upload(ndf: &Ndf) -> (DpfParams, Vec<f32>) {
 
 /// The pyramid built on the GPU: the tables (read back) and one 3D texture per level.
 pub struct GpuDpf {
+    /// The tables, read back from the GPU.
     pub pyramid: DpfPyramid,
+    /// One 3D texture per level.
     pub textures: Vec<wgpu::Texture>,
 }
 
@@ -181,6 +184,7 @@ pub fn build_levels(
 }
 
 /// The flake field as `shaders/glint/glint_count.wgsl` takes it (WGSL `Field`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintField {
@@ -193,6 +197,7 @@ pub struct GlintField {
 }
 
 /// One glint query (WGSL `Query`): the footprint, P, and the direction cell.
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintQuery {
@@ -205,6 +210,7 @@ pub struct GlintQuery {
 }
 
 impl GlintQuery {
+    /// The query for footprint `fp` with DPF value `p` and direction cell `cell`.
     pub fn new(fp: &crate::flakes::Footprint, p: f64, cell: (u32, u32)) -> Self {
         GlintQuery {
             center: fp.center.as_vec2().to_array(),
@@ -230,6 +236,7 @@ pub fn flake_constants() -> Vec<(&'static str, f64)> {
 }
 
 impl GlintField {
+    /// The uniform of `field` counted under `cfg`.
     pub fn new(field: &crate::flakes::FlakeField, cfg: &crate::glint_brdf::GlintConfig) -> Self {
         GlintField {
             density: field.density as f32,
@@ -250,6 +257,7 @@ pub struct GlintCounter {
 }
 
 impl GlintCounter {
+    /// Builds the pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         let constants = flake_constants();
         Ok(GlintCounter {
@@ -300,6 +308,7 @@ impl GlintCounter {
 }
 
 /// Uniforms of `shaders/glint/glint_eval.wgsl` (WGSL `EvalParams`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintEvalParams {
@@ -319,6 +328,7 @@ pub struct GlintEvalParams {
 }
 
 /// One evaluation (WGSL `EvalQuery`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GlintEvalQuery {
@@ -331,6 +341,7 @@ pub struct GlintEvalQuery {
 }
 
 impl GlintEvalQuery {
+    /// The query for (ωi, ωo) over footprint `fp`.
     pub fn new(wi: glam::DVec3, wo: glam::DVec3, fp: &crate::flakes::Footprint) -> Self {
         GlintEvalQuery {
             wi: wi.as_vec3().extend(0.0).to_array(),
@@ -352,6 +363,7 @@ pub struct GlintEvaluator {
 }
 
 impl GlintEvaluator {
+    /// Builds the pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         let constants = flake_constants();
         Ok(GlintEvaluator {

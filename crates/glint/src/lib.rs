@@ -17,6 +17,8 @@
 //! assert!((p / 7.587e-3 - 1.0).abs() < 0.01);
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod dpf;
 pub mod flakes;
 pub mod glint_brdf;

@@ -7,6 +7,7 @@
 pub const KEY: [u32; 4] = [0xA341_316C, 0xC801_3EA4, 0xAD90_777D, 0x7E95_761E];
 /// TEA's round constant δ.
 pub const DELTA: u32 = 0x9e37_79b9;
+/// Rounds of TEA per hash.
 pub const ROUNDS: u32 = 8;
 // shaders/glint/tea.inc.wgsl writes out at most 16 rounds.
 const _: () = assert!(ROUNDS <= 16);

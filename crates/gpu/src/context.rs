@@ -57,9 +57,13 @@ impl GpuOptions {
 /// A chosen adapter with its device and queue. Domain code takes `&wgpu::Device` and
 /// `&wgpu::Queue` from it; this struct owns nothing else.
 pub struct Gpu {
+    /// The chosen adapter.
     pub adapter: wgpu::Adapter,
+    /// The device opened on it.
     pub device: wgpu::Device,
+    /// The device's queue.
     pub queue: wgpu::Queue,
+    /// The adapter's name, backend and driver.
     pub info: wgpu::AdapterInfo,
     /// Timestamp queries are available.
     pub timestamps: bool,
@@ -88,6 +92,7 @@ impl Gpu {
         Self::with_options(&GpuOptions::from_env()?)
     }
 
+    /// An adapter and device chosen by `opts`.
     pub fn with_options(opts: &GpuOptions) -> Result<Self, GpuError> {
         let backends = opts
             .backends

@@ -12,11 +12,13 @@
 //! # Ok::<(), facet_gpu::GpuError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod buffer;
-pub mod context;
+mod context;
 pub mod dispatch;
-pub mod error;
-pub mod runtime_dir;
+mod error;
+mod runtime_dir;
 pub mod shader;
 pub mod skip;
 pub mod timer;

@@ -148,6 +148,7 @@ pub struct StructLayout {
 /// One member of a [`StructLayout`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MemberLayout {
+    /// The member's name.
     pub name: String,
     /// Byte offset in the struct.
     pub offset: u32,

@@ -26,10 +26,14 @@ use std::time::{Duration, Instant};
 /// obvhs's build presets, fastest build (slowest traversal) to slowest build.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum BvhPreset {
+    /// obvhs's `fastest_build`.
     Fastest,
+    /// obvhs's `very_fast_build`.
     VeryFast,
+    /// obvhs's `fast_build`.
     Fast,
     #[default]
+    /// obvhs's `medium_build`.
     Medium,
     /// Pre-splits large triangles: a triangle may sit in several leaves.
     Slow,
@@ -38,6 +42,7 @@ pub enum BvhPreset {
 }
 
 impl BvhPreset {
+    /// Every preset, fastest build first.
     pub const ALL: [BvhPreset; 6] = [
         BvhPreset::Fastest,
         BvhPreset::VeryFast,
@@ -97,6 +102,7 @@ pub struct Hit {
     pub prim: u32,
     /// Barycentrics: p = (1−u−v)·v0 + u·v1 + v·v2, vertices in the triangle's index order.
     pub u: f32,
+    /// See `u`.
     pub v: f32,
 }
 
@@ -177,6 +183,7 @@ impl Bvh {
         self.cwbvh.validate(&self.triangles, false)
     }
 
+    /// Whether the BVH holds no triangle.
     pub fn is_empty(&self) -> bool {
         self.cwbvh.nodes.is_empty()
     }

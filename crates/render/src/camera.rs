@@ -7,10 +7,15 @@ use glam::Vec3;
 /// An orthonormal camera frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraFrame {
+    /// Eye position, world space.
     pub position: Vec3,
+    /// Unit view direction.
     pub forward: Vec3,
+    /// Unit up, orthogonal to `forward`.
     pub up: Vec3,
+    /// Unit right, `forward × up`.
     pub right: Vec3,
+    /// Vertical field of view, radians.
     pub yfov: f32,
 }
 

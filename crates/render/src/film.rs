@@ -10,8 +10,11 @@ use std::path::Path;
 /// A linear RGB image, row-major, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
+    /// Pixels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
+    /// Linear RGB radiance, row-major, row 0 at the top.
     pub pixels: Vec<[f32; 3]>,
     /// Samples each pixel received.
     pub samples: Vec<u32>,
@@ -52,6 +55,7 @@ impl Image {
         sum.map(|s| s / n.max(1) as f64)
     }
 
+    /// Mean RGB over every pixel.
     pub fn mean(&self) -> [f64; 3] {
         self.mean_where(|_, _| true)
     }

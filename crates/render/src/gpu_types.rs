@@ -12,6 +12,7 @@ pub const NONE: u32 = u32::MAX;
 pub const PATH_REGIONS: u64 = crate::tags::Region::ALL.len() as u64;
 
 /// WGSL `Frame` (`shaders/render/frame.inc.wgsl`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuFrame {
@@ -51,6 +52,7 @@ pub struct GpuFrame {
 }
 
 /// WGSL `Material` (`shaders/render/scene.inc.wgsl`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuMaterial {
@@ -81,6 +83,7 @@ pub struct GpuMaterial {
 }
 
 /// WGSL `Light`.
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuLight {

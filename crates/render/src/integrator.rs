@@ -26,12 +26,15 @@ pub(crate) type EncodeStage<'a> = dyn FnMut(&mut wgpu::ComputePass) + 'a;
 /// Settings of one render.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderConfig {
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
     /// Samples per pixel.
     pub spp: u32,
     /// Bounces after the camera ray (1: direct lighting only).
     pub max_depth: u32,
+    /// Seed of the per-pixel random numbers.
     pub seed: u32,
     /// Depth from which Russian roulette plays.
     pub rr_depth: u32,
@@ -43,7 +46,9 @@ pub struct RenderConfig {
     pub time_limit: Option<f64>,
     /// Iterations submitted between checks for completion.
     pub iterations_per_check: u32,
+    /// How direct lighting is sampled.
     pub strategy: Strategy,
+    /// How the normals of microfacet lobes are sampled.
     pub ndf_sampling: NdfSampling,
 }
 
@@ -88,6 +93,7 @@ impl RenderConfig {
 /// What a render did.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RenderStats {
+    /// Wall-clock time, milliseconds.
     pub ms: f64,
     /// Samples taken (all pixels).
     pub samples: u64,
@@ -116,6 +122,7 @@ pub struct Integrator {
 }
 
 impl Integrator {
+    /// The pipelines for the material classes of `scene`.
     pub fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
         let layouts = Layouts::new(device);
         let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {

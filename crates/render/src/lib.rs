@@ -21,21 +21,22 @@
 //! # Ok::<(), facet_render::RenderError>(())
 //! ```
 
+#![warn(missing_docs)]
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bvh;
 pub mod camera;
-pub mod error;
+mod error;
 pub mod film;
 pub mod gpu_types;
-pub mod integrator;
-pub mod limits;
+mod integrator;
+pub(crate) mod limits;
 pub mod procedural;
-pub mod queues;
+pub(crate) mod queues;
 pub mod resources;
 pub mod scene;
-pub mod stages;
+pub(crate) mod stages;
 pub mod tags;
 pub mod tonemap;
 pub mod trace;
@@ -43,7 +44,10 @@ pub mod wavefront;
 
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use error::RenderError;
+pub use facet_gpu::{Gpu, GpuError};
 pub use film::Image;
+/// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
+pub use glam;
 pub use integrator::{Integrator, NdfSampling, RenderConfig, RenderStats, Strategy};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;

@@ -11,10 +11,12 @@ use std::collections::HashMap;
 pub struct Rng(u64);
 
 impl Rng {
+    /// A generator seeded with `seed`.
     pub fn new(seed: u64) -> Self {
         Rng(seed)
     }
 
+    /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
         let mut z = self.0;
@@ -54,11 +56,14 @@ impl Rng {
 /// An indexed triangle list.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
+    /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Triangles as vertex indices.
     pub indices: Vec<[u32; 3]>,
 }
 
 impl Mesh {
+    /// The number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.indices.len()
     }

@@ -18,7 +18,9 @@ macro_rules! tags {
         }
 
         impl $name {
+            /// Every tag, in value order.
             pub const ALL: &[$name] = &[$($name::$variant),+];
+            /// The prefix of the WGSL constants' names.
             pub const WGSL_PREFIX: &str = $prefix;
 
             /// The WGSL constant's name.
@@ -160,8 +162,11 @@ tags!(
 
 /// One tag enum: its Rust name, its WGSL prefix and its (WGSL name, value, doc) constants.
 pub struct TagSet {
+    /// The Rust enum's name.
     pub rust: &'static str,
+    /// The WGSL constants' prefix.
     pub prefix: &'static str,
+    /// (WGSL name, value, doc) of each tag.
     pub tags: Vec<(&'static str, u32, &'static str)>,
 }
 

@@ -6,6 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use facet_gpu::{Gpu, buffer, dispatch, shader};
 
 /// WGSL `Params` of `render/tonemap.wgsl`.
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct ToneMapParams {
@@ -27,6 +28,7 @@ pub struct ToneMap {
 }
 
 impl ToneMap {
+    /// The tone-map pass over `film` (`width` × `height` pixels).
     pub fn new(
         gpu: &Gpu,
         film: &wgpu::Buffer,

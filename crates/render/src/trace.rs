@@ -9,6 +9,7 @@ use facet_gpu::{GpuError, buffer, dispatch, shader};
 const SHADER: &str = "render/trace.wgsl";
 
 /// One ray (WGSL `Ray`, 32 bytes). `dir` need not be unit length: t is in units of `dir`.
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuRay {
@@ -21,6 +22,7 @@ pub struct GpuRay {
 }
 
 impl GpuRay {
+    /// A ray from `origin` along `dir`, up to distance `tmax`.
     pub fn new(origin: glam::Vec3, dir: glam::Vec3, tmax: f32) -> Self {
         GpuRay {
             origin: origin.into(),
@@ -32,6 +34,7 @@ impl GpuRay {
 }
 
 /// One closest hit (WGSL `Hit`, 16 bytes).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuHit {
@@ -45,8 +48,10 @@ pub struct GpuHit {
 }
 
 impl GpuHit {
+    /// `prim` of a ray that hit nothing.
     pub const MISS: u32 = u32::MAX;
 
+    /// Whether the ray hit a triangle.
     pub fn is_hit(&self) -> bool {
         self.prim != Self::MISS
     }
@@ -64,6 +69,7 @@ pub struct RayTracer {
 }
 
 impl RayTracer {
+    /// Builds the traversal pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         Ok(RayTracer {
             closest: shader::compute_pipeline(device, SHADER, "trace_closest_rays", &[])?,
@@ -73,7 +79,7 @@ impl RayTracer {
     }
 
     /// Most rays one dispatch takes: the ray binding (32 bytes a ray) within the device's
-    /// storage binding limit, rounded down to [`CHUNK_ALIGN`].
+    /// storage binding limit, rounded down to `CHUNK_ALIGN`.
     pub fn max_rays_per_dispatch(device: &wgpu::Device) -> u64 {
         let limit = device.limits().max_storage_buffer_binding_size;
         (limit / size_of::<GpuRay>() as u64 / CHUNK_ALIGN * CHUNK_ALIGN).max(CHUNK_ALIGN)

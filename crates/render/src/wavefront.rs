@@ -60,8 +60,9 @@ pub fn next_batch(spp: u32, ms: f64) -> u32 {
 /// One stage's share of one iteration.
 #[derive(Clone, Debug, PartialEq)]
 pub struct StageTime {
-    /// "logic", "generate", "extend", "shade <class>", "connect", "close <queue>".
+    /// `logic`, `generate`, `extend`, `shade <class>`, `connect`, `close <queue>`.
     pub stage: String,
+    /// Milliseconds.
     pub ms: f64,
 }
 

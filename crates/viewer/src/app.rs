@@ -11,8 +11,11 @@ use std::time::Instant;
 
 /// A fit running on a background thread.
 pub struct FitJob {
+    /// What is being fitted.
     pub label: String,
+    /// When the fit started.
     pub started: Instant,
+    /// The phase the fit is in, for the status line.
     pub stage: std::sync::Arc<std::sync::Mutex<String>>,
     rx: Receiver<Result<FittedMaterial, String>>,
 }
@@ -20,16 +23,21 @@ pub struct FitJob {
 /// What a screenshot run (`--screenshot PATH --frames N`) does.
 #[derive(Clone, Debug)]
 pub struct ScreenshotPlan {
+    /// Where the PNG goes (PATH.json beside it).
     pub path: PathBuf,
     /// Preview frames to accumulate before the shot.
     pub frames: u32,
     /// Stage: 0 waiting for frames/2, 1 nudged αx and waiting, 2 shot requested, 3 saved.
     pub stage: u32,
+    /// When the run started.
     pub started: Instant,
+    /// Set once the PNG is written.
     pub saved: std::sync::Arc<std::sync::atomic::AtomicBool>,
 }
 
+/// The UI state of the viewer window (GPU work lives in [`Preview`]).
 pub struct ViewerApp {
+    /// The material being edited.
     pub material: EditedMaterial,
     /// Bumped whenever the material the renderer sees changes (the preview restarts).
     pub generation: u64,
@@ -37,17 +45,25 @@ pub struct ViewerApp {
     pub sent_key: Option<MaterialKey>,
     /// When the last edit happened (for the edit-to-frame latency).
     pub edited_at: Option<Instant>,
+    /// Exposure of the preview, stops.
     pub exposure: f32,
+    /// The preview camera.
     pub orbit: Orbit,
     /// The open field: a path, `nbrdf:NAME` or `analytic:SPEC`.
     pub open_text: String,
+    /// The save field: the path of the fit JSON to write.
     pub save_text: String,
+    /// The last error, shown until the next action.
     pub error: Option<String>,
+    /// The status line.
     pub status: String,
+    /// A fit running in the background.
     pub fit_job: Option<FitJob>,
     /// The live preview; `None` without a GPU (then `preview_error` says why).
     pub preview: Option<Preview>,
+    /// Why there is no preview, or why it stopped.
     pub preview_error: Option<String>,
+    /// The preview image on egui's side.
     pub texture: Option<egui::TextureHandle>,
     /// The preview frame the texture shows.
     pub shown_frame: u64,
@@ -59,6 +75,7 @@ pub struct ViewerApp {
     pub nbrdf: Option<PathBuf>,
     /// The neural proxies' names, read when the list is first opened.
     pub proxy_names: Option<Result<Vec<String>, String>>,
+    /// The screenshot run, under `--screenshot`.
     pub screenshot: Option<ScreenshotPlan>,
 }
 

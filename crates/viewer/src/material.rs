@@ -12,13 +12,16 @@ pub enum Shown {
     Measured,
     /// The tabulated fit with the edited stretch.
     Tabulated,
+    /// The GGX fit with its edited α.
     Ggx,
+    /// The Beckmann fit with its edited α.
     Beckmann,
     /// The GGX model with glints.
     Glint,
 }
 
 impl Shown {
+    /// Every choice, in the order of the selector.
     pub const ALL: [Shown; 5] = [
         Shown::Measured,
         Shown::Tabulated,
@@ -27,6 +30,7 @@ impl Shown {
         Shown::Glint,
     ];
 
+    /// The selector's label.
     pub fn label(self) -> &'static str {
         match self {
             Shown::Measured => "measured data",
@@ -41,8 +45,11 @@ impl Shown {
 /// Glint settings of the edit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GlintEdit {
+    /// Flakes per unit UV area.
     pub density: f32,
+    /// Cone half-angle γ, degrees.
     pub gamma_deg: f32,
+    /// Expected count above which the count is replaced by its mean.
     pub threshold: f32,
 }
 
@@ -66,14 +73,18 @@ pub struct EditedMaterial {
     pub source: String,
     /// The record with edited α and rotation.
     pub record: FitRecord,
+    /// Which model the preview shows.
     pub shown: Shown,
+    /// RGB multiplier of every Fresnel table.
     pub tint: [f64; 3],
+    /// Glint settings.
     pub glint: GlintEdit,
     /// αx and αy move together (their ratio kept).
     pub lock: bool,
 }
 
 impl EditedMaterial {
+    /// The edit of `base` (from `source`) before any change: GGX shown when fitted, else the tabulated fit.
     pub fn new(base: FittedMaterial, source: String) -> Self {
         let record = base.record.clone();
         let shown = if record.ggx.is_some() {
@@ -224,11 +235,18 @@ impl EditedMaterial {
 /// See [`EditedMaterial::key`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct MaterialKey {
+    /// Address of the base fit (a new fit is a new key).
     pub base: usize,
+    /// The model shown.
     pub shown: Shown,
+    /// αx, αy, rotation of the tabulated stretch.
     pub stretch: [f64; 3],
+    /// αx, αy, rotation of GGX.
     pub ggx: Option<[f64; 3]>,
+    /// αx, αy, rotation of Beckmann.
     pub beckmann: Option<[f64; 3]>,
+    /// The Fresnel tint.
     pub tint: [f64; 3],
+    /// Glint settings, when glints are shown.
     pub glint: Option<GlintEdit>,
 }

@@ -27,9 +27,13 @@ pub use facet_render::wavefront::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
 /// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Orbit {
+    /// The point looked at.
     pub target: Vec3,
+    /// Azimuth around the vertical axis, radians.
     pub yaw: f32,
+    /// Elevation, radians.
     pub pitch: f32,
+    /// Distance from `target`.
     pub distance: f32,
     /// Vertical field of view, radians.
     pub yfov: f32,
@@ -63,6 +67,7 @@ impl Orbit {
         }
     }
 
+    /// The camera of this orbit.
     pub fn camera(&self) -> Camera {
         let pitch = self.pitch.clamp(-0.2, 1.4);
         let dir = Vec3::new(
@@ -85,9 +90,11 @@ impl Orbit {
 /// A scene for the preview: the scene, which material the edits go to, where the orbit starts.
 #[derive(Clone, Debug)]
 pub struct PreviewScene {
+    /// The scene.
     pub scene: Scene,
     /// Index of the edited material.
     pub edited: usize,
+    /// Where the orbit starts.
     pub orbit: Orbit,
 }
 
@@ -130,15 +137,20 @@ impl PreviewScene {
 pub enum Command {
     /// A new sphere material; `sent` is when the edit happened (latency is measured from it).
     Material {
+        /// The generation it belongs to ([`crate::ViewerApp::generation`]).
         generation: u64,
+        /// The material.
         material: Box<Material>,
+        /// When the edit happened.
         sent: Instant,
     },
+    /// Another camera (the accumulation restarts).
     Camera(Orbit),
     /// Tone map the image at this exposure (stops) from now on.
     Exposure(f32),
     /// Another scene (resources and pipelines are rebuilt).
     Scene(Box<PreviewScene>),
+    /// Stop the worker.
     Quit,
 }
 
@@ -147,12 +159,15 @@ pub enum Command {
 pub struct Shared {
     /// The material generation the accumulated image shows.
     pub generation: u64,
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
     /// The image so far, tone mapped on the GPU (RGBA8, alpha 255).
     pub rgba: Vec<[u8; 4]>,
     /// The exposure `rgba` was tone mapped with.
     pub exposure: f32,
+    /// Samples per pixel accumulated.
     pub samples: u32,
     /// Samples per pixel the last batch added.
     pub spp_per_frame: u32,
@@ -169,14 +184,18 @@ pub struct Shared {
     /// Whether the last material change needed new resources (pipelines) rather than an
     /// in-place buffer write.
     pub last_rebuilt: bool,
+    /// Whether resources are being rebuilt now.
     pub rebuilding: bool,
+    /// The worker's last error.
     pub error: Option<String>,
+    /// The adapter's description.
     pub adapter: String,
 }
 
 /// The UI's handle on the worker.
 pub struct Preview {
     tx: Sender<Command>,
+    /// What the worker publishes, read by the UI.
     pub shared: Arc<Mutex<Shared>>,
     /// The device's uncaptured errors (wgpu would panic on them): shown in the window.
     pub gpu_error: Arc<Mutex<Option<String>>>,
@@ -247,6 +266,7 @@ impl Preview {
         }
     }
 
+    /// Sends a command to the worker (ignored once it has stopped).
     pub fn send(&self, cmd: Command) {
         let _ = self.tx.send(cmd);
     }

@@ -7,6 +7,7 @@ use crate::grid::{GridSamples, IsoTables, fresnel_from_sums, sample_geometry};
 use crate::merl::THETA_D_RES;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
+/// The Fresnel average over the MERL grid on the GPU (`shaders/fit/fresnel.wgsl`).
 pub struct FresnelAverage {
     pipeline: wgpu::ComputePipeline,
     /// `@workgroup_size` of the shader, read by naga (written once, there).
@@ -20,6 +21,7 @@ pub struct GpuSamples {
 }
 
 impl FresnelAverage {
+    /// Builds the pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         Ok(FresnelAverage {
             pipeline: shader::compute_pipeline(device, "fit/fresnel.wgsl", "fresnel_sums", &[])?,

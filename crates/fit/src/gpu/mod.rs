@@ -14,6 +14,7 @@ use bytemuck::{Pod, Zeroable};
 use facet_gpu::{Gpu, GpuError};
 
 /// A node or query of the power iteration (WGSL `Node` in `fit/node.inc.wgsl`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuNode {
@@ -28,6 +29,7 @@ pub struct GpuNode {
 }
 
 /// Iteration state (WGSL `State`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuState {
@@ -38,6 +40,7 @@ pub struct GpuState {
 }
 
 /// One MERL-grid sample for the Fresnel average (WGSL `Sample` in `fit/fresnel.wgsl`).
+#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuSample {
@@ -53,12 +56,16 @@ pub struct GpuSample {
 
 /// The GPU pipelines of the fitter, built once and reused for every material.
 pub struct GpuFitter<'g> {
+    /// The GPU the pipelines were built on.
     pub gpu: &'g Gpu,
+    /// The power iteration and the table integrals.
     pub power: PowerIteration,
+    /// The Fresnel average.
     pub fresnel: FresnelAverage,
 }
 
 impl<'g> GpuFitter<'g> {
+    /// Builds every pipeline of the fitter on `gpu`.
     pub fn new(gpu: &'g Gpu) -> Result<Self, GpuError> {
         let (power, fresnel) = gpu.scoped(|| {
             Ok::<_, GpuError>((

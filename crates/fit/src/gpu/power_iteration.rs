@@ -15,6 +15,7 @@ const BATCH: usize = 8;
 /// a tighter tolerance is taken as this one on the GPU.
 const F32_RESIDUAL_FLOOR: f64 = 1e-6;
 
+/// The power iteration and the D / G1 table integrals on the GPU (`shaders/fit/kernel.wgsl`, `normalise.wgsl`).
 pub struct PowerIteration {
     kernel_iso: wgpu::ComputePipeline,
     kernel_aniso: wgpu::ComputePipeline,
@@ -41,6 +42,7 @@ fn gpu_nodes(p: &Problem) -> Vec<GpuNode> {
 }
 
 impl PowerIteration {
+    /// Builds the pipelines on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         let k = "fit/kernel.wgsl";
         let n = "fit/normalise.wgsl";

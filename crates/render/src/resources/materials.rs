@@ -16,9 +16,11 @@ pub const FRESNEL_NODES: usize = 91;
 /// What one material needs on the GPU: its record (table offsets and queue still to be
 /// assigned), its Fresnel table, its tabulated NDF, its glint parameters.
 pub struct MaterialPlan<'a> {
+    /// The material's GPU record.
     pub gpu: GpuMaterial,
     /// F(θd) at FRESNEL_NODES nodes, RGB interleaved (fitted materials).
     pub fresnel: Option<Vec<f32>>,
+    /// A tabulated material's NDF.
     pub tabulated: Option<&'a TabulatedNdf>,
     /// A glint material's NDF and parameters.
     pub glint: Option<(AnalyticNdf, GlintParams)>,

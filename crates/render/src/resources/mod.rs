@@ -35,13 +35,21 @@ pub struct Built {
     pub classes: Vec<&'static str>,
     /// DPF pyramids (one per glint material) and their levels in degrees.
     pub glint_pyramids: Vec<Vec<f64>>,
+    /// Textures uploaded.
     pub textures: usize,
+    /// Whether the environment is a map (not a constant).
     pub environment_map: bool,
+    /// Tabulated NDFs uploaded.
     pub tabulated_tables: usize,
+    /// Triangles with emission.
     pub emissive_triangles: usize,
+    /// Lights of every kind.
     pub lights: usize,
+    /// Nodes of the CWBVH.
     pub bvh_nodes: usize,
+    /// Time to build the BVH, milliseconds.
     pub bvh_build_ms: f64,
+    /// Time to build the DPF pyramids, milliseconds.
     pub glint_build_ms: f64,
     /// The probability of picking each light (punctual, emissive triangles, environment).
     pub light_pmf: Vec<f32>,
@@ -49,35 +57,59 @@ pub struct Built {
 
 /// One glint material's GPU resources (bind group 2 of its shading stage).
 pub struct GlintResources {
+    /// Its material index.
     pub material: u32,
+    /// Its DPF pyramid on the GPU.
     pub dpf: GpuDpf,
+    /// The flake field uniform.
     pub field: wgpu::Buffer,
+    /// The evaluation parameters uniform.
     pub params: wgpu::Buffer,
+    /// The finer of the two pyramid levels bound.
     pub level0: wgpu::TextureView,
+    /// The coarser of the two pyramid levels bound.
     pub level1: wgpu::TextureView,
 }
 
 /// The scene on the GPU (bind group 1 of every stage).
 pub struct SceneResources {
+    /// The CWBVH.
     pub bvh: GpuBvh,
+    /// Vertex attributes.
     pub vertices: wgpu::Buffer,
+    /// Triangle records.
     pub triangles: wgpu::Buffer,
+    /// Material records.
     pub materials: wgpu::Buffer,
+    /// Texels of every texture.
     pub textures: wgpu::Buffer,
+    /// Punctual lights and emissive triangles as light records.
     pub lights: wgpu::Buffer,
+    /// The scene tables (f32 words: Fresnel and NDF tables, the environment map and its CDFs, the light-selection CDF).
     pub tables: wgpu::Buffer,
+    /// The light of each emissive triangle.
     pub triangle_light: wgpu::Buffer,
+    /// The GPU state of each glint material.
     pub glints: Vec<GlintResources>,
     /// Which shading queues have hits routed to them.
     pub queues_used: Vec<Queue>,
+    /// Vertices uploaded.
     pub n_vertices: u32,
+    /// Lights uploaded.
     pub n_lights: u32,
+    /// Offset of the light-selection CDF in `tables`.
     pub light_cdf: u32,
+    /// The environment's kind tag.
     pub env_kind: u32,
+    /// The environment map's size.
     pub env_size: (u32, u32),
+    /// Word offsets of the environment map's texels, marginal and conditional CDFs in `tables`.
     pub env_offsets: (u32, u32, u32),
+    /// The constant environment's radiance.
     pub env_color: [f32; 4],
+    /// Radius of the scene's bounding sphere.
     pub scene_radius: f32,
+    /// What was built.
     pub built: Built,
     /// The materials as uploaded (for [`SceneResources::update_material`]).
     pub material_data: Vec<GpuMaterial>,
@@ -86,6 +118,7 @@ pub struct SceneResources {
 /// Settings of the resources that are not in the scene file.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ResourceConfig {
+    /// How the BVH is built.
     pub bvh: BvhConfig,
     /// DPF table resolution of glint materials.
     pub dpf: DpfConfig,
@@ -96,6 +129,7 @@ pub struct ResourceConfig {
 }
 
 impl ResourceConfig {
+    /// The medium BVH, the standard DPF tables, the glint filter on, robust light selection.
     pub const fn standard() -> Self {
         ResourceConfig {
             bvh: BvhConfig::medium(),
@@ -107,6 +141,7 @@ impl ResourceConfig {
 }
 
 impl SceneResources {
+    /// Uploads `scene` and `environment` to `gpu`.
     pub fn new(
         gpu: &Gpu,
         scene: &Scene,

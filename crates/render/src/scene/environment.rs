@@ -95,7 +95,9 @@ pub fn luminance(c: Vec3) -> f32 {
 pub struct EnvironmentMap {
     /// The file it came from (or a label).
     pub path: PathBuf,
+    /// Texels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
     /// Linear RGB radiance, row-major, row 0 straight up.
     pub texels: Vec<Vec3>,

@@ -46,14 +46,20 @@ pub const MAX_BYTE_STRIDE: u64 = 252;
 /// What an accessor is read as.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Attribute {
+    /// `POSITION`.
     Position,
+    /// `NORMAL`.
     Normal,
+    /// `TANGENT`.
     Tangent,
+    /// `TEXCOORD_0`.
     TexCoord0,
+    /// The index accessor.
     Indices,
 }
 
 impl Attribute {
+    /// The glTF name of the attribute.
     pub fn name(self) -> &'static str {
         match self {
             Attribute::Position => "POSITION",
@@ -370,6 +376,7 @@ pub fn check_view(
 pub enum CameraKind {
     /// A perspective camera and its yfov.
     Perspective(f32),
+    /// An orthographic camera.
     Orthographic,
 }
 

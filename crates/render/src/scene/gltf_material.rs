@@ -30,8 +30,11 @@ use std::sync::Arc;
 /// `extras.facet` of one material, validated; `fit` already resolved against the glTF folder.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FacetExtras {
+    /// The fit JSON.
     pub fit: Option<PathBuf>,
+    /// Which model of the fit to render.
     pub model: FacetModel,
+    /// Glint parameters, for a glint material.
     pub glint: Option<GlintParams>,
 }
 

@@ -9,9 +9,13 @@ use glam::{Vec2, Vec3, Vec4};
 /// A primitive's attributes in world space, as read from the file.
 #[derive(Clone, Debug, Default)]
 pub struct RawPrimitive {
+    /// Positions.
     pub positions: Vec<Vec3>,
+    /// Normals, if the file has them.
     pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates, if the file has them.
     pub uvs: Option<Vec<Vec2>>,
+    /// Tangents, if the file has them.
     pub tangents: Option<Vec<Vec4>>,
     /// Indices already checked to be `< positions.len()`.
     pub indices: Vec<[u32; 3]>,
@@ -20,10 +24,15 @@ pub struct RawPrimitive {
 /// A primitive with every attribute present, finite and unit where it should be.
 #[derive(Clone, Debug, Default)]
 pub struct CleanPrimitive {
+    /// Positions.
     pub positions: Vec<Vec3>,
+    /// Unit normals.
     pub normals: Vec<Vec3>,
+    /// Texture coordinates.
     pub uvs: Vec<Vec2>,
+    /// Tangents, xyz unit and w = ±1.
     pub tangents: Vec<Vec4>,
+    /// Triangles as vertex indices.
     pub indices: Vec<[u32; 3]>,
     /// Triangles dropped for zero area or a non-finite corner.
     pub dropped: usize,

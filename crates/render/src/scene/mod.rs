@@ -37,9 +37,13 @@ pub struct Scene {
     pub indices: Vec<[u32; 3]>,
     /// Index into `materials` per triangle.
     pub triangle_material: Vec<u32>,
+    /// The materials that `triangle_material` indexes.
     pub materials: Vec<Material>,
+    /// The textures that materials index.
     pub textures: Vec<Texture>,
+    /// Punctual lights.
     pub lights: Vec<Light>,
+    /// The camera.
     pub camera: Camera,
     /// Messages about things skipped or defaulted (a missing texture, a dropped triangle).
     pub warnings: Vec<String>,
@@ -51,6 +55,7 @@ pub struct Scene {
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Eye position, world space.
     pub position: Vec3,
     /// Unit view direction.
     pub forward: Vec3,
@@ -75,21 +80,28 @@ impl Default for Camera {
 /// A glTF metallic-roughness material, optionally replaced by a Facet material.
 #[derive(Clone, Debug)]
 pub struct Material {
+    /// The material's name.
     pub name: String,
     /// Linear RGBA base colour factor.
     pub base_color: Vec4,
+    /// Texture index of the base colour.
     pub base_color_texture: Option<u32>,
+    /// Metalness factor in [0, 1].
     pub metallic: f32,
+    /// Perceptual roughness factor in [0, 1].
     pub roughness: f32,
     /// Weight of the dielectric specular layer (KHR_materials_specular `specularFactor`, 1 when
     /// absent); 0 with metallic 0 makes a pure Lambertian surface. Its texture is not read.
     pub specular: f32,
     /// glTF layout: roughness in G, metallic in B.
     pub metallic_roughness_texture: Option<u32>,
+    /// Texture index of the tangent-space normal map.
     pub normal_texture: Option<u32>,
+    /// Scale of the normal map's xy.
     pub normal_scale: f32,
     /// Linear emitted radiance factor (emissiveFactor × KHR_materials_emissive_strength).
     pub emissive: Vec3,
+    /// Texture index of the emission.
     pub emissive_texture: Option<u32>,
     /// A fitted material from `extras.facet` or `--material NAME=FILE`.
     pub facet: Option<FacetMaterial>,
@@ -117,8 +129,11 @@ impl Default for Material {
 /// Which model of a fit a Facet material renders with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FacetModel {
+    /// The extracted tables.
     Tabulated,
+    /// The GGX fit.
     Ggx,
+    /// The Beckmann fit.
     Beckmann,
 }
 
@@ -127,8 +142,11 @@ pub enum FacetModel {
 pub struct FacetMaterial {
     /// The fit JSON it was loaded from.
     pub source: PathBuf,
+    /// The fit.
     pub fit: Arc<facet_fit::material::FittedMaterial>,
+    /// Which of its models to render.
     pub model: FacetModel,
+    /// Glint parameters: render the model's NDF as discrete flakes.
     pub glint: Option<GlintParams>,
 }
 
@@ -146,10 +164,15 @@ pub struct GlintParams {
 /// An RGBA8 texture; `srgb` says whether RGB is sRGB-encoded (base colour, emissive).
 #[derive(Clone, Debug)]
 pub struct Texture {
+    /// The texture's name (for messages).
     pub name: String,
+    /// Texels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
+    /// Texels, row-major.
     pub texels: Vec<[u8; 4]>,
+    /// Whether RGB is sRGB-encoded.
     pub srgb: bool,
 }
 
@@ -157,20 +180,31 @@ pub struct Texture {
 /// (W/sr-like radiometric units as glTF defines: candela for point/spot, lux for directional).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Light {
+    /// A point light.
     Point {
+        /// Position, world space.
         position: Vec3,
+        /// Radiant intensity per channel.
         intensity: Vec3,
     },
+    /// A spot light.
     Spot {
+        /// Position, world space.
         position: Vec3,
+        /// Unit direction the light points to.
         direction: Vec3,
+        /// Radiant intensity per channel.
         intensity: Vec3,
+        /// Angle from the axis where the falloff starts, radians.
         inner_cone: f32,
+        /// Angle from the axis where the light ends, radians.
         outer_cone: f32,
     },
     /// `direction` is where the light travels (glTF: the node's −Z).
     Directional {
+        /// Unit direction the light travels.
         direction: Vec3,
+        /// Irradiance per channel on a surface facing the light.
         irradiance: Vec3,
     },
 }
