@@ -5,7 +5,7 @@
 //! [0, π/2], and when the table is anisotropic φv on [`N_PHI_V`] nodes — each slice a piecewise-
 //! constant density over cells: rows uniform in u = √(θh / (π/2)), columns uniform in φh
 //! (relative to φv when isotropic, absolute otherwise). A cell's mass is the projected-area
-//! integral ∫ max(0, v·h) D₀(h) dω (midpoint rule, [`QUAD`]² points). A query between nodes picks
+//! integral ∫ max(0, v·h) D₀(h) dω (midpoint rule, 3 × 3 points). A query between nodes picks
 //! a neighbouring slice with its interpolation weight, so the density of a sample is the same
 //! mixture of the slices' cell densities: exact, whatever the slices' resolution.
 //!
