@@ -280,8 +280,8 @@ mod tests {
                     &format!("tabulated {what} θo {theta_deg}°"),
                     |u| ndf.sample_visible(wo, u),
                     |h| ndf.pdf_visible(wo, h),
-                    24,
-                    3e-3,
+                    48,
+                    1e-3,
                 );
             }
         }
