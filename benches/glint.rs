@@ -82,6 +82,7 @@ fn queries(c: &mut Criterion) {
                 gamma,
                 threshold: 16.0,
                 filtered,
+                blend: true,
             };
             let label = if filtered { "filtered" } else { "unfiltered" };
             g.bench_function(format!("{label}/r{r}"), |b| {
@@ -118,6 +119,7 @@ fn queries(c: &mut Criterion) {
                 gamma,
                 threshold: 16.0,
                 filtered,
+                blend: true,
             };
             let _ = evaluator
                 .eval(

@@ -193,10 +193,10 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
             table_nu, table_nphi, pad0,
         }),
         layout_check!(GlintField, "glint/glint_count.wgsl", "Field", {
-            density, seed, root_count, filtered, threshold, pad => [pad0, pad1, pad2],
+            density, seed, root_count, filtered, threshold, blend, pad => [pad1, pad2],
         }),
         layout_check!(GlintQuery, "glint/glint_count.wgsl", "Query", {
-            center, a, b, p, cell => [cell_x, cell_y], pad => [pad0, pad1, pad2],
+            center, a, b, p, coords0, coords1,
         }),
         layout_check!(GlintEvalParams, "glint/glint_eval.wgsl", "EvalParams", {
             gamma, sigma, sigma0, sigma1, level_t, n_theta, n_dphi, ndf_kind, alpha_x,
@@ -316,4 +316,28 @@ fn every_repr_c_struct_is_checked() {
         missing.is_empty(),
         "#[repr(C)] structs without a field-by-field layout check in shared_struct_checks: {missing:?}"
     );
+}
+
+/// The glint walk's stack holds what the quadtree needs and no more: 3 · MAX_DEPTH + 1 nodes
+/// (facet_glint::lit::STACK_DEPTH), written as a WGSL `const` because a private array's size
+/// cannot be an override.
+#[test]
+fn glint_stack_is_sized_to_the_tree() {
+    let src = facet_gpu::shader::raw_source("glint/lit.inc.wgsl").expect("lit.inc.wgsl");
+    let line = src
+        .lines()
+        .find(|l| l.trim_start().starts_with("const STACK: u32 ="))
+        .expect("a `const STACK: u32 = …u;` line");
+    let value: u32 = line
+        .split('=')
+        .nth(1)
+        .and_then(|v| {
+            v.trim()
+                .trim_end_matches(';')
+                .trim_end_matches('u')
+                .parse()
+                .ok()
+        })
+        .expect("an integer");
+    assert_eq!(value, facet_glint::lit::STACK_DEPTH);
 }

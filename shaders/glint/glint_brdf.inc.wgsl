@@ -4,7 +4,8 @@
 // threshold when filtering), the correlated G2:
 //   f / F = G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo).
 // Needs from the includer: `field: Field`, `params: EvalParams`, `level0`, `level1`
-// (texture_3d<f32>), glint/tea.inc.wgsl, common/microfacet.inc.wgsl and glint/flakes.inc.wgsl.
+// (texture_3d<f32>), glint/tea.inc.wgsl, common/microfacet.inc.wgsl, glint/flakes.inc.wgsl and
+// glint/lit.inc.wgsl.
 
 // Rust: facet_glint::gpu::GlintEvalParams.
 struct EvalParams {
@@ -53,14 +54,34 @@ fn azimuth(w: vec3<f32>) -> f32 {
     return atan2(w.y, w.x);
 }
 
-// The direction cell: facet_glint::flakes::direction_cell.
-fn direction_cell(wi: vec3<f32>, wo: vec3<f32>) -> vec2<u32> {
+// atan(x) for 0 ≤ x ≤ 1 to f32 accuracy: two half-angle steps, tan(θ/2) = x / (1 + √(1 + x²)),
+// bring x below tan(π/16) ≈ 0.2, where the series to x⁹ errs by < 1e-8 (the driver's atan2 may
+// err by 1e-4, which moves the blend of direction cells visibly against the CPU).
+fn atan_unit(x: f32) -> f32 {
+    let x1 = x / (1.0 + sqrt(1.0 + x * x));
+    let x2 = x1 / (1.0 + sqrt(1.0 + x1 * x1));
+    let t = x2 * x2;
+    return 4.0 * x2 * (1.0 - t * (1.0 / 3.0 - t * (0.2 - t * (1.0 / 7.0 - t / 9.0))));
+}
+
+// The polar angle of h (h.z ≥ 0) from (r = |h.xy|, h.z).
+fn polar_precise(r: f32, z: f32) -> f32 {
+    if (z <= 0.0) {
+        return atan2(r, z);
+    }
+    if (r <= z) {
+        return atan_unit(r / z);
+    }
+    return 0.5 * PI_F - atan_unit(z / r);
+}
+
+// The half vector in cells: facet_glint::flakes::direction_coords.
+fn direction_coords(wi: vec3<f32>, wo: vec3<f32>) -> vec2<f32> {
     let h = normalize(wi + wo);
     let r = length(h.xy);
-    let theta = acos(clamp(h.z, -1.0, 1.0));
+    let theta = polar_precise(r, h.z);
     let k = select(1.0, theta / r, r > 1e-12);
-    let side = params.gamma / sqrt(2.0);
-    return vec2<u32>(u32(i32(floor(h.x * k / side)) + (1 << 24u)), u32(i32(floor(h.y * k / side)) + (1 << 24u)));
+    return h.xy * (k / (params.gamma / sqrt(2.0)));
 }
 
 // P(ωi, ωo, γ) from the two levels: P/σ interpolated between them, times σ(γ).
@@ -77,27 +98,39 @@ fn glint_dpf(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return (d0 * (1.0 - params.level_t) + select(0.0, d1 * params.level_t, params.level_t > 0.0)) * params.sigma;
 }
 
-// f / F for the footprint ellipse (center, a, b) in UV; 0 below either horizon.
+// f / F of two light directions wi.x, wi.y (one shading point's light sample and BSDF sample)
+// for one view wo over the footprint ellipse (center, a, b) in UV, the flakes walked once; 0
+// below either horizon.
+fn glint_factor_pair(wi0: vec3<f32>, wi1: vec3<f32>, wo: vec3<f32>, center: vec2<f32>, a: vec2<f32>, b: vec2<f32>) -> vec2<f32> {
+    if (wo.z <= 0.0) {
+        return vec2<f32>(0.0);
+    }
+    let ok = vec2<bool>(wi0.z > 0.0, wi1.z > 0.0);
+    let p = select(vec2<f32>(0.0), vec2<f32>(glint_dpf(wi0, wo), glint_dpf(wi1, wo)), ok);
+    let q = Query(center, a, b, p, direction_coords(wi0, wo), direction_coords(wi1, wo));
+    let count = count_pair(q);
+    let area = footprint_area(a, b);
+    return vec2<f32>(glint_scale(wi0, wo, count.x, area), glint_scale(wi1, wo, count.y, area));
+}
+
+// f / F for one light direction: glint_factor_pair with no second query.
 fn glint_factor(wi: vec3<f32>, wo: vec3<f32>, center: vec2<f32>, a: vec2<f32>, b: vec2<f32>) -> f32 {
-    if (wi.z <= 0.0 || wo.z <= 0.0) {
-        return 0.0;
-    }
-    let p = glint_dpf(wi, wo);
-    let q = Query(center, a, b, p, 0u, 0u, 0u, 0u, 0u);
-    let area = footprint_area(q);
-    let expected = field.density * area * p;
-    var count = 0.0;
-    if (field.filtered != 0u && expected > field.threshold) {
-        count = expected;
-    } else {
-        let cell = direction_cell(wi, wo);
-        count = f32(count_footprint(q, tea(cell.x, cell.y)));
-    }
-    if (count == 0.0) {
+    return glint_factor_pair(wi, vec3<f32>(0.0, 0.0, -1.0), wo, center, a, b).x;
+}
+
+// f / F = G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo).
+fn glint_scale(wi: vec3<f32>, wo: vec3<f32>, count: f32, area: f32) -> f32 {
+    if (count == 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
     let h = normalize(wi + wo);
-    // λ(φ) of the correlated G2, φ the azimuth between wi and wo.
+    let ndf = AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation);
+    let g2 = g2_glint(ndf_lambda(ndf, wi), ndf_lambda(ndf, wo), wi, wo);
+    return g2 * dot(h, wo) * count / (field.density * area * params.sigma * wi.z * h.z) / wo.z;
+}
+
+// Correlated Smith G2: 1 / (1 + max(Λi, Λo) + λ(φ) min(Λi, Λo)), λ = 4.41φ/(4.41φ + 1).
+fn g2_glint(lam_i: f32, lam_o: f32, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     let li = length(wi.xy);
     let lo = length(wo.xy);
     var phi = 0.0;
@@ -105,9 +138,5 @@ fn glint_factor(wi: vec3<f32>, wo: vec3<f32>, center: vec2<f32>, a: vec2<f32>, b
         phi = acos(clamp(dot(wi.xy, wo.xy) / (li * lo), -1.0, 1.0));
     }
     let corr = 4.41 * phi / (4.41 * phi + 1.0);
-    let ndf = AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation);
-    let lam_i = ndf_lambda(ndf, wi);
-    let lam_o = ndf_lambda(ndf, wo);
-    let g2 = 1.0 / (1.0 + max(lam_i, lam_o) + corr * min(lam_i, lam_o));
-    return g2 * dot(h, wo) * count / (field.density * area * params.sigma * wi.z * h.z) / wo.z;
+    return 1.0 / (1.0 + max(lam_i, lam_o) + corr * min(lam_i, lam_o));
 }

@@ -26,6 +26,7 @@ struct EvalQuery {
 @group(0) @binding(6) var<storage, read_write> out: array<vec4<f32>>;
 
 #include "glint/flakes.inc.wgsl"
+#include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
 
 @compute @workgroup_size(WG)

@@ -1,16 +1,12 @@
 // Include-only. The body every shading stage shares: next-event estimation toward one light
 // (MIS with BSDF sampling, power heuristic, unless frame.strategy picks one technique), a BSDF
 // sample for the continuation, the ray cone's new spread. The includer defines `Bsdf` and
-//   bsdf_setup(s, slot) -> Bsdf, bsdf_eval(b, wi, wo) -> f (no cosine),
-//   bsdf_pdf(b, wi, wo) -> solid-angle pdf, bsdf_sample(b, wo, u) -> BsdfSample,
+//   bsdf_setup(s, slot) -> Bsdf,
+//   bsdf_eval2(b, wi_light, wi_bsdf, wo) -> f of both directions (no cosine; a direction with
+//     z ≤ 0 is not needed), so a class whose evaluation walks a structure (glints) walks once,
+//   bsdf_pdf(b, wi, wo) -> solid-angle pdf, bsdf_sample_wi(b, wo, u) -> a sampled direction,
 //   bsdf_roughness(b) -> α of the lobe (for the cone),
 // all in the local shading frame (z the normal).
-
-struct BsdfSample {
-    wi: vec3<f32>,
-    f: vec3<f32>,
-    pdf: f32,
-}
 
 // Random numbers of a bounce: 0..2 light choice and point, 3..5 BSDF sample, 7 roulette.
 fn shade(slot: u32) {
@@ -31,34 +27,38 @@ fn shade(slot: u32) {
     let b = bsdf_setup(s, slot);
     let wo = to_local(s, wo_world);
 
-    // Next-event estimation.
+    // Next-event estimation's direction and the continuation's, then both evaluated at once.
     let ls = sample_light(s.p, path_rand(slot, 0u), vec2<f32>(path_rand(slot, 1u), path_rand(slot, 2u)));
     let nee = frame.strategy != STRATEGY_BSDF || ls.pdf <= 0.0;
+    var wi_light = vec3<f32>(0.0, 0.0, -1.0);
     if (nee && any(ls.weight > vec3<f32>(0.0)) && dot(ls.wi, s.ng) > 0.0) {
-        let wi = to_local(s, ls.wi);
-        if (wi.z > 0.0) {
-            let f = bsdf_eval(b, wi, wo);
-            let w = light_sample_weight(ls.pdf, bsdf_pdf(b, wi, wo));
-            let c = beta.xyz * f * wi.z * ls.weight * w;
-            if (any(c > vec3<f32>(0.0))) {
-                let origin = offset_origin(s, ls.wi);
-                let tmax = max(ls.dist - length(origin - s.p) - 2.0 * frame.ray_epsilon * (1.0 + ls.dist), 0.0);
-                path_set(R_SHADOW_O, slot, vec4<f32>(origin, tmax));
-                path_set(R_SHADOW_D, slot, vec4<f32>(ls.wi, 0.0));
-                path_set(R_SHADOW_C, slot, vec4<f32>(c, 0.0));
-                push(Q_SHADOW, slot);
-            }
+        wi_light = to_local(s, ls.wi);
+    }
+    let wi_bsdf = bsdf_sample_wi(b, wo, vec3<f32>(path_rand(slot, 3u), path_rand(slot, 4u), path_rand(slot, 5u)));
+    let f = bsdf_eval2(b, wi_light, wi_bsdf, wo);
+
+    if (wi_light.z > 0.0) {
+        let wi = wi_light;
+        let w = light_sample_weight(ls.pdf, bsdf_pdf(b, wi, wo));
+        let c = beta.xyz * f[0] * wi.z * ls.weight * w;
+        if (any(c > vec3<f32>(0.0))) {
+            let origin = offset_origin(s, ls.wi);
+            let tmax = max(ls.dist - length(origin - s.p) - 2.0 * frame.ray_epsilon * (1.0 + ls.dist), 0.0);
+            path_set(R_SHADOW_O, slot, vec4<f32>(origin, tmax));
+            path_set(R_SHADOW_D, slot, vec4<f32>(ls.wi, 0.0));
+            path_set(R_SHADOW_C, slot, vec4<f32>(c, 0.0));
+            push(Q_SHADOW, slot);
         }
     }
 
     // Continuation by BSDF sampling.
-    let bs = bsdf_sample(b, wo, vec3<f32>(path_rand(slot, 3u), path_rand(slot, 4u), path_rand(slot, 5u)));
-    let wi_world = to_world(s, bs.wi);
-    if (bs.pdf <= 0.0 || bs.wi.z <= 0.0 || dot(wi_world, s.ng) <= 0.0) {
+    let wi_world = to_world(s, wi_bsdf);
+    let pdf = bsdf_pdf(b, wi_bsdf, wo);
+    if (pdf <= 0.0 || wi_bsdf.z <= 0.0 || dot(wi_world, s.ng) <= 0.0) {
         info[slot].x = SLOT_ENDED;
         return;
     }
-    beta = vec4<f32>(beta.xyz * bs.f * bs.wi.z / bs.pdf, bs.pdf);
+    beta = vec4<f32>(beta.xyz * f[1] * wi_bsdf.z / pdf, pdf);
     if (!all(beta.xyz == beta.xyz) || all(beta.xyz <= vec3<f32>(0.0))) {
         info[slot].x = SLOT_ENDED;
         return;

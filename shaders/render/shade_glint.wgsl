@@ -1,6 +1,7 @@
 // Shading stage of one glint material (Wang et al. 2018 over Jakob et al. 2014), dispatched once
 // per glint material with its own DPF pyramid levels:
 //   f = F(θd) G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo)   (glint/glint_brdf.inc.wgsl),
+// the light sample's and the BSDF sample's counts from one walk over the flakes,
 // the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
 // N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals.
 
@@ -19,6 +20,7 @@ override Q_SHADE: u32;
 @group(2) @binding(3) var level1: texture_3d<f32>;
 
 #include "glint/flakes.inc.wgsl"
+#include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
 
 struct Bsdf {
@@ -81,13 +83,18 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     return b;
 }
 
-fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
-    let k = glint_factor(wi, wo, b.center, b.a, b.b);
-    if (k == 0.0) {
-        return vec3<f32>(0.0);
+// Both directions from one walk over the footprint's flakes.
+fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
+    let k = glint_factor_pair(wi_light, wi_bsdf, wo, b.center, b.a, b.b);
+    let m = materials[b.material];
+    var f: array<vec3<f32>, 2>;
+    if (k.x > 0.0) {
+        f[0] = fresnel_table(m, dot(wi_light, normalize(wi_light + wo))) * k.x;
     }
-    let h = normalize(wi + wo);
-    return fresnel_table(materials[b.material], dot(wi, h)) * k;
+    if (k.y > 0.0) {
+        f[1] = fresnel_table(m, dot(wi_bsdf, normalize(wi_bsdf + wo))) * k.y;
+    }
+    return f;
 }
 
 fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
@@ -98,10 +105,9 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
 }
 
-fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
+fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
     let h = lobe_sample_h(b.ndf, wo, u.xy);
-    let wi = 2.0 * dot(wo, h) * h - wo;
-    return BsdfSample(wi, bsdf_eval(b, wi, wo), bsdf_pdf(b, wi, wo));
+    return 2.0 * dot(wo, h) * h - wo;
 }
 
 fn bsdf_roughness(b: Bsdf) -> f32 {

@@ -94,7 +94,11 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
 }
 
-fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
+fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
+    return array<vec3<f32>, 2>(bsdf_eval(b, wi_light, wo), bsdf_eval(b, wi_bsdf, wo));
+}
+
+fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
     var wi: vec3<f32>;
     if (u.z < b.p_spec) {
         let h = mf_sample_h(b, wo, u.xy);
@@ -102,7 +106,7 @@ fn bsdf_sample(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> BsdfSample {
     } else {
         wi = sample_cosine(u.xy);
     }
-    return BsdfSample(wi, bsdf_eval(b, wi, wo), bsdf_pdf(b, wi, wo));
+    return wi;
 }
 
 fn bsdf_roughness(b: Bsdf) -> f32 {

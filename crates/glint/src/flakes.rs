@@ -5,9 +5,9 @@
 //! quadtree holds Poisson(density) flakes, and every node splits its count among its four
 //! children by binomial draws keyed on the node itself, so any node's count is one
 //! deterministic number and nested footprints give nested counts. Leaves (≤ [`LEAF_FLAKES`]
-//! flakes) place their flakes uniformly, from TEA keyed on (leaf, k). Each flake's uniform λ is
-//! keyed on the flake and on the direction cell of the query (the half vector quantised to
-//! cells of size γ), never on the traversal: the flake is lit when λ < P(ωi, ωo, γ).
+//! flakes) place their flakes uniformly, from TEA keyed on (leaf, k). Which flakes are lit for
+//! a query (each with probability P(ωi, ωo, γ), keyed on the direction cell of the query — the
+//! half vector quantised to cells of size γ — never on the traversal) is [`crate::lit`]'s.
 
 use crate::tea::{tea, tea_unit};
 use glam::{DMat2, DVec2, DVec3};
@@ -57,12 +57,35 @@ impl Footprint {
         }
     }
 
-    fn half_extent(&self) -> DVec2 {
+    pub(crate) fn half_extent(&self) -> DVec2 {
         DVec2::new(self.a.x.hypot(self.b.x), self.a.y.hypot(self.b.y))
     }
 
+    /// The copies of the ellipse, shifted by whole periods of the UV torus, that reach into
+    /// [0, 1)².
+    pub(crate) fn copies(&self) -> Vec<Footprint> {
+        let ext = self.half_extent();
+        let lo = (self.center - ext).floor();
+        let hi = (self.center + ext).floor();
+        let mut out = Vec::new();
+        for sx in lo.x as i64..=hi.x as i64 {
+            for sy in lo.y as i64..=hi.y as i64 {
+                out.push(Footprint {
+                    center: self.center - DVec2::new(sx as f64, sy as f64),
+                    ..*self
+                });
+            }
+        }
+        out
+    }
+
+    /// Whether `uv` lies in the ellipse; `inv` is [`Footprint::inverse`].
+    pub(crate) fn contains(&self, inv: &DMat2, uv: DVec2) -> bool {
+        (*inv * (uv - self.center)).length_squared() <= 1.0
+    }
+
     /// The inverse of [a b], mapping offsets to (s, t).
-    fn inverse(&self) -> DMat2 {
+    pub(crate) fn inverse(&self) -> DMat2 {
         DMat2::from_cols(self.a, self.b).inverse()
     }
 }
@@ -74,13 +97,18 @@ use std::f64::consts::PI;
 /// squares of side γ/√2. Moving the light by more than 2γ moves the half vector by about γ or
 /// more, which always changes the cell; a move below γ/4 changes it about one time in four.
 pub fn direction_cell(wi: DVec3, wo: DVec3, gamma: f64) -> (u32, u32) {
+    let c = direction_coords(wi, wo, gamma).floor();
+    let q = |x: f64| (x as i64 + (1 << 24)) as u32;
+    (q(c.x), q(c.y))
+}
+
+/// The half vector's position in cells: (θh cos φh, θh sin φh) / (γ/√2); the cell is its floor.
+pub fn direction_coords(wi: DVec3, wo: DVec3, gamma: f64) -> DVec2 {
     let h = (wi + wo).normalize();
     let r = h.x.hypot(h.y);
     let theta = h.z.clamp(-1.0, 1.0).acos();
     let k = if r > 1e-12 { theta / r } else { 1.0 };
-    let side = gamma / std::f64::consts::SQRT_2;
-    let q = |x: f64| ((x * k / side).floor() as i64 + (1 << 24)) as u32;
-    (q(h.x), q(h.y))
+    DVec2::new(h.x, h.y) * (k / (gamma / std::f64::consts::SQRT_2))
 }
 
 /// A flake found by a query.
@@ -93,7 +121,7 @@ pub struct Flake {
 }
 
 impl FlakeField {
-    fn node_hash(&self, level: u32, ix: u32, iy: u32) -> u64 {
+    pub(crate) fn node_hash(&self, level: u32, ix: u32, iy: u32) -> u64 {
         tea(ix | (level << 21), iy ^ self.seed.wrapping_mul(0x9e37_79b9))
     }
 
@@ -103,7 +131,7 @@ impl FlakeField {
     }
 
     /// Counts of the four children (x-major: (0,0), (1,0), (0,1), (1,1)) of a node with n flakes.
-    fn split(&self, level: u32, ix: u32, iy: u32, n: u64) -> [u64; 4] {
+    pub(crate) fn split(&self, level: u32, ix: u32, iy: u32, n: u64) -> [u64; 4] {
         let h = self.node_hash(level, ix, iy);
         let u = |k: u32| tea_unit(h as u32, k ^ (h >> 32) as u32) as f64;
         let left = binomial(n, u(0));
@@ -115,28 +143,19 @@ impl FlakeField {
     pub fn flakes_in(&self, fp: &Footprint) -> Vec<Flake> {
         let mut out = Vec::new();
         let ext = fp.half_extent();
-        // The ellipse's copies that reach into [0, 1)².
-        let lo = (fp.center - ext).floor();
-        let hi = (fp.center + ext).floor();
-        for sx in lo.x as i64..=hi.x as i64 {
-            for sy in lo.y as i64..=hi.y as i64 {
-                let shifted = Footprint {
-                    center: fp.center - DVec2::new(sx as f64, sy as f64),
-                    ..*fp
-                };
-                self.visit(
-                    &shifted,
-                    &shifted.inverse(),
-                    ext,
-                    0,
-                    0,
-                    0,
-                    self.root_count(),
-                    &mut out,
-                );
-            }
+        for shifted in fp.copies() {
+            let inv = shifted.inverse();
+            self.visit(&shifted, &inv, ext, 0, 0, 0, self.root_count(), &mut out);
         }
         out
+    }
+
+    /// Flake `k` of the leaf (level, ix, iy) whose cell starts at `min` with side `size`.
+    pub(crate) fn leaf_flake(&self, h: u64, k: u32, min: DVec2, size: f64) -> Flake {
+        let id = tea(h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32 ^ k);
+        let uv =
+            min + size * DVec2::new(tea_unit(id as u32, 1) as f64, tea_unit(id as u32, 2) as f64);
+        Flake { id, uv }
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -167,13 +186,9 @@ impl FlakeField {
         if n <= LEAF_FLAKES || level == MAX_DEPTH {
             let h = self.node_hash(level, ix, iy);
             for k in 0..n as u32 {
-                let id = tea(h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32 ^ k);
-                let uv = min
-                    + size
-                        * DVec2::new(tea_unit(id as u32, 1) as f64, tea_unit(id as u32, 2) as f64);
-                let st = *inv * (uv - fp.center);
-                if st.length_squared() <= 1.0 {
-                    out.push(Flake { id, uv });
+                let flake = self.leaf_flake(h, k, min, size);
+                if fp.contains(inv, flake.uv) {
+                    out.push(flake);
                 }
             }
             return;
@@ -184,15 +199,6 @@ impl FlakeField {
             self.visit(fp, inv, ext, level + 1, 2 * ix + dx, 2 * iy + dy, m, out);
         }
     }
-}
-
-/// λ of a flake for a direction cell: uniform in [0, 1), hashed from the pair.
-pub fn flake_lambda(flake: &Flake, cell: (u32, u32)) -> f64 {
-    let c = tea(cell.0, cell.1);
-    tea_unit(
-        flake.id as u32 ^ c as u32,
-        (flake.id >> 32) as u32 ^ (c >> 32) as u32,
-    ) as f64
 }
 
 /// Inverse CDF of Poisson(mean) at u; a normal approximation above mean 500.

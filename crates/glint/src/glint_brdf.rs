@@ -6,10 +6,11 @@
 //! with 1/cos θh does the limit become the smooth microfacet BRDF F G2 D / (4 cos θi cos θo).
 
 use crate::dpf::cone_solid_angle;
-use crate::flakes::{FlakeField, Footprint, direction_cell, flake_lambda};
+use crate::flakes::{FlakeField, Footprint, direction_coords};
+use crate::lit::{LitKey, blend_cells};
 use facet_fit::brdf::Rgb;
 use facet_fit::microfacet::{MicrofacetBrdf, correlation, g2};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 /// How glints are counted.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,20 +21,26 @@ pub struct GlintConfig {
     pub threshold: f64,
     /// Whether the mean may replace the count at all.
     pub filtered: bool,
+    /// Blend the counts of the four direction cells around the half vector (bilinear weights),
+    /// so that counts do not pop when the half vector crosses a cell edge; without it, the
+    /// count of the one cell it is in.
+    pub blend: bool,
 }
 
 impl GlintConfig {
-    /// γ = 1°, threshold 16, filter on.
+    /// γ = 1°, threshold 16, filter on, cells blended.
     pub const fn standard() -> Self {
         GlintConfig {
             gamma: std::f64::consts::PI / 180.0,
             threshold: 16.0,
             filtered: true,
+            blend: true,
         }
     }
 }
 
-/// Lit flakes in the footprint for (ωi, ωo), or N a P when the filter takes over.
+/// Lit flakes in the footprint for (ωi, ωo) (blended over cells with `cfg.blend`), or N a P when
+/// the filter takes over.
 /// `p` is P(ωi, ωo, γ) from the DPF.
 pub fn glint_count(
     field: &FlakeField,
@@ -43,16 +50,32 @@ pub fn glint_count(
     p: f64,
     cfg: &GlintConfig,
 ) -> f64 {
+    glint_count_at(field, fp, direction_coords(wi, wo, cfg.gamma), p, cfg)
+}
+
+/// [`glint_count`] for a half vector at direction coordinates `coords`
+/// ([`crate::flakes::direction_coords`]).
+pub fn glint_count_at(
+    field: &FlakeField,
+    fp: &Footprint,
+    coords: DVec2,
+    p: f64,
+    cfg: &GlintConfig,
+) -> f64 {
     let expected = field.density * fp.area() * p;
     if cfg.filtered && expected > cfg.threshold {
         return expected;
     }
-    let cell = direction_cell(wi, wo, cfg.gamma);
-    field
-        .flakes_in(fp)
+    if !cfg.blend {
+        let c = coords.floor();
+        let q = |x: f64| (x as i64 + (1 << 24)) as u32;
+        return field.lit_count(fp, p, LitKey::of_cell((q(c.x), q(c.y)))) as f64;
+    }
+    blend_cells(coords)
         .iter()
-        .filter(|f| flake_lambda(f, cell) < p)
-        .count() as f64
+        .filter(|(_, w)| *w > 0.0)
+        .map(|&(cell, w)| w * field.lit_count(fp, p, LitKey::of_cell(cell)) as f64)
+        .sum()
 }
 
 /// f(ωi, ωo) of the glint model; `model` gives F and G2 (its NDF is the one the DPF was built

@@ -193,10 +193,12 @@ pub struct GlintField {
     pub root_count: u32,
     pub filtered: u32,
     pub threshold: f32,
-    pub pad: [u32; 3],
+    pub blend: u32,
+    pub pad: [u32; 2],
 }
 
-/// One glint query (WGSL `Query`): the footprint, P, and the direction cell.
+/// Two glint queries sharing a footprint (WGSL `Query`): the footprint, the P of each (0: no
+/// query) and their half vectors' direction coordinates ([`crate::flakes::direction_coords`]).
 #[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -204,33 +206,42 @@ pub struct GlintQuery {
     pub center: [f32; 2],
     pub a: [f32; 2],
     pub b: [f32; 2],
-    pub p: f32,
-    pub cell: [u32; 2],
-    pub pad: [u32; 3],
+    pub p: [f32; 2],
+    pub coords0: [f32; 2],
+    pub coords1: [f32; 2],
 }
 
 impl GlintQuery {
-    /// The query for footprint `fp` with DPF value `p` and direction cell `cell`.
-    pub fn new(fp: &crate::flakes::Footprint, p: f64, cell: (u32, u32)) -> Self {
+    /// The pair of queries over footprint `fp` with DPF values `p` at direction coordinates
+    /// `coords`.
+    pub fn pair(fp: &crate::flakes::Footprint, p: [f64; 2], coords: [glam::DVec2; 2]) -> Self {
         GlintQuery {
             center: fp.center.as_vec2().to_array(),
             a: fp.a.as_vec2().to_array(),
             b: fp.b.as_vec2().to_array(),
-            p: p as f32,
-            cell: [cell.0, cell.1],
-            pad: [0; 3],
+            p: p.map(|x| x as f32),
+            coords0: coords[0].as_vec2().to_array(),
+            coords1: coords[1].as_vec2().to_array(),
         }
+    }
+
+    /// One query (the second one empty).
+    pub fn new(fp: &crate::flakes::Footprint, p: f64, coords: glam::DVec2) -> Self {
+        Self::pair(fp, [p, 0.0], [coords, coords])
     }
 }
 
 /// The override constants of the flake shaders (TEA and the quadtree), from Rust.
 pub fn flake_constants() -> Vec<(&'static str, f64)> {
     use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
+    use crate::lit::{LIT_EXACT_MEAN, SPLIT_EXACT_MAX};
     let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
     constants.extend([
         ("LEAF_FLAKES", LEAF_FLAKES as f64),
         ("MAX_DEPTH", MAX_DEPTH as f64),
         ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
+        ("LIT_EXACT_MEAN", LIT_EXACT_MEAN),
+        ("SPLIT_EXACT_MAX", SPLIT_EXACT_MAX as f64),
     ]);
     constants
 }
@@ -244,7 +255,8 @@ impl GlintField {
             root_count: field.root_count() as u32,
             filtered: cfg.filtered as u32,
             threshold: cfg.threshold as f32,
-            pad: [0; 3],
+            blend: cfg.blend as u32,
+            pad: [0; 2],
         }
     }
 }
@@ -271,21 +283,21 @@ impl GlintCounter {
         })
     }
 
-    /// Counts (or filtered means) for each query.
+    /// Counts (or filtered means) of both queries of each pair.
     pub fn count(
         &self,
         gpu: &Gpu,
         field: &crate::flakes::FlakeField,
         cfg: &crate::glint_brdf::GlintConfig,
         queries: &[GlintQuery],
-    ) -> Result<Vec<f64>, GpuError> {
+    ) -> Result<Vec<[f64; 2]>, GpuError> {
         let d = &gpu.device;
         let uniform = GlintField::new(field, cfg);
         let (ub, qb, cb) = gpu.scoped(|| {
             (
                 buffer::uniform(d, "glint field", &uniform),
                 buffer::storage(d, "glint queries", queries),
-                buffer::storage_zeroed(d, "glint counts", (queries.len() * 4) as u64),
+                buffer::storage_zeroed(d, "glint counts", (queries.len() * 8) as u64),
             )
         })?;
         let resources = [
@@ -302,8 +314,9 @@ impl GlintCounter {
             queries.len() as u32,
             self.workgroup_size,
         );
-        let out: Vec<f32> = buffer::read(d, &gpu.queue, &cb, queries.len())?;
-        Ok(out.into_iter().map(f64::from).collect())
+        let out: Vec<[f32; 2]> = buffer::read(d, &gpu.queue, &cb, queries.len())?;
+        gpu.check_lost()?;
+        Ok(out.into_iter().map(|c| c.map(f64::from)).collect())
     }
 }
 

@@ -3,7 +3,8 @@
 //! [`tea`]: the per-flake hash (Rust and WGSL). [`dpf`]: the Directional Probability Function
 //! by cone integration, its tables (documented cell centres) and the nine-level pyramid, with
 //! the paper's Gaussian-blurred levels for comparison. [`flakes`]: the procedural flake field,
-//! its consistent quadtree and counting over footprints. [`glint_brdf`]: the glint BRDF with its
+//! its consistent quadtree and counting over footprints. [`lit`]: lit counts per node, so a
+//! count costs O(footprint boundary), blended over the four nearest direction cells. [`glint_brdf`]: the glint BRDF with its
 //! filtered switch, sampling and pdf. [`gpu`]: the pyramid built on the GPU into 3D textures,
 //! glint counting, evaluation and sampling in WGSL.
 //!
@@ -23,4 +24,5 @@ pub mod dpf;
 pub mod flakes;
 pub mod glint_brdf;
 pub mod gpu;
+pub mod lit;
 pub mod tea;

@@ -26,6 +26,7 @@ pub fn build(
         gamma: (spec.gamma_deg as f64).to_radians(),
         threshold: spec.threshold as f64,
         filtered: config.glint_filter,
+        blend: true,
     };
     let ([k0, k1], w) = DpfPyramid::levels_for(cfg.gamma);
     let which: Vec<usize> = if w > 0.0 { vec![k0, k1] } else { vec![k0] };

@@ -1,0 +1,293 @@
+// Include-only. Lit counts per node (Rust twin: facet_glint::lit): the root's lit count from
+// Binomial(n, P) at a keyed uniform, split down the quadtree by keyed hypergeometric draws as
+// the positions split, leaves picking their lit flakes by selection sampling; a node inside the
+// footprint adds its lit count, only boundary nodes descend. One walk serves the two queries of
+// a shading point (light sample and BSDF sample), each blended over four direction cells: eight
+// chains of lit counts share the positions' splits.
+// Needs glint/tea.inc.wgsl and glint/flakes.inc.wgsl (with `field: Field`).
+
+// Set from Rust (facet_glint::lit), written once there.
+override LIT_EXACT_MEAN: f32;
+override SPLIT_EXACT_MAX: u32;
+
+// Chains of lit counts in one walk: 2 queries × 4 direction cells.
+const CHAINS: u32 = 8u;
+// The walk's stack: a node pops and pushes at most 4 children, so a walk to depth MAX_DEPTH
+// holds at most 3 · MAX_DEPTH + 1 nodes (facet_glint::lit::STACK_DEPTH, checked by a test).
+const STACK: u32 = 61u;
+
+// pcg3d (Jarzynski & Olano 2020): facet_glint::lit::pcg3d.
+fn pcg3d(x: vec3<u32>) -> vec3<u32> {
+    var v = x * 1664525u + 1013904223u;
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    v ^= v >> vec3<u32>(16u);
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    return v;
+}
+
+// 24 bits to [0, 1).
+fn unit24(x: u32) -> f32 {
+    return f32(x >> 8u) / 16777216.0;
+}
+
+// ln(1 − p), accurate for small p.
+fn ln_1m(p: f32) -> f32 {
+    if (p < 0.01) {
+        return -p * (1.0 + p * (0.5 + p / 3.0));
+    }
+    return log(1.0 - p);
+}
+
+// Inverse CDF of Binomial(n, p) at u, p ≤ ½ (facet_glint::lit::binomial_p).
+fn binomial_low(n: u32, p: f32, u: f32) -> u32 {
+    let mean = f32(n) * p;
+    if (mean > LIT_EXACT_MEAN) {
+        let x = mean + sqrt(mean * (1.0 - p)) * normal_quantile(u) + 0.5;
+        return min(u32(max(x, 0.0)), n);
+    }
+    var pmf = exp(f32(n) * ln_1m(p));
+    var cdf = pmf;
+    var k = 0u;
+    let ratio = p / (1.0 - p);
+    while (cdf <= u && k < n) {
+        pmf *= f32(n - k) / f32(k + 1u) * ratio;
+        k += 1u;
+        cdf += pmf;
+    }
+    return k;
+}
+
+fn binomial_p(n: u32, p: f32, u: f32) -> u32 {
+    if (n == 0u || p <= 0.0) {
+        return 0u;
+    }
+    if (p >= 1.0) {
+        return n;
+    }
+    if (p > 0.5) {
+        return n - binomial_low(n, 1.0 - p, 1.0 - u);
+    }
+    return binomial_low(n, p, u);
+}
+
+// Hypergeometric(n, m, l) at u for m, l ≤ n/2 (support from 0).
+fn hypergeometric_small(n: u32, m: u32, l: u32, u: f32) -> u32 {
+    if (l == 0u || m == 0u) {
+        return 0u;
+    }
+    let top = min(l, m);
+    if (l > SPLIT_EXACT_MAX) {
+        let q = f32(m) / f32(n);
+        let v = f32(l) * q * (1.0 - q) * f32(n - l) / f32(n - 1u);
+        let x = f32(l) * q + sqrt(v) * normal_quantile(u) + 0.5;
+        return min(u32(max(x, 0.0)), top);
+    }
+    var pmf = 1.0;
+    for (var j = 0u; j < l; j++) {
+        pmf *= f32(n - m - j) / f32(n - j);
+    }
+    var cdf = pmf;
+    var k = 0u;
+    while (cdf <= u && k < top) {
+        pmf *= (f32(m - k) * f32(l - k)) / (f32(k + 1u) * f32(n - m - l + k + 1u));
+        k += 1u;
+        cdf += pmf;
+    }
+    return k;
+}
+
+// Lit flakes among the m of n in one part when l of the n are lit (facet_glint::lit::hypergeometric).
+fn hypergeometric(n: u32, m: u32, l: u32, u: f32) -> u32 {
+    let flip_l = 2u * l > n;
+    let l1 = select(l, n - l, flip_l);
+    let flip_m = 2u * m > n;
+    let m1 = select(m, n - m, flip_m);
+    var k = hypergeometric_small(n, m1, l1, u);
+    k = select(k, l1 - k, flip_m);
+    return select(k, m - k, flip_l);
+}
+
+// A chain's lit counts of the four children (c: their flake counts), node hash h.
+fn split_lit(h: vec2<u32>, c: vec4<u32>, lit: u32, key: vec2<u32>) -> vec4<u32> {
+    if (lit == 0u) {
+        return vec4<u32>(0u);
+    }
+    let r = pcg3d(vec3<u32>(h.x ^ key.x, h.y ^ key.y, 0x2545f491u));
+    let left = c.x + c.z;
+    let n = left + c.y + c.w;
+    let lit_left = hypergeometric(n, left, lit, unit24(r.x));
+    let l00 = hypergeometric(left, c.x, lit_left, unit24(r.y));
+    let l10 = hypergeometric(n - left, c.y, lit - lit_left, unit24(r.z));
+    return vec4<u32>(l00, l10, lit_left - l00, lit - lit_left - l10);
+}
+
+// Algorithm S: a leaf's flake (id) is lit with probability needed / remaining.
+fn leaf_lit(id: vec2<u32>, needed: u32, remaining: u32, key: vec2<u32>) -> bool {
+    let r = pcg3d(vec3<u32>(id.x ^ key.x, id.y ^ key.y, 0x27d4eb2fu));
+    return unit24(r.x) * f32(remaining) < f32(needed);
+}
+
+struct LitNode {
+    level: u32,
+    ix: u32,
+    iy: u32,
+    n: u32,
+    lit: array<u32, CHAINS>,
+}
+
+var<private> lit_stack: array<LitNode, STACK>;
+
+// Whether any chain has lit flakes (chains past the live ones hold 0). Written out, not a
+// loop: llvmpipe caps the iterations of each shader invocation's loops at 65 535.
+fn any_lit(l: array<u32, CHAINS>) -> bool {
+    return (l[0] | l[1] | l[2] | l[3] | l[4] | l[5] | l[6] | l[7]) != 0u;
+}
+
+// Only the first nc chains are live (llvmpipe caps each loop's iterations per invocation, so
+// loops run over live chains only).
+fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<u32, CHAINS>, keys_in: array<vec2<u32>, CHAINS>, nc: u32) -> array<u32, CHAINS> {
+    var acc: array<u32, CHAINS>;
+    var root = root_in;
+    var keys = keys_in;
+    if (!any_lit(root)) {
+        return acc;
+    }
+    lit_stack[0] = LitNode(0u, 0u, 0u, field.root_count, root);
+    var top = 1u;
+    while (top > 0u) {
+        top -= 1u;
+        var nd = lit_stack[top];
+        let size = 1.0 / f32(1u << nd.level);
+        let lo = vec2<f32>(f32(nd.ix), f32(nd.iy)) * size;
+        let hi = lo + size;
+        if (hi.x < center.x - ext.x || lo.x > center.x + ext.x || hi.y < center.y - ext.y || lo.y > center.y + ext.y) {
+            continue;
+        }
+        let s00 = inv * (lo - center);
+        let s10 = inv * (vec2<f32>(hi.x, lo.y) - center);
+        let s01 = inv * (vec2<f32>(lo.x, hi.y) - center);
+        let s11 = inv * (hi - center);
+        if (max(max(dot(s00, s00), dot(s10, s10)), max(dot(s01, s01), dot(s11, s11))) <= 1.0) {
+            acc[0] += nd.lit[0];
+            acc[1] += nd.lit[1];
+            acc[2] += nd.lit[2];
+            acc[3] += nd.lit[3];
+            acc[4] += nd.lit[4];
+            acc[5] += nd.lit[5];
+            acc[6] += nd.lit[6];
+            acc[7] += nd.lit[7];
+            continue;
+        }
+        let h = node_hash(nd.level, nd.ix, nd.iy);
+        if (nd.n <= LEAF_FLAKES || nd.level == MAX_DEPTH) {
+            var needed = nd.lit;
+            for (var k = 0u; k < nd.n; k++) {
+                let id = leaf_flake_id(h, k);
+                let uv = lo + size * vec2<f32>(tea_unit(id.x, 1u), tea_unit(id.x, 2u));
+                let st = inv * (uv - center);
+                let inside = dot(st, st) <= 1.0;
+                for (var c = 0u; c < nc; c++) {
+                    if (needed[c] > 0u && leaf_lit(id, needed[c], nd.n - k, keys[c])) {
+                        needed[c] -= 1u;
+                        if (inside) {
+                            acc[c] += 1u;
+                        }
+                    }
+                }
+            }
+            continue;
+        }
+        let u0 = tea_unit(h.x, 0u ^ h.y);
+        let u1 = tea_unit(h.x, 1u ^ h.y);
+        let u2 = tea_unit(h.x, 2u ^ h.y);
+        let left = binomial(nd.n, u0);
+        let l0 = binomial(left, u1);
+        let r0 = binomial(nd.n - left, u2);
+        let cn = vec4<u32>(l0, r0, left - l0, nd.n - left - r0);
+        var child: array<array<u32, CHAINS>, 4>;
+        for (var c = 0u; c < nc; c++) {
+            let l = split_lit(h, cn, nd.lit[c], keys[c]);
+            child[0][c] = l.x;
+            child[1][c] = l.y;
+            child[2][c] = l.z;
+            child[3][c] = l.w;
+        }
+        for (var k = 0u; k < 4u; k++) {
+            if (cn[k] > 0u && any_lit(child[k]) && top < STACK) {
+                lit_stack[top] = LitNode(nd.level + 1u, 2u * nd.ix + (k & 1u), 2u * nd.iy + (k >> 1u), cn[k], child[k]);
+                top += 1u;
+            }
+        }
+    }
+    return acc;
+}
+
+// The four direction cells around coords and their bilinear weights (facet_glint::lit::blend_cells);
+// without blending, the one cell coords is in, weight 1.
+fn cell_keys(coords: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, weights: ptr<function, array<f32, CHAINS>>, first: u32) {
+    let base = floor(coords);
+    let f = coords - base;
+    let bx = i32(base.x) + (1 << 24u);
+    let by = i32(base.y) + (1 << 24u);
+    for (var k = 0u; k < 4u; k++) {
+        let dx = k & 1u;
+        let dy = k >> 1u;
+        (*keys)[first + k] = tea(u32(bx + i32(dx)), u32(by + i32(dy)));
+        let wx = select(1.0 - f.x, f.x, dx == 1u);
+        let wy = select(1.0 - f.y, f.y, dy == 1u);
+        (*weights)[first + k] = select(select(0.0, 1.0, k == 0u), wx * wy, field.blend != 0u);
+    }
+}
+
+// The counts of the two queries over the footprint (all its copies on the torus): blended lit
+// counts, or N a P where the filter takes over; a query with p = 0 counts 0.
+fn count_pair(q: Query) -> vec2<f32> {
+    let area = footprint_area(q.a, q.b);
+    let expected = field.density * area * q.p;
+    let filt = vec2<bool>(field.filtered != 0u) & (expected > vec2<f32>(field.threshold));
+    var cell_key: array<vec2<u32>, CHAINS>;
+    var cell_weight: array<f32, CHAINS>;
+    cell_keys(q.coords0, &cell_key, &cell_weight, 0u);
+    cell_keys(q.coords1, &cell_key, &cell_weight, 4u);
+    // The live chains, compacted: key, weight, query, root lit count.
+    var keys: array<vec2<u32>, CHAINS>;
+    var weights: array<f32, CHAINS>;
+    var query: array<u32, CHAINS>;
+    var root: array<u32, CHAINS>;
+    var nc = 0u;
+    for (var c = 0u; c < CHAINS; c++) {
+        let j = c / 4u;
+        if (cell_weight[c] > 0.0 && q.p[j] > 0.0 && !filt[j]) {
+            let r = pcg3d(vec3<u32>(cell_key[c].x, cell_key[c].y, 0xffffffffu));
+            keys[nc] = cell_key[c];
+            weights[nc] = cell_weight[c];
+            query[nc] = j;
+            root[nc] = binomial_p(field.root_count, q.p[j], unit24(r.x));
+            nc += 1u;
+        }
+    }
+    let m = mat2x2<f32>(q.a, q.b);
+    let det = m[0].x * m[1].y - m[1].x * m[0].y;
+    let inv = mat2x2<f32>(vec2<f32>(m[1].y, -m[0].y) / det, vec2<f32>(-m[1].x, m[0].x) / det);
+    let ext = vec2<f32>(length(vec2<f32>(q.a.x, q.b.x)), length(vec2<f32>(q.a.y, q.b.y)));
+    let lo = floor(q.center - ext);
+    let hi = floor(q.center + ext);
+    var total: array<u32, CHAINS>;
+    for (var sx = i32(lo.x); sx <= i32(hi.x); sx++) {
+        for (var sy = i32(lo.y); sy <= i32(hi.y); sy++) {
+            var acc = walk_lit(q.center - vec2<f32>(f32(sx), f32(sy)), inv, ext, root, keys, nc);
+            for (var c = 0u; c < nc; c++) {
+                total[c] += acc[c];
+            }
+        }
+    }
+    var out = select(vec2<f32>(0.0), expected, filt);
+    for (var c = 0u; c < nc; c++) {
+        out[query[c]] += weights[c] * f32(total[c]);
+    }
+    return out;
+}
