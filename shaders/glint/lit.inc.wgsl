@@ -86,18 +86,50 @@ fn hypergeometric_small(n: u32, m: u32, l: u32, u: f32) -> u32 {
         let x = f32(l) * q + sqrt(v) * normal_quantile(u) + 0.5;
         return min(u32(max(x, 0.0)), top);
     }
+    // P(0) = Π_{j<l} (n − m − j)/(n − j), then the CDF search: both written out to
+    // SPLIT_EXACT_MAX = 8 steps, not loops (llvmpipe caps an invocation's loop iterations).
     var pmf = 1.0;
-    for (var j = 0u; j < l; j++) {
-        pmf *= f32(n - m - j) / f32(n - j);
+    pmf *= pmf0_factor(n, m, l, 0u);
+    pmf *= pmf0_factor(n, m, l, 1u);
+    pmf *= pmf0_factor(n, m, l, 2u);
+    pmf *= pmf0_factor(n, m, l, 3u);
+    pmf *= pmf0_factor(n, m, l, 4u);
+    pmf *= pmf0_factor(n, m, l, 5u);
+    pmf *= pmf0_factor(n, m, l, 6u);
+    pmf *= pmf0_factor(n, m, l, 7u);
+    var st = HyperStep(0u, pmf, pmf);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    st = hyper_step(st, n, m, l, top, u);
+    return st.k;
+}
+
+// Factor j of P(0), 1 past l.
+fn pmf0_factor(n: u32, m: u32, l: u32, j: u32) -> f32 {
+    if (j >= l) {
+        return 1.0;
     }
-    var cdf = pmf;
-    var k = 0u;
-    while (cdf <= u && k < top) {
-        pmf *= (f32(m - k) * f32(l - k)) / (f32(k + 1u) * f32(n - m - l + k + 1u));
-        k += 1u;
-        cdf += pmf;
+    return f32(n - m - j) / f32(n - j);
+}
+
+struct HyperStep {
+    k: u32,
+    pmf: f32,
+    cdf: f32,
+}
+
+// One step of the search: P(k+1) = P(k) (m − k)(l − k) / ((k + 1)(n − m − l + k + 1)).
+fn hyper_step(s: HyperStep, n: u32, m: u32, l: u32, top: u32, u: f32) -> HyperStep {
+    if (s.cdf > u || s.k >= top) {
+        return s;
     }
-    return k;
+    let pmf = s.pmf * (f32(m - s.k) * f32(l - s.k)) / (f32(s.k + 1u) * f32(n - m - l + s.k + 1u));
+    return HyperStep(s.k + 1u, pmf, s.cdf + pmf);
 }
 
 // Lit flakes among the m of n in one part when l of the n are lit (facet_glint::lit::hypergeometric).

@@ -22,11 +22,13 @@ use glam::{DMat2, DVec2};
 /// steps, once per query); larger ones use the continuity-corrected normal approximation.
 pub const LIT_EXACT_MEAN: f64 = 30.0;
 /// Hypergeometric splits of up to this many lit (or unlit) flakes are exact inverse CDFs (two
-/// loops of at most this many steps); larger ones use the normal approximation. Small because
-/// a walk splits eight chains three times per node, and llvmpipe (lavapipe) caps the loop
-/// iterations of a shader invocation at 65 535: at 32 a render's unfiltered footprints came back
-/// short on lavapipe.
+/// searches of at most this many steps, written out in WGSL); larger ones use the normal
+/// approximation. Small because a walk splits eight chains three times per node, and llvmpipe
+/// (lavapipe) caps the loop iterations of a shader invocation at 65 535: with loops of 32 steps
+/// a render's unfiltered footprints came back short on lavapipe.
 pub const SPLIT_EXACT_MAX: u64 = 8;
+// lit.inc.wgsl writes the exact split's steps out, eight of them.
+const _: () = assert!(SPLIT_EXACT_MAX <= 8);
 
 /// The most nodes the WGSL walk's stack holds: each node popped pushes at most four children,
 /// so a walk to depth [`MAX_DEPTH`] holds 3 · MAX_DEPTH + 1 (`STACK` in lit.inc.wgsl).
