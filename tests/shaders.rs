@@ -173,6 +173,7 @@ macro_rules! layout_check {
 /// `#[repr(C)]` structs by that name).
 fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
     use facet_fit::gpu::{GpuNode, GpuSample, GpuState};
+    use facet_glint::cone_rule::Ring;
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
     use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial};
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
@@ -189,8 +190,11 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
             x, i, gi, go, inv_cos_i, inv_cos_o, corr, pad => [pad0, pad1, pad2],
         }),
         layout_check!(DpfParams, "glint/dpf_build.wgsl", "Params", {
-            n_theta, n_dphi, n_psi, n_chi, gamma, ndf_kind, alpha_x, alpha_y, rotation,
-            table_nu, table_nphi, pad0,
+            n_theta, n_dphi, n_rings, ndf_kind, alpha_x, alpha_y, rotation,
+            table_nu, table_nphi, pad0, pad1, pad2,
+        }),
+        layout_check!(Ring, "glint/dpf_build.wgsl", "Ring", {
+            cos_psi, sin_psi, weight, n_chi,
         }),
         layout_check!(GlintField, "glint/glint_count.wgsl", "Field", {
             density, seed, root_count, filtered, threshold, blend, pad => [pad1, pad2],

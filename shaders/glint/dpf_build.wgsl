@@ -1,7 +1,8 @@
 // Builds one level of the DPF table: one thread per cell (θo, θi, Δφ) at its centre,
 //   P = ∫_{ω ∈ cone(ωo, γ)} D(h) cos θh / (4 ωi·h) dω,  h = normalize(ωi + ω),
-// Gauss–Legendre in the cone's polar angle ψ (nodes from Rust) × midpoint in its azimuth χ,
-// the same rule as the CPU reference (facet_glint::dpf::dpf).
+// Gauss–Legendre in the cone's polar angle ψ × midpoint in its azimuth χ: the rings of the cone
+// rule as Rust built them (facet_glint::cone_rule), the same the CPU reference sums
+// (facet_glint::dpf::dpf_on_rings).
 
 #include "common/microfacet.inc.wgsl"
 
@@ -12,9 +13,7 @@ const PI: f32 = 3.14159265358979;
 struct Params {
     n_theta: u32,
     n_dphi: u32,
-    n_psi: u32,
-    n_chi: u32,
-    gamma: f32,
+    n_rings: u32,
     // 0: GGX, 1: Beckmann, 2: table over (u = sqrt(θ/(π/2)), φ).
     ndf_kind: u32,
     alpha_x: f32,
@@ -23,11 +22,22 @@ struct Params {
     table_nu: u32,
     table_nphi: u32,
     pad0: u32,
+    pad1: u32,
+    pad2: u32,
+}
+
+// Rust: facet_glint::cone_rule::Ring. Nodes cos ψ ωo + sin ψ (cos χ t + sin χ b),
+// χ = (k + ½) 2π / n_chi, each weighted w_gl γ sin ψ 2π / n_chi.
+struct Ring {
+    cos_psi: f32,
+    sin_psi: f32,
+    weight: f32,
+    n_chi: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
-// Gauss–Legendre nodes and weights on [0, 1].
-@group(0) @binding(1) var<storage, read> gl: array<vec2<f32>>;
+// The rings of the cone rule.
+@group(0) @binding(1) var<storage, read> rings: array<Ring>;
 // The NDF table when ndf_kind = 2 (index k · nphi + l).
 @group(0) @binding(2) var<storage, read> ndf_table: array<f32>;
 @group(0) @binding(3) var<storage, read_write> out: array<f32>;
@@ -96,17 +106,14 @@ fn dpf_build(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let t = normalize(cross(a, wo));
     let b = cross(wo, t);
     var sum = 0.0;
-    for (var k = 0u; k < params.n_psi; k++) {
-        let node = gl[k];
-        let psi = node.x * params.gamma;
-        let sp = sin(psi);
-        let cp = cos(psi);
+    for (var k = 0u; k < params.n_rings; k++) {
+        let r = rings[k];
         var ring = 0.0;
-        for (var m = 0u; m < params.n_chi; m++) {
-            let chi = (f32(m) + 0.5) / f32(params.n_chi) * 2.0 * PI;
-            ring += density(wi, cp * wo + sp * (cos(chi) * t + sin(chi) * b));
+        for (var m = 0u; m < r.n_chi; m++) {
+            let chi = (f32(m) + 0.5) / f32(r.n_chi) * 2.0 * PI;
+            ring += density(wi, r.cos_psi * wo + r.sin_psi * (cos(chi) * t + sin(chi) * b));
         }
-        sum += node.y * params.gamma * sp * ring * 2.0 * PI / f32(params.n_chi);
+        sum += r.weight * ring; // Σ_rings weight · Σ_χ p(h)/(4 ωi·h)
     }
     out[cell] = sum;
 }

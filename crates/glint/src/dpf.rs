@@ -5,10 +5,11 @@
 //! Computed by integrating over the cone, not by summing 1° cells (which overestimates P(γ) by
 //! 7–24 %): with h(ω) = normalize(ωi + ω) and dω_h = dω / (4 ωi·h),
 //!   P = ∫_{ω ∈ cone(ωo, γ)} D(h) cos θh / (4 ωi·h) dω,
-//! Gauss–Legendre in the cone's polar angle ψ (weight sin ψ) × midpoint in its azimuth χ.
+//! Gauss–Legendre in the cone's polar angle ψ (weight sin ψ) × midpoint in its azimuth χ, with
+//! node counts sized to the NDF's lobe ([`crate::cone_rule`]).
 
+use crate::cone_rule::{ConeRule, Ring, lobe_width};
 use facet_fit::microfacet::Ndf;
-use facet_fit::quadrature::gauss_legendre;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -21,28 +22,36 @@ pub fn cone_solid_angle(gamma: f64) -> f64 {
     2.0 * PI * (1.0 - gamma.cos())
 }
 
-/// Quadrature nodes (ψ, χ) of a cone of half-angle γ, shared by the CPU and the GPU: they grow
-/// with the cone so that a peaked NDF (α ≈ 0.05) is resolved at any γ.
-pub fn cone_rule(gamma: f64) -> (usize, usize) {
-    let deg = gamma.to_degrees();
-    (12 + (deg * 0.75) as usize, 24 + (deg * 1.5) as usize)
+/// P(ωi, ωo, γ) by quadrature over the cone with the [`ConeRule::fast`] rule sized to the NDF's
+/// [`lobe_width`]; `wi`, `wo` unit vectors, z up. The tables ([`DpfTable::build`], and the GPU
+/// build) use the same rule.
+pub fn dpf(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64) -> f64 {
+    dpf_with(ndf, wi, wo, gamma, &ConeRule::fast())
 }
 
-/// P(ωi, ωo, γ) by quadrature over the cone; `wi`, `wo` unit vectors, z up.
-pub fn dpf(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64) -> f64 {
-    let (n_psi, n_chi) = cone_rule(gamma);
+/// P by the [`ConeRule::direct`] rule: the reference integral the fast rule is measured against.
+pub fn dpf_reference(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64) -> f64 {
+    dpf_with(ndf, wi, wo, gamma, &ConeRule::direct())
+}
+
+/// P by the cone rule `rule`.
+pub fn dpf_with(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64, rule: &ConeRule) -> f64 {
+    dpf_on_rings(ndf, wi, wo, &rule.rings(gamma, lobe_width(ndf)))
+}
+
+/// P by the rings of a cone rule: Σ_rings weight · Σ_χ p(h)/(4 ωi·h) (what the shader sums).
+pub fn dpf_on_rings(ndf: &Ndf, wi: DVec3, wo: DVec3, rings: &[Ring]) -> f64 {
     let (t, b) = frame(wo);
     let mut sum = 0.0;
-    for (x, w) in gauss_legendre(n_psi) {
-        let psi = x * gamma;
-        let (sp, cp) = psi.sin_cos();
+    for r in rings {
+        let (sp, cp) = (r.sin_psi as f64, r.cos_psi as f64);
         let mut ring = 0.0;
-        for k in 0..n_chi {
-            let chi = (k as f64 + 0.5) / n_chi as f64 * 2.0 * PI;
+        for k in 0..r.n_chi {
+            let chi = (k as f64 + 0.5) / r.n_chi as f64 * 2.0 * PI;
             let w_dir = cp * wo + sp * (chi.cos() * t + chi.sin() * b);
             ring += flake_density(ndf, wi, w_dir);
         }
-        sum += w * gamma * sp * ring * 2.0 * PI / n_chi as f64;
+        sum += r.weight as f64 * ring;
     }
     sum
 }
@@ -121,16 +130,22 @@ pub fn query_directions(theta_o: f64, theta_i: f64, dphi: f64) -> (DVec3, DVec3)
 }
 
 impl DpfTable {
-    /// The CPU reference build, cell centres in parallel.
+    /// The CPU reference build, cell centres in parallel, with the [`ConeRule::fast`] rule.
     pub fn build(ndf: &Ndf, gamma: f64, config: DpfConfig) -> Self {
+        Self::build_with(ndf, gamma, config, &ConeRule::fast())
+    }
+
+    /// The CPU build with the cone rule `rule`.
+    pub fn build_with(ndf: &Ndf, gamma: f64, config: DpfConfig, rule: &ConeRule) -> Self {
         let (nt, np) = (config.n_theta, config.n_dphi);
+        let rings = rule.rings(gamma, lobe_width(ndf));
         let values = (0..nt * nt * np)
             .into_par_iter()
             .map(|c| {
                 let (o, i, p) = (c / (nt * np), c / np % nt, c % np);
                 let (theta_o, theta_i, dphi) = Self::cell_centre(config, o, i, p);
                 let (wi, wo) = query_directions(theta_o, theta_i, dphi);
-                dpf(ndf, wi, wo, gamma) as f32
+                dpf_on_rings(ndf, wi, wo, &rings) as f32
             })
             .collect();
         DpfTable {
@@ -199,11 +214,21 @@ impl DpfPyramid {
 
     /// Only the levels listed (indices into [`LEVELS_DEG`]).
     pub fn build_levels(ndf: &Ndf, config: DpfConfig, which: &[usize]) -> Self {
+        Self::build_levels_with(ndf, config, which, &ConeRule::fast())
+    }
+
+    /// Only the levels listed, with the cone rule `rule`.
+    pub fn build_levels_with(
+        ndf: &Ndf,
+        config: DpfConfig,
+        which: &[usize],
+        rule: &ConeRule,
+    ) -> Self {
         let levels = (0..LEVELS_DEG.len())
             .map(|k| {
                 which
                     .contains(&k)
-                    .then(|| DpfTable::build(ndf, LEVELS_DEG[k].to_radians(), config))
+                    .then(|| DpfTable::build_with(ndf, LEVELS_DEG[k].to_radians(), config, rule))
             })
             .collect();
         DpfPyramid { levels }

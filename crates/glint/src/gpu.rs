@@ -1,11 +1,11 @@
 //! Host driver of `shaders/glint/dpf_build.wgsl`: the DPF levels built on the GPU and stored as
 //! one 3D texture per level (R32Float, x = Δφ, y = θi, z = θo, values at cell centres).
 
-use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG, cone_rule};
+use crate::cone_rule::{ConeRule, lobe_width};
+use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG};
 use bytemuck::{Pod, Zeroable};
 use facet_fit::geometry::spherical;
 use facet_fit::microfacet::Ndf;
-use facet_fit::quadrature::gauss_legendre;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Uniforms of the build (WGSL `Params`).
@@ -15,9 +15,7 @@ use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 pub struct DpfParams {
     pub n_theta: u32,
     pub n_dphi: u32,
-    pub n_psi: u32,
-    pub n_chi: u32,
-    pub gamma: f32,
+    pub n_rings: u32,
     /// 0 GGX, 1 Beckmann, 2 table.
     pub ndf_kind: u32,
     pub alpha_x: f32,
@@ -26,6 +24,8 @@ pub struct DpfParams {
     pub table_nu: u32,
     pub table_nphi: u32,
     pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// Resolution of the NDF table for tabulated (or stretched) NDFs on the GPU.
@@ -85,17 +85,31 @@ pub fn build_pyramid(gpu: &Gpu, ndf: &Ndf, config: DpfConfig) -> Result<GpuDpf, 
     build_levels(gpu, ndf, config, &[0, 1, 2, 3, 4, 5, 6, 7, 8])
 }
 
-/// Builds the listed levels (indices into [`LEVELS_DEG`]); `textures` holds them in order.
+/// Builds the listed levels (indices into [`LEVELS_DEG`]) with the [`ConeRule::fast`] rule;
+/// `textures` holds them in order.
 pub fn build_levels(
     gpu: &Gpu,
     ndf: &Ndf,
     config: DpfConfig,
     which: &[usize],
 ) -> Result<GpuDpf, GpuError> {
+    build_levels_with(gpu, ndf, config, which, &ConeRule::fast())
+}
+
+/// Builds the listed levels with the cone rule `rule` (the CPU's [`DpfPyramid::build_levels_with`]
+/// on the same rings).
+pub fn build_levels_with(
+    gpu: &Gpu,
+    ndf: &Ndf,
+    config: DpfConfig,
+    which: &[usize],
+    rule: &ConeRule,
+) -> Result<GpuDpf, GpuError> {
     let d = &gpu.device;
     let pipeline = shader::compute_pipeline(d, "glint/dpf_build.wgsl", "dpf_build", &[])?;
     let wg = shader::workgroup_size("glint/dpf_build.wgsl", "dpf_build")?;
     let (base, table) = ndf_upload(ndf);
+    let width = lobe_width(ndf);
     let cells = config.n_theta * config.n_theta * config.n_dphi;
     let table_buf = gpu.scoped(|| buffer::storage(d, "ndf table", &table))?;
     let mut levels = vec![None; LEVELS_DEG.len()];
@@ -106,23 +120,17 @@ pub fn build_levels(
         .filter(|(k, _)| which.contains(k))
     {
         let gamma = deg.to_radians();
-        let (n_psi, n_chi) = cone_rule(gamma);
-        let nodes: Vec<[f32; 2]> = gauss_legendre(n_psi)
-            .into_iter()
-            .map(|(x, w)| [x as f32, w as f32])
-            .collect();
+        let rings = rule.rings(gamma, width);
         let params = DpfParams {
             n_theta: config.n_theta as u32,
             n_dphi: config.n_dphi as u32,
-            n_psi: n_psi as u32,
-            n_chi: n_chi as u32,
-            gamma: gamma as f32,
+            n_rings: rings.len() as u32,
             ..base
         };
         let (pb, gb, ob) = gpu.scoped(|| {
             (
                 buffer::uniform(d, "dpf params", &params),
-                buffer::storage(d, "gauss-legendre", &nodes),
+                buffer::storage(d, "cone rings", &rings),
                 buffer::storage_zeroed(d, "dpf level", (cells * 4) as u64),
             )
         })?;

@@ -1,6 +1,7 @@
 //! # facet-glint: discrete stochastic microfacets with the filterable DPF
 //!
-//! [`tea`]: the per-flake hash (Rust and WGSL). [`dpf`]: the Directional Probability Function
+//! [`tea`]: the per-flake hash (Rust and WGSL). [`cone_rule`]: the quadrature over a cone,
+//! sized to the NDF's lobe, shared by the CPU and the GPU. [`dpf`]: the Directional Probability Function
 //! by cone integration, its tables (documented cell centres) and the nine-level pyramid, with
 //! the paper's Gaussian-blurred levels for comparison. [`flakes`]: the procedural flake field,
 //! its consistent quadtree and counting over footprints. [`lit`]: lit counts per node, so a
@@ -20,6 +21,7 @@
 
 #![warn(missing_docs)]
 
+pub mod cone_rule;
 pub mod dpf;
 pub mod flakes;
 pub mod glint_brdf;
