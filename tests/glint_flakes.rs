@@ -654,3 +654,34 @@ fn blended_counts_do_not_pop_at_cell_edges() {
     );
     assert!(ratios[1] < 1.5, "blended counts pop: {ratios:?}");
 }
+
+/// The glint model of a fit's tabulated NDF (the demo fit: D, Λ and P from its tables) has the
+/// smooth tabulated BRDF as its large-footprint limit, as the analytic one does.
+#[test]
+fn tabulated_glints_converge_to_the_smooth_tabulated_brdf() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo/default_fit.json");
+    let fit = facet_fit::material::FittedMaterial::load(&path).unwrap();
+    let model = fit.tabulated.clone();
+    assert!(matches!(model.ndf, Ndf::Tabulated(_)));
+    let field = FlakeField {
+        density: 1.0e9,
+        seed: 2,
+    };
+    let cfg = GlintConfig::standard();
+    let fp = Footprint {
+        center: DVec2::splat(0.5),
+        a: DVec2::new(0.05, 0.0),
+        b: DVec2::new(0.0, 0.04),
+    };
+    for (wi, wo) in [
+        (dir(0.0, 0.0), dir(10.0, 90.0)),
+        (dir(30.0, 0.0), dir(30.0, 180.0)),
+        (dir(60.0, 0.0), dir(45.0, 160.0)),
+    ] {
+        let p = dpf(&model.ndf, wi, wo, cfg.gamma);
+        let glint = glint_eval(&model, &field, &fp, wi, wo, p, &cfg);
+        let smooth = facet_fit::brdf::Brdf::eval(&model, wi, wo).unwrap();
+        println!("tabulated: glint {glint:.5?} smooth {smooth:.5?}");
+        assert!((0..3).all(|c| (glint[c] / smooth[c] - 1.0).abs() < 0.01));
+    }
+}

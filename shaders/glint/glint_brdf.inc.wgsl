@@ -3,7 +3,8 @@
 // textures read at cell centres), the flake count over the footprint (or its mean N a P above the
 // threshold when filtering), the correlated G2:
 //   f / F = G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo).
-// Needs from the includer: `field: Field`, `params: EvalParams`, `level0`, `level1`
+// Needs from the includer: `glint_lambda(w) -> Λ(w)` of the material's NDF, `field: Field`,
+// `params: EvalParams`, `level0`, `level1`
 // (texture_3d<f32>), glint/tea.inc.wgsl, common/microfacet.inc.wgsl, glint/flakes.inc.wgsl and
 // glint/lit.inc.wgsl.
 
@@ -17,7 +18,7 @@ struct EvalParams {
     level_t: f32,
     n_theta: u32,
     n_dphi: u32,
-    // 0 GGX, 1 Beckmann.
+    // 0 GGX, 1 Beckmann, 2 the renderer's tabulated NDF (alpha, rotation: its stretch).
     ndf_kind: u32,
     alpha_x: f32,
     alpha_y: f32,
@@ -124,8 +125,7 @@ fn glint_scale(wi: vec3<f32>, wo: vec3<f32>, count: f32, area: f32) -> f32 {
         return 0.0;
     }
     let h = normalize(wi + wo);
-    let ndf = AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation);
-    let g2 = g2_glint(ndf_lambda(ndf, wi), ndf_lambda(ndf, wo), wi, wo);
+    let g2 = g2_glint(glint_lambda(wi), glint_lambda(wo), wi, wo);
     return g2 * dot(h, wo) * count / (field.density * area * params.sigma * wi.z * h.z) / wo.z;
 }
 

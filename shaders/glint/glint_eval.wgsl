@@ -29,6 +29,11 @@ struct EvalQuery {
 #include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
 
+// Λ of the analytic NDF the evaluation takes.
+fn glint_lambda(w: vec3<f32>) -> f32 {
+    return ndf_lambda(AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation), w);
+}
+
 @compute @workgroup_size(WG)
 fn glint_eval(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let idx = gid.x + gid.y * nwg.x * WG;

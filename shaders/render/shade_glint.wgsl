@@ -10,6 +10,7 @@
 #include "render/bvh.inc.wgsl"
 #include "render/scene.inc.wgsl"
 #include "render/shade.inc.wgsl"
+#include "render/tabulated.inc.wgsl"
 #include "glint/tea.inc.wgsl"
 
 override Q_SHADE: u32;
@@ -19,6 +20,9 @@ override Q_SHADE: u32;
 @group(2) @binding(2) var level0: texture_3d<f32>;
 @group(2) @binding(3) var level1: texture_3d<f32>;
 
+// EvalParams.ndf_kind of a tabulated NDF (facet_glint::gpu::GlintEvalParams).
+const NDF_TABULATED: u32 = 2u;
+
 #include "glint/flakes.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
@@ -26,6 +30,8 @@ override Q_SHADE: u32;
 struct Bsdf {
     material: u32,
     ndf: AnalyticNdf,
+    // The fit's tabulated NDF, when params.ndf_kind is NDF_TABULATED.
+    tab: TabNdf,
     center: vec2<f32>,
     a: vec2<f32>,
     b: vec2<f32>,
@@ -55,6 +61,9 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     var b: Bsdf;
     b.material = s.material;
     b.ndf = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
+    if (params.ndf_kind == NDF_TABULATED) {
+        b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
+    }
     b.center = s.uv;
     // The cone's circle of radius w/2 around the ray, projected onto the tangent plane: an
     // ellipse with semi-axes r (across the ray) and r / |cos θ| (along it).
@@ -85,6 +94,7 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
 
 // Both directions from one walk over the footprint's flakes.
 fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
+    glint_tab = b.tab;
     let k = glint_factor_pair(wi_light, wi_bsdf, wo, b.center, b.a, b.b);
     let m = materials[b.material];
     var f: array<vec3<f32>, 2>;
@@ -97,20 +107,44 @@ fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -
     return f;
 }
 
+// Λ of the material's NDF, for the glint BRDF's G2 (glint/glint_brdf.inc.wgsl). The stage is one
+// material's, so params.ndf_kind is uniform; the tabulated NDF is the one at params' material.
+var<private> glint_tab: TabNdf;
+
+fn glint_lambda(w: vec3<f32>) -> f32 {
+    if (params.ndf_kind == NDF_TABULATED) {
+        return tab_lambda(glint_tab, w);
+    }
+    return ndf_lambda(AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation), w);
+}
+
+// The smooth lobe's visible normals: analytic, or the table's visible distribution.
 fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return 0.0;
     }
     let h = normalize(wi + wo);
+    if (params.ndf_kind == NDF_TABULATED) {
+        return tab_pdf_visible(b.tab, wo, h) / (4.0 * abs(dot(wo, h)));
+    }
     return lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
 }
 
 fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
-    let h = lobe_sample_h(b.ndf, wo, u.xy);
+    var h: vec3<f32>;
+    if (params.ndf_kind == NDF_TABULATED) {
+        h = tab_sample_visible(b.tab, wo, u.xy);
+    } else {
+        h = lobe_sample_h(b.ndf, wo, u.xy);
+    }
     return 2.0 * dot(wo, h) * h - wo;
 }
 
 fn bsdf_roughness(b: Bsdf) -> f32 {
+    // m.roughness: the fit's effective α (GGX) for a table, √(αx αy) for an analytic NDF.
+    if (params.ndf_kind == NDF_TABULATED) {
+        return materials[b.material].roughness;
+    }
     return sqrt(b.ndf.alpha_x * b.ndf.alpha_y);
 }
 

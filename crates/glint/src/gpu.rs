@@ -340,7 +340,7 @@ pub struct GlintEvalParams {
     pub level_t: f32,
     pub n_theta: u32,
     pub n_dphi: u32,
-    /// 0 GGX, 1 Beckmann.
+    /// 0 GGX, 1 Beckmann, 2 the renderer's tabulated NDF (α and rotation: its stretch).
     pub ndf_kind: u32,
     pub alpha_x: f32,
     pub alpha_y: f32,
@@ -411,7 +411,7 @@ impl GlintEvaluator {
         queries: &[GlintEvalQuery],
     ) -> Result<Vec<[f64; 3]>, GpuError> {
         let d = &gpu.device;
-        let (params, t0, t1) = eval_params(cfg, ndf, dpf)?;
+        let (params, t0, t1) = eval_params(cfg, &Ndf::Analytic(*ndf), dpf)?;
         let uniform = GlintField::new(field, cfg);
         let f: Vec<[f32; 4]> = fresnel
             .rgb
@@ -462,7 +462,7 @@ impl GlintEvaluator {
 /// one twice when γ is on a level). Fails when `dpf` lacks a level it needs.
 pub fn eval_params<'a>(
     cfg: &crate::glint_brdf::GlintConfig,
-    ndf: &facet_fit::microfacet::AnalyticNdf,
+    ndf: &Ndf,
     dpf: &'a GpuDpf,
 ) -> Result<(GlintEvalParams, &'a wgpu::Texture, &'a wgpu::Texture), GpuError> {
     use crate::dpf::cone_solid_angle;
@@ -479,6 +479,19 @@ pub fn eval_params<'a>(
         Ok((dpf.pyramid.levels[k].as_ref().unwrap(), &dpf.textures[pos]))
     };
     let ((l0, t0), (l1, t1)) = (level(k0)?, level(k1)?);
+    // A tabulated NDF's parameters are its stretch (the table itself is the renderer's).
+    let (ndf_kind, alpha_x, alpha_y, rotation) = match ndf {
+        Ndf::Analytic(a) => (
+            match a.kind {
+                facet_fit::microfacet::NdfKind::Ggx => 0,
+                facet_fit::microfacet::NdfKind::Beckmann => 1,
+            },
+            a.alpha_x,
+            a.alpha_y,
+            a.rotation,
+        ),
+        Ndf::Tabulated(t) => (2, t.stretch.alpha_x, t.stretch.alpha_y, t.stretch.rotation),
+    };
     let params = GlintEvalParams {
         gamma: cfg.gamma as f32,
         sigma: cone_solid_angle(cfg.gamma) as f32,
@@ -487,13 +500,10 @@ pub fn eval_params<'a>(
         level_t: t as f32,
         n_theta: l0.config.n_theta as u32,
         n_dphi: l0.config.n_dphi as u32,
-        ndf_kind: match ndf.kind {
-            facet_fit::microfacet::NdfKind::Ggx => 0,
-            facet_fit::microfacet::NdfKind::Beckmann => 1,
-        },
-        alpha_x: ndf.alpha_x as f32,
-        alpha_y: ndf.alpha_y as f32,
-        rotation: ndf.rotation as f32,
+        ndf_kind,
+        alpha_x: alpha_x as f32,
+        alpha_y: alpha_y as f32,
+        rotation: rotation as f32,
         pad0: 0,
     };
     Ok((params, t0, t1))

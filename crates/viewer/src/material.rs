@@ -51,6 +51,8 @@ pub struct GlintEdit {
     pub gamma_deg: f32,
     /// Expected count above which the count is replaced by its mean.
     pub threshold: f32,
+    /// Flakes drawn from the fit's tabulated NDF instead of its GGX model.
+    pub tabulated: bool,
 }
 
 impl Default for GlintEdit {
@@ -59,6 +61,7 @@ impl Default for GlintEdit {
             density: 2.0e5,
             gamma_deg: 1.0,
             threshold: 64.0,
+            tabulated: false,
         }
     }
 }
@@ -105,18 +108,28 @@ impl EditedMaterial {
 
     /// The model the shown choice renders with.
     pub fn model(&self) -> FacetModel {
-        match self.shown {
+        match self.lobe() {
             Shown::Measured | Shown::Tabulated => FacetModel::Tabulated,
             Shown::Ggx | Shown::Glint => FacetModel::Ggx,
             Shown::Beckmann => FacetModel::Beckmann,
         }
     }
 
+    /// The smooth model whose NDF the shown material uses: glints take the tabulated NDF when
+    /// asked to (or when the fit has no GGX model), else GGX.
+    pub fn lobe(&self) -> Shown {
+        match self.shown {
+            Shown::Glint if self.glint.tabulated || self.record.ggx.is_none() => Shown::Tabulated,
+            Shown::Glint => Shown::Ggx,
+            s => s,
+        }
+    }
+
     /// Whether the shown model exists in the fit (GGX/Beckmann may be absent).
     pub fn available(&self, shown: Shown) -> bool {
         match shown {
-            Shown::Measured | Shown::Tabulated => true,
-            Shown::Ggx | Shown::Glint => self.record.ggx.is_some(),
+            Shown::Measured | Shown::Tabulated | Shown::Glint => true,
+            Shown::Ggx => self.record.ggx.is_some(),
             Shown::Beckmann => self.record.beckmann.is_some(),
         }
     }
@@ -124,7 +137,7 @@ impl EditedMaterial {
     /// (αx, αy, rotation) of the shown model: the tabulated stretch or the analytic α.
     pub fn alpha(&self) -> Option<(f64, f64, f64)> {
         let r = &self.record;
-        match self.shown {
+        match self.lobe() {
             Shown::Measured => None,
             Shown::Tabulated => {
                 let s = r.tabulated.stretch;
@@ -141,8 +154,9 @@ impl EditedMaterial {
     /// Sets (αx, αy, rotation) of the shown model; α clamped to [1e-3, 4].
     pub fn set_alpha(&mut self, ax: f64, ay: f64, rotation: f64) {
         let (ax, ay) = (ax.clamp(1e-3, 4.0), ay.clamp(1e-3, 4.0));
+        let lobe = self.lobe();
         let r = &mut self.record;
-        match self.shown {
+        match lobe {
             Shown::Measured => {}
             Shown::Tabulated => {
                 r.tabulated.stretch.alpha_x = ax;
@@ -150,7 +164,7 @@ impl EditedMaterial {
                 r.tabulated.stretch.rotation = rotation;
             }
             Shown::Ggx | Shown::Glint | Shown::Beckmann => {
-                let p = if self.shown == Shown::Beckmann {
+                let p = if lobe == Shown::Beckmann {
                     r.beckmann.as_mut()
                 } else {
                     r.ggx.as_mut()

@@ -108,7 +108,7 @@ pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
     // Fresnel per channel of the edited model.
     ui.add_space(8.0);
     let rec = m.edited_record();
-    let table = match m.shown {
+    let table = match m.lobe() {
         Shown::Ggx | Shown::Glint => rec.ggx.as_ref().map(|p| &p.fresnel),
         Shown::Beckmann => rec.beckmann.as_ref().map(|p| &p.fresnel),
         _ => None,

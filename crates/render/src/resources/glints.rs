@@ -1,11 +1,12 @@
 //! Glint materials on the GPU: per material, the two DPF pyramid levels bracketing its γ
-//! (3D textures), its flake field and evaluation parameters (bind group 2 of its stage).
+//! (3D textures) built from its NDF (analytic or the fit's table), its flake field and
+//! evaluation parameters (bind group 2 of its stage).
 
 use super::{GlintResources, ResourceConfig};
 use crate::error::RenderError;
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::scene::GlintParams;
-use facet_fit::microfacet::{AnalyticNdf, Ndf};
+use facet_fit::microfacet::Ndf;
 use facet_glint::dpf::{DpfPyramid, LEVELS_DEG};
 use facet_glint::flakes::FlakeField;
 use facet_glint::glint_brdf::GlintConfig;
@@ -19,7 +20,7 @@ pub fn build(
     limits: &DeviceLimits,
     config: &ResourceConfig,
     material: u32,
-    ndf: AnalyticNdf,
+    ndf: Ndf,
     spec: GlintParams,
 ) -> Result<(GlintResources, Vec<f64>), RenderError> {
     let cfg = GlintConfig {
@@ -41,7 +42,7 @@ pub fn build(
         ),
         Planned::storage("a DPF level buffer", product(&[nt, nt, np, 4]), &set_by),
     ])?;
-    let dpf = facet_glint::gpu::build_levels(gpu, &Ndf::Analytic(ndf), config.dpf, &which)?;
+    let dpf = facet_glint::gpu::build_levels(gpu, &ndf, config.dpf, &which)?;
     let (params, t0, t1) = facet_glint::gpu::eval_params(&cfg, &ndf, &dpf)?;
     let field = FlakeField {
         density: spec.density as f64,

@@ -7,7 +7,7 @@ use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
 use crate::scene::{FacetModel, GlintParams, Material};
 use facet_fit::material::ModelChoice;
-use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+use facet_fit::microfacet::{Ndf, NdfKind};
 use facet_fit::tabulated::TabulatedNdf;
 
 /// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
@@ -23,7 +23,7 @@ pub struct MaterialPlan<'a> {
     /// A tabulated material's NDF.
     pub tabulated: Option<&'a TabulatedNdf>,
     /// A glint material's NDF and parameters.
-    pub glint: Option<(AnalyticNdf, GlintParams)>,
+    pub glint: Option<(Ndf, GlintParams)>,
 }
 
 impl MaterialPlan<'_> {
@@ -83,7 +83,7 @@ fn texture(t: Option<u32>) -> u32 {
 }
 
 /// The plan of material `m`. A fitted material takes its model's NDF, Fresnel and diffuse term;
-/// a glint material needs an analytic model.
+/// a glint material renders that model's NDF (analytic or tabulated) as flakes.
 pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
     let mut gpu = GpuMaterial {
         base_color: m.base_color.to_array(),
@@ -162,22 +162,12 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
             tabulated = Some(tab.as_ref());
         }
     }
-    let glint = match (f.glint, &brdf.ndf) {
-        (None, _) => None,
-        (Some(g), Ndf::Analytic(a)) => {
-            gpu.kind = MaterialKind::Glint as u32;
-            Some((*a, g))
-        }
-        (Some(_), Ndf::Tabulated(_)) => {
-            return Err(RenderError::input(
-                &f.source,
-                format!(
-                    "material {:?}: glints need the fit's GGX or Beckmann model, not the tabulated one",
-                    m.name
-                ),
-            ));
-        }
-    };
+    // A glint material keeps its NDF's parameters (and a tabulated one its tables) for the
+    // glint stage's D, Λ and sampling.
+    let glint = f.glint.map(|g| {
+        gpu.kind = MaterialKind::Glint as u32;
+        (brdf.ndf.clone(), g)
+    });
     Ok(MaterialPlan {
         gpu,
         fresnel: Some(fresnel),

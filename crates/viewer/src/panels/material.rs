@@ -81,7 +81,7 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     if let Some((mut ax, mut ay, rot)) = m.alpha() {
         let rot_deg0 = rot.to_degrees();
         let mut rot_deg = rot_deg0;
-        let what = if m.shown == Shown::Tabulated {
+        let what = if m.lobe() == Shown::Tabulated {
             "stretch of the tabulated NDF"
         } else {
             "α of the model"
@@ -132,6 +132,9 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     }
     if m.shown == Shown::Glint {
         ui.label("Glints:");
+        if m.record.ggx.is_some() {
+            ui.checkbox(&mut m.glint.tabulated, "flakes from the tabulated NDF");
+        }
         ui.add(
             egui::Slider::new(&mut m.glint.density, 1e3..=1e7)
                 .logarithmic(true)
