@@ -149,7 +149,9 @@ pub fn probe(src: &MerlBrdf) {
         std::hint::black_box(microfacet_error(&model, &set));
     }
     let t_e = t.elapsed().as_secs_f64() * 1e2;
-    println!("probe: first set (with the grid geometry) {t_first:.2} ms, set {t_set:.2} ms, fresnel pass {t_f:.2} ms, error pass {t_e:.2} ms");
+    println!(
+        "probe: first set (with the grid geometry) {t_first:.2} ms, set {t_set:.2} ms, fresnel pass {t_f:.2} ms, error pass {t_e:.2} ms"
+    );
 }
 
 /// α and full-grid error of the least-squares fits against the search's subsampling stride.
