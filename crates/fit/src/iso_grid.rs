@@ -51,6 +51,8 @@ impl IsoSamples {
         let per_i = THETA_D_RES;
         let mut log_x = vec![0.0f32; 3 * ROWS * ROW];
         let mut valid = vec![false; ROWS * ROW];
+        crate::huge_pages::advise(&mut log_x);
+        crate::huge_pages::advise(&mut valid);
         let mut sum_x = vec![[0.0f64; 3]; ROWS];
         let mut count = vec![0u16; ROWS];
         let channels = [table.channel(0), table.channel(1), table.channel(2)];

@@ -49,6 +49,7 @@ pub mod geometry;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod grid;
+pub(crate) mod huge_pages;
 pub mod input;
 pub(crate) mod iso_grid;
 pub mod material;

@@ -97,6 +97,7 @@ impl MerlTable {
         }
         let mut header = [0u8; HEADER_BYTES as usize];
         let mut raw = vec![0.0f64; 3 * SAMPLES];
+        crate::huge_pages::advise(&mut raw);
         let io = |e| FitError::io(path, e);
         file.read_exact(&mut header).map_err(io)?;
         let dims: [i32; 3] = std::array::from_fn(|d| {

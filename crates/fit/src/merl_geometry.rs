@@ -56,6 +56,8 @@ fn build() -> MerlGeometry {
     let per_i = THETA_D_RES;
     let mut mu = vec![0.0f32; ROWS * MU_ROW];
     let mut corr = vec![0.0f32; ROWS * ROW];
+    crate::huge_pages::advise(&mut mu);
+    crate::huge_pages::advise(&mut corr);
     mu.par_chunks_mut(per_i * MU_ROW)
         .zip(corr.par_chunks_mut(per_i * ROW))
         .enumerate()
