@@ -2,7 +2,7 @@
 //!
 //! The Fresnel average and the error metric both run over every valid sample of a source on
 //! the MERL grid (bin lower edges, both directions above the horizon, the sample present).
-//! Isotropic sources are held in the compact row form of [`crate::iso_grid`], and isotropic
+//! Isotropic sources are held in a compact row form (`iso_grid.rs`), and isotropic
 //! microfacet models take a fast path there: D depends only on the θh bin, F only on the θd
 //! bin and Λ only on cos θ, so each is a small table; `tests/models.rs` checks it against the
 //! direct evaluation.
