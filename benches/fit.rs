@@ -44,6 +44,18 @@ fn full_fit(c: &mut Criterion) {
     c.bench_function("extract_g1_fresnel_n90", |b| {
         b.iter(|| fit_material(&src, "bench", &paper_scope).unwrap())
     });
+    // The tabulated model alone: extraction, Fresnel and its error.
+    let tabulated_only = FitConfig {
+        models: facet_fit::fit::Models {
+            tabulated: true,
+            ggx: false,
+            beckmann: false,
+        },
+        ..cfg
+    };
+    c.bench_function("fit_tabulated_n90", |b| {
+        b.iter(|| fit_material(&src, "bench", &tabulated_only).unwrap())
+    });
 }
 
 fn resolution(c: &mut Criterion) {

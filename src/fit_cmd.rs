@@ -46,16 +46,24 @@ fn open_gpu(arg: BackendArg) -> Result<Option<Gpu>> {
     match arg {
         BackendArg::Cpu => Ok(None),
         BackendArg::Gpu => Ok(Some(Gpu::new().context("--backend gpu")?)),
-        BackendArg::Auto => match Gpu::new() {
-            // A software rasteriser (lavapipe, llvmpipe) is slower than the f64 CPU path.
-            Ok(g) if g.info.device_type == wgpu::DeviceType::Cpu => {
+        // The adapter is looked at before a device is opened on it: a software rasteriser
+        // (lavapipe, llvmpipe) is slower than the CPU path, and opening one costs more than a
+        // fit.
+        BackendArg::Auto => match Gpu::best_adapter_info().and_then(|info| {
+            if info.device_type == wgpu::DeviceType::Cpu {
+                Ok(Err(info))
+            } else {
+                Gpu::new().map(Ok)
+            }
+        }) {
+            Ok(Err(info)) => {
                 eprintln!(
                     "notice: only a software adapter ({}); fitting on the CPU (--backend gpu uses it)",
-                    g.info.name
+                    info.name
                 );
                 Ok(None)
             }
-            Ok(g) => Ok(Some(g)),
+            Ok(Ok(g)) => Ok(Some(g)),
             Err(e) => {
                 eprintln!("notice: {e}; fitting on the CPU");
                 Ok(None)

@@ -187,7 +187,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
             iteration, lambda, pad0, pad1,
         }),
         layout_check!(GpuSample, "fit/fresnel.wgsl", "Sample", {
-            x, i, gi, go, inv_cos_i, inv_cos_o, corr, pad => [pad0, pad1, pad2],
+            i, gi, go, inv_cos_i, inv_cos_o, corr, pad => [pad0, pad1],
         }),
         layout_check!(DpfParams, "glint/dpf_build.wgsl", "Params", {
             n_theta, n_dphi, n_rings, ndf_kind, alpha_x, alpha_y, rotation,

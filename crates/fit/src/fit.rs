@@ -8,10 +8,10 @@ use crate::fresnel::{Fresnel, FresnelTable};
 use crate::gpu::{GpuFitter, gpu_error};
 #[cfg(feature = "gpu")]
 use crate::grid::IsoTables;
-use crate::grid::{GridSamples, fresnel_average, microfacet_error};
+use crate::grid::{GridSamples, fresnel_and_error, fresnel_average, microfacet_error};
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
-use crate::params::{fit_least_squares, fit_moments};
+use crate::params::{fit_least_squares, fit_moments, refine_on_full_grid};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -50,8 +50,10 @@ pub struct FitConfig {
     pub anisotropic: bool,
     /// Which models to fit and report.
     pub models: Models,
-    /// The least-squares searches run on every `search_stride`-th grid sample; the reported
-    /// errors use every sample.
+    /// The least-squares searches run on a subsampled grid ([`GridSamples::subsample`]: every
+    /// `search_stride`-th (θh, θd) row of an isotropic source, every `search_stride`-th sample
+    /// of an anisotropic one); an isotropic fit then takes its final steps on the full grid
+    /// ([`crate::params::refine_on_full_grid`]), and the reported errors use every sample.
     pub search_stride: usize,
 }
 
@@ -160,13 +162,8 @@ fn fit_with(
             problem: "no valid sample on the MERL grid".into(),
         });
     }
-    let max = crate::grid::MAX_X;
-    if let Some(s) = set
-        .samples
-        .iter()
-        .find(|s| s.x.iter().any(|x| !(x.abs() <= max)))
-    {
-        let (i, j) = (s.i, s.j);
+    if let Some(s) = set.out_of_range() {
+        let (i, j, max) = (s.i, s.j, crate::grid::MAX_X);
         return Err(FitError::Extraction {
             name: src.name().into(),
             problem: format!(
@@ -191,7 +188,7 @@ fn fit_with(
         if let (Some((g, samples)), Some(tables)) = (&uploaded, IsoTables::new(model)) {
             return g
                 .fresnel
-                .average(g.gpu, samples, &tables)
+                .average(g.gpu, samples, &set, &tables)
                 .map_err(|e| gpu_error(src.name(), e));
         }
         Ok(fresnel_average(model, &set))
@@ -202,15 +199,23 @@ fn fit_with(
         fresnel: Fresnel::Schlick { f0: [1.0; 3] },
         diffuse: [0.0; 3],
     };
-    let fresnel = FresnelTable::on_merl_bins(average(&tabulated)?);
+    // On the CPU the tabulated model's error shares G2 with its Fresnel average.
+    let (rgb, fused_error) = if gpu.is_none() && cfg.models.tabulated {
+        let (f, e) = fresnel_and_error(&tabulated, &set);
+        (f, Some(e))
+    } else {
+        (average(&tabulated)?, None)
+    };
+    let fresnel = FresnelTable::on_merl_bins(rgb);
     tabulated.fresnel = Fresnel::Table(fresnel.clone());
     let fresnel_ms = ms(t);
 
     let t = Instant::now();
-    let tab_error = cfg
-        .models
-        .tabulated
-        .then(|| microfacet_error(&tabulated, &set));
+    let tab_error = fused_error.or_else(|| {
+        cfg.models
+            .tabulated
+            .then(|| microfacet_error(&tabulated, &set))
+    });
     let search = set.subsample(cfg.search_stride);
     let fit_kind = |kind: NdfKind| -> Result<ParamRecord, FitError> {
         let moments = fit_moments(kind, &ex.ndf);
@@ -223,14 +228,39 @@ fn fit_with(
             diffuse: [0.0; 3],
         };
         // The least-squares model with a Fresnel table averaged for its own D and G.
-        let mut lsq_model = MicrofacetBrdf {
-            name: "lsq".into(),
-            ndf: Ndf::Analytic(lsq),
-            fresnel: Fresnel::Schlick { f0: [1.0; 3] },
-            diffuse: [0.0; 3],
+        let lsq_model = |ndf: AnalyticNdf| -> Result<(f64, MicrofacetBrdf), FitError> {
+            let mut m = MicrofacetBrdf {
+                name: "lsq".into(),
+                ndf: Ndf::Analytic(ndf),
+                fresnel: Fresnel::Schlick { f0: [1.0; 3] },
+                diffuse: [0.0; 3],
+            };
+            let (f, e) = if gpu.is_some() {
+                let f = average(&m)?;
+                m.fresnel = Fresnel::Table(FresnelTable::on_merl_bins(f));
+                (None, microfacet_error(&m, &set))
+            } else {
+                let (f, e) = fresnel_and_error(&m, &set);
+                (Some(f), e)
+            };
+            if let Some(f) = f {
+                m.fresnel = Fresnel::Table(FresnelTable::on_merl_bins(f));
+            }
+            Ok((e, m))
         };
-        let lsq_fresnel = FresnelTable::on_merl_bins(average(&lsq_model)?);
-        lsq_model.fresnel = Fresnel::Table(lsq_fresnel.clone());
+        // Isotropic: the final steps on the full grid (coarse to fine).
+        let (lsq, error, lsq_model) = if cfg.anisotropic {
+            let (e, m) = lsq_model(lsq)?;
+            (lsq, e, m)
+        } else {
+            let (t, e, m) = refine_on_full_grid(lsq.alpha_x.ln(), |t| {
+                lsq_model(AnalyticNdf::isotropic(kind, t.exp()))
+            })?;
+            (AnalyticNdf::isotropic(kind, t.exp()), e, m)
+        };
+        let Fresnel::Table(lsq_fresnel) = lsq_model.fresnel else {
+            unreachable!("the least-squares model has a Fresnel table")
+        };
         let params = |n: &AnalyticNdf, e| Params {
             alpha_x: n.alpha_x,
             alpha_y: n.alpha_y,
@@ -242,7 +272,7 @@ fn fit_with(
             alpha_x: lsq.alpha_x,
             alpha_y: lsq.alpha_y,
             rotation: lsq.rotation,
-            error: microfacet_error(&lsq_model, &set),
+            error,
             method: "least_squares".into(),
             moments,
             fresnel: lsq_fresnel,

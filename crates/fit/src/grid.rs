@@ -2,64 +2,23 @@
 //!
 //! The Fresnel average and the error metric both run over every valid sample of a source on
 //! the MERL grid (bin lower edges, both directions above the horizon, the sample present).
-//! Isotropic microfacet models take a fast path: D depends only on the θh bin, F only on the
-//! θd bin and G1 only on θ, so each is a small table; `tests/grid.rs` checks it against the
+//! Isotropic sources are held in a compact row form (`iso_grid.rs`), and isotropic
+//! microfacet models take a fast path there: D depends only on the θh bin, F only on the θd
+//! bin and Λ only on cos θ, so each is a small table; `tests/models.rs` checks it against the
 //! direct evaluation.
 
 use crate::brdf::{Brdf, Rgb};
 use crate::geometry::{HalfDiff, azimuth_between, from_half_diff};
+use crate::iso_grid::IsoSamples;
 use crate::merl::{self, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles};
 use crate::microfacet::{MicrofacetBrdf, Ndf, correlation, g2};
 use glam::DVec3;
 use rayon::prelude::*;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 use std::sync::OnceLock;
 
-/// Entries of the Λ cos θ tables of the fast path, uniform in θ over [0, π/2].
-const LAMBDA_TABLE: usize = 4096;
-
-/// Geometry of one grid bin (rotation-independent), in the form the inner loops use.
-#[derive(Clone, Copy, Debug)]
-struct BinGeometry {
-    cos_i: f32,
-    inv_cos_i: f32,
-    inv_cos_o: f32,
-    /// θi and θo in units of the Λ cos θ table's step.
-    gi: f32,
-    go: f32,
-    /// λ(φ) of the correlated G2, φ the azimuth between wi and wo.
-    corr: f32,
-}
-
-/// Per-bin geometry of the whole grid, computed once per process (the grid never changes).
-fn geometry() -> &'static [BinGeometry] {
-    static GEOMETRY: OnceLock<Vec<BinGeometry>> = OnceLock::new();
-    GEOMETRY.get_or_init(|| {
-        let step = (LAMBDA_TABLE - 1) as f64 / FRAC_PI_2;
-        (0..SAMPLES)
-            .into_par_iter()
-            .map(|s| {
-                let (wi, wo) = from_half_diff(bin_angles(
-                    s / (PHI_D_RES * THETA_D_RES),
-                    s / PHI_D_RES % THETA_D_RES,
-                    s % PHI_D_RES,
-                ));
-                BinGeometry {
-                    cos_i: wi.z as f32,
-                    inv_cos_i: (1.0 / wi.z) as f32,
-                    inv_cos_o: (1.0 / wo.z) as f32,
-                    gi: (wi.z.clamp(-1.0, 1.0).acos() * step) as f32,
-                    go: (wo.z.clamp(-1.0, 1.0).acos() * step) as f32,
-                    corr: correlation(azimuth_between(wi, wo)) as f32,
-                }
-            })
-            .collect()
-    })
-}
-
-fn above_horizon(g: &BinGeometry) -> bool {
-    g.inv_cos_i > 0.0 && g.inv_cos_o > 0.0
-}
+/// Entries of the Λ cos θ tables of the fast path, uniform in cos θ over [0, 1].
+pub(crate) const LAMBDA_TABLE: usize = 4096;
 
 /// The largest x = f_r cos θi a source may give on the MERL grid: a GGX mirror of α = 10⁻⁴ at
 /// its peak stays below 10⁹; beyond 10¹² the f32 sums over 1.5·10⁶ samples of the Fresnel
@@ -87,8 +46,11 @@ pub struct GridSample {
 pub struct GridSamples {
     /// Azimuths φh at which the grid is laid: `[0]` for isotropic sources.
     pub rotations: Vec<f64>,
-    /// The valid samples, in MERL bin order for each rotation.
-    pub samples: Vec<GridSample>,
+    /// The samples as a list: given for anisotropic sources, built on first use from the
+    /// compact form for isotropic ones.
+    samples: OnceLock<Vec<GridSample>>,
+    /// The compact form of an isotropic source's samples.
+    pub(crate) iso: Option<IsoSamples>,
 }
 
 impl GridSamples {
@@ -97,58 +59,14 @@ impl GridSamples {
     /// φd bin, to keep the sample count that of one full grid.
     pub fn new(src: &dyn Brdf) -> Self {
         if src.is_isotropic() {
-            let table = src.merl_table();
-            let geo = geometry();
-            // Count the valid samples of each θh bin, then fill one allocation in place, a θh bin
-            // per task (no intermediate vectors, no zeroing: page faults dominate this step).
-            let per_i = THETA_D_RES * PHI_D_RES;
-            let valid_in = |i: usize| {
-                (i * per_i..(i + 1) * per_i).filter_map(|s| {
-                    let g = &geo[s];
-                    if !above_horizon(g) {
-                        return None;
-                    }
-                    table.value_at(s).map(|v| make_sample(s, 0, v, g))
-                })
-            };
-            let counts: Vec<usize> = (0..THETA_H_RES)
-                .into_par_iter()
-                .map(|i| {
-                    (i * per_i..(i + 1) * per_i)
-                        .filter(|&s| above_horizon(&geo[s]) && table.value_at(s).is_some())
-                        .count()
-                })
-                .collect();
-            let total = counts.iter().sum();
-            let mut samples: Vec<GridSample> = Vec::with_capacity(total);
-            let mut chunks = Vec::with_capacity(THETA_H_RES);
-            let mut rest = &mut samples.spare_capacity_mut()[..total];
-            for &n in &counts {
-                let (head, tail) = rest.split_at_mut(n);
-                chunks.push(head);
-                rest = tail;
-            }
-            chunks.into_par_iter().enumerate().for_each(|(i, chunk)| {
-                let mut written = 0;
-                for (out, s) in chunk.iter_mut().zip(valid_in(i)) {
-                    out.write(s);
-                    written += 1;
-                }
-                assert_eq!(
-                    written,
-                    chunk.len(),
-                    "the count and fill passes use one predicate"
-                );
-            });
-            // SAFETY: every one of the `total` slots was written above (asserted per chunk).
-            unsafe { samples.set_len(total) };
             return GridSamples {
                 rotations: vec![0.0],
-                samples,
+                samples: OnceLock::new(),
+                iso: Some(IsoSamples::new(src)),
             };
         }
         let rotations: Vec<f64> = (0..4).map(|r| r as f64 * PI / 4.0).collect();
-        let samples = (0..SAMPLES * rotations.len())
+        let samples: Vec<GridSample> = (0..SAMPLES * rotations.len())
             .into_par_iter()
             .filter_map(|sr| {
                 let (s, r) = (sr % SAMPLES, sr / SAMPLES);
@@ -156,38 +74,96 @@ impl GridSamples {
                 if j % 2 == 1 || k % 2 == 1 {
                     return None;
                 }
-                if !above_horizon(&geometry()[s]) {
+                let (wi, wo) = sample_directions(s, rotations[r]);
+                if !(wi.z > 0.0 && wo.z > 0.0) {
                     return None;
                 }
-                let (wi, wo) = sample_directions(s, rotations[r]);
                 let v = src.eval(wi, wo)?;
-                Some(make_sample(s, r as u8, v, &geometry()[s]))
+                Some(make_sample(s, r as u8, v, wi.z))
             })
             .collect();
-        GridSamples { rotations, samples }
+        GridSamples {
+            rotations,
+            samples: OnceLock::from(samples),
+            iso: None,
+        }
     }
 
-    /// Every `stride`-th sample: the cheap set that parameter searches run on.
+    /// A cheaper set for parameter searches: every `stride`-th (θh, θd) row holding samples,
+    /// with all its φd bins, of an isotropic source; every `stride`-th sample otherwise.
     pub fn subsample(&self, stride: usize) -> GridSamples {
+        if let Some(iso) = &self.iso {
+            return GridSamples {
+                rotations: self.rotations.clone(),
+                samples: OnceLock::new(),
+                iso: Some(iso.subsample(stride)),
+            };
+        }
         GridSamples {
             rotations: self.rotations.clone(),
-            samples: self
-                .samples
-                .iter()
-                .step_by(stride.max(1))
-                .copied()
-                .collect(),
+            samples: OnceLock::from(
+                self.samples()
+                    .iter()
+                    .step_by(stride.max(1))
+                    .copied()
+                    .collect::<Vec<_>>(),
+            ),
+            iso: None,
         }
+    }
+
+    /// The valid samples, in MERL bin order for each rotation. For an isotropic source they are
+    /// built from the compact form on first use (x from ln(1 + x), to f32 precision).
+    pub fn samples(&self) -> &[GridSample] {
+        self.samples.get_or_init(|| {
+            let iso = self
+                .iso
+                .as_ref()
+                .expect("a set without a list is isotropic");
+            iso.rows
+                .iter()
+                .flat_map(|&r| iso.row_samples(r as usize))
+                .map(|(s, log_x)| GridSample {
+                    bin: s as u32,
+                    rot: 0,
+                    i: (s / (PHI_D_RES * THETA_D_RES)) as u8,
+                    j: (s / PHI_D_RES % THETA_D_RES) as u8,
+                    x: log_x.map(|l| (l as f64).exp_m1() as f32),
+                    log_x,
+                })
+                .collect()
+        })
+    }
+
+    /// The first sample whose x = f_r cos θi is not finite or beyond ±[`MAX_X`].
+    pub fn out_of_range(&self) -> Option<GridSample> {
+        if let Some(iso) = &self.iso {
+            return iso.data.out_of_range.map(|(s, x)| GridSample {
+                bin: s as u32,
+                rot: 0,
+                i: (s / (PHI_D_RES * THETA_D_RES)) as u8,
+                j: (s / PHI_D_RES % THETA_D_RES) as u8,
+                x,
+                log_x: [0.0; 3],
+            });
+        }
+        self.samples()
+            .iter()
+            .find(|s| s.x.iter().any(|x| !(x.abs() <= MAX_X)))
+            .copied()
     }
 
     /// The number of valid samples.
     pub fn len(&self) -> usize {
-        self.samples.len()
+        match &self.iso {
+            Some(iso) => iso.count,
+            None => self.samples().len(),
+        }
     }
 
     /// Whether there is no valid sample.
     pub fn is_empty(&self) -> bool {
-        self.samples.is_empty()
+        self.len() == 0
     }
 
     /// (wi, wo) of a sample.
@@ -196,8 +172,8 @@ impl GridSamples {
     }
 }
 
-fn make_sample(s: usize, rot: u8, v: Rgb, g: &BinGeometry) -> GridSample {
-    let x = v.map(|f| (f * g.cos_i as f64) as f32);
+fn make_sample(s: usize, rot: u8, v: Rgb, cos_i: f64) -> GridSample {
+    let x = v.map(|f| (f * cos_i) as f32);
     GridSample {
         bin: s as u32,
         rot,
@@ -210,9 +186,12 @@ fn make_sample(s: usize, rot: u8, v: Rgb, g: &BinGeometry) -> GridSample {
 
 /// ln(1 + x) in f32 for x ≥ 0, to ~2e-7: exponent and mantissa split, the mantissa brought
 /// into m ∈ [√½, √2) and ln m = t·P(t), t = m − 1, P a degree-7 Chebyshev fit (max error
-/// 6e-8). No division and no branch: the metric spends most of its time here, and libm's
-/// log1pf is several times slower.
-#[inline]
+/// 6e-8). Below x = 1/16, where rounding 1 + x would cost relative accuracy, the series
+/// x − x²/2 + x³/3 − x⁴/4 + x⁵/5 (error below x⁶/6 ≤ 1e-8, 1.6e-7 relative) is taken instead, so
+/// that x is recovered from ln(1 + x) to f32 precision. No division and no branch (both are
+/// computed and one selected): the metric spends most of its time here and vectorises it, and
+/// libm's log1pf is several times slower.
+#[inline(always)]
 pub fn ln_1p(x: f32) -> f32 {
     const P: [f32; 8] = [
         0.999_999_94,
@@ -224,7 +203,8 @@ pub fn ln_1p(x: f32) -> f32 {
         0.162_343_81,
         -0.101_341_79,
     ];
-    let y = 1.0 + x.max(0.0);
+    let x = x.max(0.0);
+    let y = 1.0 + x;
     let bits = y.to_bits();
     let m1 = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
     // Branch-free: mantissas are random, a branch would mispredict half the time.
@@ -240,7 +220,9 @@ pub fn ln_1p(x: f32) -> f32 {
     let p45 = P[4] + P[5] * t;
     let p67 = P[6] + P[7] * t;
     let p = (p01 + p23 * t2) + (p45 + p67 * t2) * t4;
-    e as f32 * std::f32::consts::LN_2 + t * p
+    let big = e as f32 * std::f32::consts::LN_2 + t * p;
+    let small = x * (1.0 + x * (-0.5 + x * (1.0 / 3.0 + x * (-0.25 + x * 0.2))));
+    if x < 0.0625 { small } else { big }
 }
 
 fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
@@ -253,16 +235,18 @@ fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
 }
 
 /// An isotropic microfacet model reduced to tables over the grid's bins.
+#[derive(Clone)]
 pub struct IsoTables {
-    /// D at each θh bin.
-    d: [f64; THETA_H_RES],
-    /// Λ(θ) cos θ on [0, π/2], uniform in θ: finite at 90° where Λ diverges (GGX: α/2), so it
-    /// interpolates well, and Λ = table · (1/cos θ) needs no division in the inner loop.
-    lambda_cos: Vec<f64>,
+    /// D at each θh bin, in f32 as the passes use it.
+    pub(crate) d32: [f32; THETA_H_RES],
+    /// Λ(θ) cos θ as a function of μ = cos θ on [0, 1], uniform in μ: finite at μ = 0 where Λ
+    /// diverges (GGX: α/2), smooth in μ (GGX: (sqrt(μ² + α²(1 − μ²)) − μ) / 2), so it
+    /// interpolates well, and a bin's table coordinate is its cosine times a constant: no acos.
+    pub(crate) lambda_cos: Box<[f32; LAMBDA_TABLE]>,
     /// F at each θd bin.
-    fresnel: [Rgb; THETA_D_RES],
+    pub(crate) fresnel: [Rgb; THETA_D_RES],
     /// ρd/π.
-    diffuse: Rgb,
+    pub(crate) diffuse: Rgb,
 }
 
 impl IsoTables {
@@ -273,24 +257,24 @@ impl IsoTables {
         {
             return None;
         }
-        let d = std::array::from_fn(|i| {
+        let d32 = std::array::from_fn(|i| {
             model
                 .ndf
-                .d(crate::geometry::spherical(bin_angles(i, 0, 0).theta_h, 0.0))
+                .d(crate::geometry::spherical(bin_angles(i, 0, 0).theta_h, 0.0)) as f32
         });
-        let mut lambda_cos: Vec<f64> = (0..LAMBDA_TABLE - 1)
-            .map(|k| {
-                let t = k as f64 / (LAMBDA_TABLE - 1) as f64 * FRAC_PI_2;
-                model.ndf.lambda(crate::geometry::spherical(t, 0.0)) * t.cos()
-            })
-            .collect();
-        // At 90° Λ cos θ is ∞ · 0: extrapolate linearly from the two entries before it.
-        let n = lambda_cos.len();
-        lambda_cos.push((2.0 * lambda_cos[n - 1] - lambda_cos[n - 2]).max(0.0));
+        let last = (LAMBDA_TABLE - 1) as f64;
+        // Λ cos θ at μ_k = k / (n − 1), k ≥ 1; at μ = 0 it is ∞ · 0: extrapolated linearly.
+        let mut lambda_cos = Box::new([0.0f32; LAMBDA_TABLE]);
+        for (k, l) in lambda_cos.iter_mut().enumerate().skip(1) {
+            let mu = k as f64 / last;
+            let w = DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+            *l = (model.ndf.lambda(w) * mu) as f32;
+        }
+        lambda_cos[0] = (2.0 * lambda_cos[1] - lambda_cos[2]).max(0.0);
         let fresnel =
             std::array::from_fn(|j| model.fresnel.eval(bin_angles(0, j, 0).theta_d.cos()));
         Some(IsoTables {
-            d,
+            d32,
             lambda_cos,
             fresnel,
             diffuse: model.diffuse.map(|k| k / PI),
@@ -299,14 +283,14 @@ impl IsoTables {
 
     /// D per θh bin.
     #[cfg(feature = "gpu")]
-    pub(crate) fn d_table(&self) -> &[f64] {
-        &self.d
+    pub(crate) fn d_table(&self) -> &[f32] {
+        &self.d32
     }
 
-    /// Λ cos θ, uniform in θ over [0, π/2].
+    /// Λ cos θ, uniform in cos θ over [0, 1].
     #[cfg(feature = "gpu")]
-    pub(crate) fn lambda_cos_table(&self) -> &[f64] {
-        &self.lambda_cos
+    pub(crate) fn lambda_cos_table(&self) -> &[f32] {
+        &self.lambda_cos[..]
     }
 
     /// The same model with another Fresnel table.
@@ -314,44 +298,53 @@ impl IsoTables {
         self.fresnel.copy_from_slice(&f[..THETA_D_RES]);
     }
 
-    /// Λ cos θ at θ given in table steps.
-    #[inline]
-    fn lambda_cos(&self, x: f32) -> f64 {
-        let k = (x as usize).min(LAMBDA_TABLE - 2);
-        let t = x as f64 - k as f64;
-        self.lambda_cos[k] + t * (self.lambda_cos[k + 1] - self.lambda_cos[k])
-    }
-
-    /// D G2 / (4 cos θo): x = f cos θi of the model with F = 1 and no diffuse term; one
-    /// division (G2's).
-    #[inline(always)]
-    fn x_ideal(&self, g: &BinGeometry, s: &GridSample) -> f64 {
-        let li = self.lambda_cos(g.gi) * g.inv_cos_i as f64;
-        let lo = self.lambda_cos(g.go) * g.inv_cos_o as f64;
-        self.d[s.i as usize] * 0.25 * g.inv_cos_o as f64 * g2(li, lo, g.corr as f64)
-    }
-
-    #[inline]
-    fn x(&self, g: &BinGeometry, s: &GridSample) -> Rgb {
-        let ideal = self.x_ideal(g, s);
-        let f = self.fresnel[s.j as usize];
-        std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * g.cos_i as f64)
+    /// D G2 / (4 cos θo) at a sample of θh bin `i` given by its directions (the list path).
+    fn x_ideal_at(&self, wi: DVec3, wo: DVec3, i: usize) -> f64 {
+        let lambda = |mu: f64| {
+            let x = (mu * (LAMBDA_TABLE - 1) as f64).clamp(0.0, (LAMBDA_TABLE - 1) as f64);
+            let k = (x as usize).min(LAMBDA_TABLE - 2);
+            let (a, b) = (self.lambda_cos[k] as f64, self.lambda_cos[k + 1] as f64);
+            (a + (x - k as f64) * (b - a)) / mu
+        };
+        let g = g2(
+            lambda(wi.z),
+            lambda(wo.z),
+            correlation(azimuth_between(wi, wo)),
+        );
+        self.d32[i] as f64 * g / (4.0 * wo.z)
     }
 
     /// Σ over samples of Σ_c |ln(1 + x_model) − ln(1 + x_data)|.
     fn log_error_sum(&self, set: &GridSamples) -> f64 {
-        let geo = geometry();
-        set.samples
+        if let Some(iso) = &set.iso {
+            return iso.log_error_sum(self);
+        }
+        set.samples()
             .par_iter()
             .with_min_len(4096)
-            .map(|s| log_diff(self.x(&geo[s.bin as usize], s), s))
+            .map(|s| {
+                let (wi, wo) = set.directions(s);
+                let ideal = self.x_ideal_at(wi, wo, s.i as usize);
+                let f = self.fresnel[s.j as usize];
+                log_diff(
+                    std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * wi.z),
+                    s,
+                )
+            })
             .sum()
     }
 
     /// F per θd bin for this model's D and G (see [`fresnel_average`]).
     pub fn fresnel_average(&self, set: &GridSamples) -> Vec<Rgb> {
-        let geo = geometry();
-        average_per_theta_d(set, |s| self.x_ideal(&geo[s.bin as usize], s))
+        if let Some(iso) = &set.iso {
+            let num = iso.fresnel_numerators(self);
+            let den = iso.ideal_sums(self);
+            return fresnel_from_sums(&num.into_iter().zip(den).collect::<Vec<_>>());
+        }
+        average_per_theta_d(set, |s| {
+            let (wi, wo) = set.directions(s);
+            self.x_ideal_at(wi, wo, s.i as usize)
+        })
     }
 }
 
@@ -366,7 +359,7 @@ fn x_direct(model: &dyn Brdf, set: &GridSamples, s: &GridSample) -> Option<Rgb> 
 /// are left out.
 pub fn error_metric(model: &dyn Brdf, set: &GridSamples) -> f64 {
     let (sum, count) = set
-        .samples
+        .samples()
         .par_iter()
         .filter_map(|s| x_direct(model, set, s).map(|x| log_diff(x, s)))
         .fold(|| (0.0, 0usize), |(a, n), e| (a + e, n + 1))
@@ -380,6 +373,25 @@ pub fn microfacet_error(model: &MicrofacetBrdf, set: &GridSamples) -> f64 {
         return error_metric(model, set);
     };
     tables.log_error_sum(set) / (3 * set.len().max(1)) as f64
+}
+
+/// The model with a Fresnel table averaged for its own D and G ([`fresnel_average`]), and
+/// that model's error ([`microfacet_error`]): the two passes of a least-squares step, sharing
+/// G2 on an isotropic set.
+pub fn fresnel_and_error(model: &MicrofacetBrdf, set: &GridSamples) -> (Vec<Rgb>, f64) {
+    if let (Some(iso), Some(tables)) = (&set.iso, IsoTables::new(model)) {
+        let (f, e) = iso.fresnel_and_error_sum(&tables);
+        return (f, e / (3 * set.len().max(1)) as f64);
+    }
+    let f = fresnel_average(model, set);
+    let with = MicrofacetBrdf {
+        fresnel: crate::fresnel::Fresnel::Table(crate::fresnel::FresnelTable::on_merl_bins(
+            f.clone(),
+        )),
+        ..model.clone()
+    };
+    let e = microfacet_error(&with, set);
+    (f, e)
 }
 
 /// Error of an isotropic model given as tables (the parameter searches' inner loop).
@@ -408,13 +420,6 @@ pub fn fresnel_average(model: &MicrofacetBrdf, set: &GridSamples) -> Vec<Rgb> {
     }
 }
 
-/// For the GPU upload: (θi, θo in Λ-table steps, 1/cos θi, 1/cos θo, λ(φ)) of a sample.
-#[cfg(feature = "gpu")]
-pub(crate) fn sample_geometry(s: &GridSample) -> [f32; 5] {
-    let g = &geometry()[s.bin as usize];
-    [g.gi, g.go, g.inv_cos_i, g.inv_cos_o, g.corr]
-}
-
 /// F per θd bin from the sums (Σ x_data per channel, Σ x_ideal); empty bins interpolated.
 pub(crate) fn fresnel_from_sums(acc: &[([f64; 3], f64)]) -> Vec<Rgb> {
     let per_bin: Vec<Option<Rgb>> = acc
@@ -428,7 +433,7 @@ pub(crate) fn fresnel_from_sums(acc: &[([f64; 3], f64)]) -> Vec<Rgb> {
 fn average_per_theta_d(set: &GridSamples, ideal: impl Fn(&GridSample) -> f64 + Sync) -> Vec<Rgb> {
     type Acc = Vec<([f64; 3], f64)>;
     let acc: Acc = set
-        .samples
+        .samples()
         .par_iter()
         .with_min_len(4096)
         .fold(

@@ -49,9 +49,12 @@ pub mod geometry;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod grid;
+pub(crate) mod huge_pages;
 pub mod input;
+pub(crate) mod iso_grid;
 pub mod material;
 pub mod merl;
+pub(crate) mod merl_geometry;
 pub mod microfacet;
 pub mod nbrdf;
 pub mod params;

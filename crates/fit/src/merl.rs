@@ -77,7 +77,45 @@ impl std::fmt::Debug for MerlTable {
 impl MerlTable {
     /// Reads and validates a MERL `.binary` file.
     pub fn read(path: &Path) -> Result<Self, FitError> {
+        if let Some(table) = Self::read_standard(path)? {
+            return Ok(table);
+        }
         Self::parse(path, &crate::input::read(path, crate::input::Cap::MERL)?)
+    }
+
+    /// A file of exactly the standard size with the standard header, read straight into the
+    /// table (one 35 MB buffer, not a byte copy beside it); `None` for any other file, which
+    /// [`MerlTable::parse`] then reads and explains.
+    fn read_standard(path: &Path) -> Result<Option<Self>, FitError> {
+        use std::io::Read;
+        if cfg!(target_endian = "big") {
+            return Ok(None);
+        }
+        let (mut file, len) = crate::input::open(path, crate::input::Cap::MERL)?;
+        if len != HEADER_BYTES + (3 * 8 * SAMPLES) as u64 {
+            return Ok(None);
+        }
+        let mut header = [0u8; HEADER_BYTES as usize];
+        let mut raw = vec![0.0f64; 3 * SAMPLES];
+        crate::huge_pages::advise(&mut raw);
+        let io = |e| FitError::io(path, e);
+        file.read_exact(&mut header).map_err(io)?;
+        let dims: [i32; 3] = std::array::from_fn(|d| {
+            i32::from_le_bytes(header[4 * d..4 * d + 4].try_into().unwrap())
+        });
+        if dims != [THETA_H_RES as i32, THETA_D_RES as i32, PHI_D_RES as i32] {
+            return Ok(None);
+        }
+        file.read_exact(bytemuck::cast_slice_mut(&mut raw))
+            .map_err(io)?;
+        // One byte more would be a file that grew while read: the general path explains it.
+        if file.read(&mut [0u8]).map_err(io)? != 0 {
+            return Ok(None);
+        }
+        if raw.iter().any(|v| !(*v <= MAX_STORED)) {
+            return Ok(None); // the general path names the sample
+        }
+        Ok(Some(MerlTable { raw }))
     }
 
     /// Validates the bytes of a MERL file; `path` names it in errors.
@@ -205,6 +243,12 @@ impl MerlTable {
             }
         }
         MerlTable { raw }
+    }
+
+    /// The stored values of channel `c` (0 red, 1 green, 2 blue) in flat bin order: f_r is a
+    /// value times `SCALE[c]`, negative where missing.
+    pub(crate) fn channel(&self, c: usize) -> &[f64] {
+        &self.raw[c * SAMPLES..(c + 1) * SAMPLES]
     }
 
     /// f_r of bin (i, j, k), or `None` if the sample is missing.

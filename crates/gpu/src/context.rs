@@ -86,34 +86,45 @@ fn rank(info: &wgpu::AdapterInfo) -> (u32, u32) {
     (kind, backend)
 }
 
+/// The best-ranked adapter allowed by `opts`.
+fn best_adapter(opts: &GpuOptions) -> Result<wgpu::Adapter, GpuError> {
+    let backends = opts
+        .backends
+        .unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::GL);
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = backends;
+    let instance = wgpu::Instance::new(desc);
+    let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+    if let Some(name) = &opts.adapter_name {
+        let name = name.to_ascii_lowercase();
+        adapters.retain(|a| a.get_info().name.to_ascii_lowercase().contains(&name));
+    }
+    adapters.sort_by_key(|a| rank(&a.get_info()));
+    adapters.into_iter().next().ok_or_else(|| {
+        GpuError::NoAdapter(match &opts.adapter_name {
+            Some(n) => format!("none matches FACET_ADAPTER={n} on {backends:?}"),
+            None => {
+                format!("none found on {backends:?} (install mesa-vulkan-drivers for lavapipe)")
+            }
+        })
+    })
+}
+
 impl Gpu {
     /// The best adapter under `FACET_BACKEND` / `FACET_ADAPTER`.
     pub fn new() -> Result<Self, GpuError> {
         Self::with_options(&GpuOptions::from_env()?)
     }
 
+    /// The adapter [`Gpu::new`] would take, without opening a device on it (which costs tens of
+    /// milliseconds on a software adapter that a caller may not want).
+    pub fn best_adapter_info() -> Result<wgpu::AdapterInfo, GpuError> {
+        Ok(best_adapter(&GpuOptions::from_env()?)?.get_info())
+    }
+
     /// An adapter and device chosen by `opts`.
     pub fn with_options(opts: &GpuOptions) -> Result<Self, GpuError> {
-        let backends = opts
-            .backends
-            .unwrap_or(wgpu::Backends::VULKAN | wgpu::Backends::GL);
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
-        let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
-        if let Some(name) = &opts.adapter_name {
-            let name = name.to_ascii_lowercase();
-            adapters.retain(|a| a.get_info().name.to_ascii_lowercase().contains(&name));
-        }
-        adapters.sort_by_key(|a| rank(&a.get_info()));
-        let adapter = adapters.into_iter().next().ok_or_else(|| {
-            GpuError::NoAdapter(match &opts.adapter_name {
-                Some(n) => format!("none matches FACET_ADAPTER={n} on {backends:?}"),
-                None => {
-                    format!("none found on {backends:?} (install mesa-vulkan-drivers for lavapipe)")
-                }
-            })
-        })?;
+        let adapter = best_adapter(opts)?;
         let info = adapter.get_info();
         let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let mut limits = adapter.limits();

@@ -3,8 +3,9 @@
 
 use super::GpuSample;
 use crate::brdf::Rgb;
-use crate::grid::{GridSamples, IsoTables, fresnel_from_sums, sample_geometry};
+use crate::grid::{GridSamples, IsoTables, LAMBDA_TABLE, fresnel_from_sums};
 use crate::merl::THETA_D_RES;
+use crate::merl_geometry::{ROW, merl_geometry};
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// The Fresnel average over the MERL grid on the GPU (`shaders/fit/fresnel.wgsl`).
@@ -31,31 +32,33 @@ impl FresnelAverage {
 
     /// Uploads an isotropic sample set (the GPU path covers isotropic sources only).
     pub fn upload(&self, gpu: &Gpu, set: &GridSamples) -> Result<GpuSamples, GpuError> {
-        let mut order: Vec<usize> = (0..set.len()).collect();
-        order.sort_by_key(|&k| set.samples[k].j);
-        let samples: Vec<GpuSample> = order
-            .iter()
-            .map(|&k| {
-                let s = &set.samples[k];
-                let [gi, go, inv_cos_i, inv_cos_o, corr] = sample_geometry(s);
-                GpuSample {
-                    x: s.x,
-                    i: s.i as u32,
-                    gi,
-                    go,
-                    inv_cos_i,
-                    inv_cos_o,
-                    corr,
-                    pad: [0.0; 3],
-                }
-            })
-            .collect();
+        let iso = set
+            .iso
+            .as_ref()
+            .expect("the GPU Fresnel average takes isotropic sample sets");
+        let geo = merl_geometry();
+        let scale = (LAMBDA_TABLE - 1) as f32;
+        let mut samples = Vec::with_capacity(iso.count);
         let mut offsets = vec![0u32; THETA_D_RES + 1];
-        for s in &set.samples {
-            offsets[s.j as usize + 1] += 1;
-        }
+        // Sorted by θd bin: a workgroup per bin.
         for j in 0..THETA_D_RES {
-            offsets[j + 1] += offsets[j];
+            for &r in iso.rows.iter().filter(|&&r| r as usize % THETA_D_RES == j) {
+                let r = r as usize;
+                let (mu, corr) = (geo.mu_row(r), geo.corr_row(r));
+                for k in (0..ROW).filter(|&k| iso.valid(r * ROW + k)) {
+                    let (mu_i, mu_o) = (mu[ROW - k], mu[k]);
+                    samples.push(GpuSample {
+                        i: (r / THETA_D_RES) as u32,
+                        gi: mu_i * scale,
+                        go: mu_o * scale,
+                        inv_cos_i: 1.0 / mu_i,
+                        inv_cos_o: 1.0 / mu_o,
+                        corr: corr[k],
+                        pad: [0.0; 2],
+                    });
+                }
+            }
+            offsets[j + 1] = samples.len() as u32;
         }
         buffer::check_binding(
             &gpu.device,
@@ -68,20 +71,22 @@ impl FresnelAverage {
         })
     }
 
-    /// F per θd bin and channel for a model given as tables: Σ x_data / Σ x_ideal.
+    /// F per θd bin and channel for a model given as tables: Σ x_data / Σ x_ideal, the
+    /// denominators summed on the GPU, the numerators (per-row sums of the source, kept by the
+    /// set) on the CPU. `samples` is `set` uploaded.
     pub fn average(
         &self,
         gpu: &Gpu,
         samples: &GpuSamples,
+        set: &GridSamples,
         model: &IsoTables,
     ) -> Result<Vec<Rgb>, GpuError> {
         let d = &gpu.device;
-        let f32s = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
         let (ndf, lambda_cos, sums) = gpu.scoped(|| {
             (
-                buffer::storage(d, "ndf per theta_h bin", &f32s(model.d_table())),
-                buffer::storage(d, "lambda cos", &f32s(model.lambda_cos_table())),
-                buffer::storage_zeroed(d, "fresnel sums", (THETA_D_RES * 16) as u64),
+                buffer::storage(d, "ndf per theta_h bin", model.d_table()),
+                buffer::storage(d, "lambda cos", model.lambda_cos_table()),
+                buffer::storage_zeroed(d, "fresnel sums", (THETA_D_RES * 4) as u64),
             )
         })?;
         let resources = [
@@ -102,10 +107,12 @@ impl FresnelAverage {
             THETA_D_RES as u32 * wg,
             wg,
         );
-        let raw: Vec<[f32; 4]> = buffer::read(d, &gpu.queue, &sums, THETA_D_RES)?;
-        let acc: Vec<([f64; 3], f64)> = raw
-            .iter()
-            .map(|s| ([s[0] as f64, s[1] as f64, s[2] as f64], s[3] as f64))
+        let raw: Vec<f32> = buffer::read(d, &gpu.queue, &sums, THETA_D_RES)?;
+        let iso = set.iso.as_ref().expect("an uploaded set is isotropic");
+        let acc: Vec<([f64; 3], f64)> = iso
+            .fresnel_numerators(model)
+            .into_iter()
+            .zip(raw.iter().map(|&s| s as f64))
             .collect();
         Ok(fresnel_from_sums(&acc))
     }

@@ -44,14 +44,13 @@ pub struct GpuState {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuSample {
-    pub x: [f32; 3],
     pub i: u32,
     pub gi: f32,
     pub go: f32,
     pub inv_cos_i: f32,
     pub inv_cos_o: f32,
     pub corr: f32,
-    pub pad: [f32; 3],
+    pub pad: [f32; 2],
 }
 
 /// The GPU pipelines of the fitter, built once and reused for every material.

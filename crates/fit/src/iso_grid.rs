@@ -1,0 +1,506 @@
+//! An isotropic source's samples on the MERL grid in compact form, and the two passes over
+//! them: the Fresnel average and the error metric of an isotropic microfacet model.
+//!
+//! The samples are stored row by row ([`crate::merl_geometry`]): ln(1 + x) per channel and a
+//! validity flag for each of the 180 φd bins, Σ x per channel and the valid count per row.
+//! A pass runs over rows (rayon over θh bins): per row D is one number (θh alone), F one
+//! RGB value (θd alone), Λ is read from a table uniform in cos θ at the row's 181 cosines, and
+//! G2 / (4 cos θo) is formed for the 180 bins in loops of fixed length the compiler vectorises;
+//! the sums run in eight f32 lanes per row and in f64 across rows.
+
+use crate::brdf::Brdf;
+use crate::brdf::Rgb;
+use crate::grid::{IsoTables, LAMBDA_TABLE, MAX_X, fresnel_from_sums, ln_1p};
+use crate::merl::{THETA_D_RES, THETA_H_RES};
+use crate::merl_geometry::{MU_ROW, MerlGeometry, ROW, ROWS, merl_geometry};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// Bins per row rounded up to the sums' eight lanes.
+const PADDED: usize = ROW.div_ceil(8) * 8;
+
+/// The samples of one isotropic source over the whole grid.
+pub(crate) struct IsoData {
+    /// ln(1 + x) per bin, row r channel c at `(3 r + c) · ROW`; 0 where invalid.
+    log_x: Vec<f32>,
+    /// Whether the bin holds a valid sample (both directions above the horizon, a value).
+    valid: Vec<bool>,
+    /// Σ x per channel over the row's valid bins (x as stored, f32, summed in f64).
+    sum_x: Vec<[f64; 3]>,
+    /// Valid bins per row.
+    count: Vec<u16>,
+    /// The first sample with |x| beyond [`MAX_X`] or not finite: (flat bin, x).
+    pub out_of_range: Option<(usize, [f32; 3])>,
+}
+
+/// A set of rows of an [`IsoData`]: the whole grid, or a subsample for searches.
+#[derive(Clone)]
+pub(crate) struct IsoSamples {
+    pub data: Arc<IsoData>,
+    /// The rows in the set that hold a valid sample, increasing.
+    pub rows: Vec<u16>,
+    /// Valid samples in those rows.
+    pub count: usize,
+}
+
+impl IsoSamples {
+    /// The samples of an isotropic source from its MERL table.
+    pub fn new(src: &dyn Brdf) -> Self {
+        let table = src.merl_table();
+        let geo = merl_geometry();
+        let per_i = THETA_D_RES;
+        let mut log_x = vec![0.0f32; 3 * ROWS * ROW];
+        let mut valid = vec![false; ROWS * ROW];
+        crate::huge_pages::advise(&mut log_x);
+        crate::huge_pages::advise(&mut valid);
+        let mut sum_x = vec![[0.0f64; 3]; ROWS];
+        let mut count = vec![0u16; ROWS];
+        let channels = [table.channel(0), table.channel(1), table.channel(2)];
+        let out_of_range = log_x
+            .par_chunks_mut(3 * per_i * ROW)
+            .zip(valid.par_chunks_mut(per_i * ROW))
+            .zip(sum_x.par_chunks_mut(per_i))
+            .zip(count.par_chunks_mut(per_i))
+            .enumerate()
+            .map(|(i, (((log_x, valid), sum_x), count))| {
+                let rows = RowsOut {
+                    first: i * per_i,
+                    log_x,
+                    valid,
+                    sum_x,
+                    count,
+                };
+                build_rows(rows, channels, geo)
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .flatten()
+            .next();
+        let data = IsoData {
+            log_x,
+            valid,
+            sum_x,
+            count,
+            out_of_range,
+        };
+        Self::rows_of(Arc::new(data))
+    }
+
+    /// The rows of `data` that hold samples.
+    fn rows_of(data: Arc<IsoData>) -> Self {
+        let rows: Vec<u16> = (0..ROWS)
+            .filter(|&r| data.count[r] > 0)
+            .map(|r| r as u16)
+            .collect();
+        let count = rows.iter().map(|&r| data.count[r as usize] as usize).sum();
+        IsoSamples { data, rows, count }
+    }
+
+    /// Every `stride`-th row of this set holding samples (all of their φd bins).
+    pub fn subsample(&self, stride: usize) -> Self {
+        let rows: Vec<u16> = self.rows.iter().copied().step_by(stride.max(1)).collect();
+        let count = rows
+            .iter()
+            .map(|&r| self.data.count[r as usize] as usize)
+            .sum();
+        IsoSamples {
+            data: self.data.clone(),
+            rows,
+            count,
+        }
+    }
+
+    /// The valid bins of row `r` with ln(1 + x) per channel: (flat bin, ln(1 + x)).
+    pub fn row_samples(&self, r: usize) -> impl Iterator<Item = (usize, [f32; 3])> + '_ {
+        let d = &self.data;
+        (0..ROW)
+            .filter(move |&k| d.valid[r * ROW + k])
+            .map(move |k| {
+                let l = std::array::from_fn(|c| d.log_x[(3 * r + c) * ROW + k]);
+                (r * ROW + k, l)
+            })
+    }
+
+    /// Whether a row's bin is valid.
+    #[cfg(feature = "gpu")]
+    pub fn valid(&self, s: usize) -> bool {
+        self.data.valid[s]
+    }
+
+    /// Σ x per channel over the valid samples of each θd bin, counting the rows whose D is
+    /// positive: the numerators of the Fresnel average.
+    pub fn fresnel_numerators(&self, tables: &IsoTables) -> Vec<[f64; 3]> {
+        let mut num = vec![[0.0; 3]; THETA_D_RES];
+        for &r in &self.rows {
+            let r = r as usize;
+            if tables.d32[r / THETA_D_RES] > 0.0 {
+                let s = self.data.sum_x[r];
+                (0..3).for_each(|c| num[r % THETA_D_RES][c] += s[c]);
+            }
+        }
+        num
+    }
+
+    /// Σ over valid samples of x_ideal = D G2 / (4 cos θo) per θd bin (rows with D > 0).
+    pub fn ideal_sums(&self, tables: &IsoTables) -> Vec<f64> {
+        self.run(&IdealSums { set: self, tables })
+    }
+
+    /// Σ over samples of Σ_c |ln(1 + x_model) − ln(1 + x_data)|, x_model = F D G2 / (4 cos θo)
+    /// + ρd/π cos θi.
+    pub fn log_error_sum(&self, tables: &IsoTables) -> f64 {
+        self.run(&ErrorSum {
+            set: self,
+            tables,
+            cached: None,
+        })
+    }
+
+    /// The Fresnel average of a model and the error sum of the model with it, G2 / (4 cos θo)
+    /// formed once: kept from the first pass (the sums) for the second (the error).
+    pub fn fresnel_and_error_sum(&self, tables: &IsoTables) -> (Vec<Rgb>, f64) {
+        let (den, ideal) = self.run(&IdealRows { set: self, tables });
+        let num = self.fresnel_numerators(tables);
+        let fresnel = fresnel_from_sums(&num.into_iter().zip(den).collect::<Vec<_>>());
+        let mut at = vec![0u32; ROWS];
+        for (p, &r) in self.rows.iter().enumerate() {
+            at[r as usize] = p as u32;
+        }
+        let tables = IsoTables {
+            fresnel: std::array::from_fn(|j| fresnel[j]),
+            ..tables.clone()
+        };
+        let e = self.run(&ErrorSum {
+            set: self,
+            tables: &tables,
+            cached: Some((&ideal, &at)),
+        });
+        (fresnel, e)
+    }
+
+    /// A pass over this set's rows, a θh bin's rows per task.
+    fn run<P: RowPass>(&self, pass: &P) -> P::Acc {
+        // Rows are increasing: split them by θh bin.
+        let bounds: Vec<usize> = (0..=THETA_H_RES)
+            .map(|i| {
+                self.rows
+                    .partition_point(|&r| (r as usize) < i * THETA_D_RES)
+            })
+            .collect();
+        (0..THETA_H_RES)
+            .into_par_iter()
+            .fold(P::init, |mut acc, i| {
+                run_rows(pass, &mut acc, &self.rows[bounds[i]..bounds[i + 1]]);
+                acc
+            })
+            .reduce(P::init, |mut a, b| {
+                P::merge(&mut a, b);
+                a
+            })
+    }
+}
+
+/// A pass: an accumulator, what one row adds to it, how two merge.
+trait RowPass: Sync {
+    type Acc: Send;
+    fn init() -> Self::Acc;
+    fn row(&self, acc: &mut Self::Acc, r: usize);
+    fn merge(a: &mut Self::Acc, b: Self::Acc);
+}
+
+/// Σ x_ideal per θd bin.
+struct IdealSums<'a> {
+    set: &'a IsoSamples,
+    tables: &'a IsoTables,
+}
+
+impl RowPass for IdealSums<'_> {
+    type Acc = Vec<f64>;
+
+    fn init() -> Vec<f64> {
+        vec![0.0; THETA_D_RES]
+    }
+
+    #[inline(always)]
+    fn row(&self, acc: &mut Vec<f64>, r: usize) {
+        let d = self.tables.d32[r / THETA_D_RES];
+        if !(d > 0.0) {
+            return;
+        }
+        let mut ideal = [0.0f32; PADDED];
+        row_ideal(self.tables, merl_geometry(), r, &mut ideal);
+        let valid = &self.set.data.valid[r * ROW..(r + 1) * ROW];
+        for (x, &v) in ideal.iter_mut().zip(valid) {
+            *x = if v { *x } else { 0.0 };
+        }
+        ideal[ROW..].fill(0.0);
+        acc[r % THETA_D_RES] += d as f64 * lanes_sum(&ideal);
+    }
+
+    fn merge(a: &mut Vec<f64>, b: Vec<f64>) {
+        a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+    }
+}
+
+/// Σ x_ideal per θd bin, and each row's G2 / (4 cos θo) kept (`PADDED` per row, in row order).
+struct IdealRows<'a> {
+    set: &'a IsoSamples,
+    tables: &'a IsoTables,
+}
+
+impl RowPass for IdealRows<'_> {
+    type Acc = (Vec<f64>, Vec<f32>);
+
+    fn init() -> Self::Acc {
+        (vec![0.0; THETA_D_RES], Vec::new())
+    }
+
+    #[inline(always)]
+    fn row(&self, acc: &mut Self::Acc, r: usize) {
+        let mut ideal = [0.0f32; PADDED];
+        row_ideal(self.tables, merl_geometry(), r, &mut ideal);
+        acc.1.extend_from_slice(&ideal);
+        let d = self.tables.d32[r / THETA_D_RES];
+        if !(d > 0.0) {
+            return;
+        }
+        let valid = &self.set.data.valid[r * ROW..(r + 1) * ROW];
+        for (x, &v) in ideal.iter_mut().zip(valid) {
+            *x = if v { *x } else { 0.0 };
+        }
+        ideal[ROW..].fill(0.0);
+        acc.0[r % THETA_D_RES] += d as f64 * lanes_sum(&ideal);
+    }
+
+    fn merge(a: &mut Self::Acc, b: Self::Acc) {
+        a.0.iter_mut().zip(b.0).for_each(|(a, b)| *a += b);
+        a.1.extend_from_slice(&b.1);
+    }
+}
+
+/// Σ of the error over samples and channels.
+struct ErrorSum<'a> {
+    set: &'a IsoSamples,
+    tables: &'a IsoTables,
+    /// G2 / (4 cos θo) of every row already formed, and each row's place in it.
+    cached: Option<(&'a [f32], &'a [u32])>,
+}
+
+impl RowPass for ErrorSum<'_> {
+    type Acc = f64;
+
+    fn init() -> f64 {
+        0.0
+    }
+
+    #[inline(always)]
+    fn row(&self, acc: &mut f64, r: usize) {
+        let (t, data) = (self.tables, &self.set.data);
+        let geo = merl_geometry();
+        let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
+        let mut ideal = [0.0f32; PADDED];
+        match self.cached {
+            Some((rows, at)) => {
+                let p = at[r] as usize * PADDED;
+                ideal.copy_from_slice(&rows[p..p + PADDED]);
+            }
+            None => row_ideal(t, geo, r, &mut ideal),
+        }
+        let d = t.d32[i];
+        let f = t.fresnel[j].map(|f| f as f32 * d);
+        let kd = t.diffuse.map(|k| k as f32);
+        let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
+        let mut e = [0.0f32; PADDED];
+        for c in 0..3 {
+            let log_x: &[f32; ROW] = data.log_x[(3 * r + c) * ROW..(3 * r + c + 1) * ROW]
+                .try_into()
+                .unwrap();
+            let (f, kd) = (f[c], kd[c]);
+            if kd != 0.0 {
+                for k in 0..ROW {
+                    // x = F D (G2 / (4 cos θo)) + ρd/π cos θi
+                    let x = f * ideal[k] + kd * mu[ROW - k];
+                    e[k] += (ln_1p(x) - log_x[k]).abs();
+                }
+            } else {
+                for k in 0..ROW {
+                    e[k] += (ln_1p(f * ideal[k]) - log_x[k]).abs();
+                }
+            }
+        }
+        let valid = &data.valid[r * ROW..(r + 1) * ROW];
+        for (e, &v) in e.iter_mut().zip(valid) {
+            *e = if v { *e } else { 0.0 };
+        }
+        e[ROW..].fill(0.0);
+        *acc += lanes_sum(&e);
+    }
+
+    fn merge(a: &mut f64, b: f64) {
+        *a += b;
+    }
+}
+
+/// A pass's rows, compiled for AVX2 as well where the CPU has it: the loops of a pass are
+/// written for the compiler to vectorise, and the baseline x86-64 target gives it four lanes
+/// (SSE2) where AVX2 gives eight. The results do not depend on the path taken: no
+/// floating-point operation is fused or reordered (Rust contracts nothing into FMA) and the
+/// sums run in eight lanes in both.
+#[inline(always)]
+fn run_rows<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F, checked just above.
+            return unsafe { run_rows_avx512(pass, acc, rows) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { run_rows_avx2(pass, acc, rows) };
+        }
+    }
+    run_rows_baseline(pass, acc, rows)
+}
+
+#[inline(always)]
+fn run_rows_baseline<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
+    for &r in rows {
+        pass.row(acc, r as usize);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn run_rows_avx2<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
+    run_rows_baseline(pass, acc, rows)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn run_rows_avx512<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
+    run_rows_baseline(pass, acc, rows)
+}
+
+/// The outputs of consecutive rows of an [`IsoData`] being built.
+struct RowsOut<'a> {
+    first: usize,
+    log_x: &'a mut [f32],
+    valid: &'a mut [bool],
+    sum_x: &'a mut [[f64; 3]],
+    count: &'a mut [u16],
+}
+
+/// Fills rows from the MERL channels (AVX2 where the CPU has it, as the passes); returns the
+/// first sample out of range.
+fn build_rows(out: RowsOut, raw: [&[f64]; 3], geo: &MerlGeometry) -> Option<(usize, [f32; 3])> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2, checked just above.
+        return unsafe { build_rows_avx2(out, raw, geo) };
+    }
+    build_rows_baseline(out, raw, geo)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn build_rows_avx2(
+    out: RowsOut,
+    raw: [&[f64]; 3],
+    geo: &MerlGeometry,
+) -> Option<(usize, [f32; 3])> {
+    build_rows_baseline(out, raw, geo)
+}
+
+#[inline(always)]
+fn build_rows_baseline(
+    out: RowsOut,
+    raw: [&[f64]; 3],
+    geo: &MerlGeometry,
+) -> Option<(usize, [f32; 3])> {
+    let mut bad = None;
+    for (n, (sum, count)) in out.sum_x.iter_mut().zip(out.count.iter_mut()).enumerate() {
+        let r = out.first + n;
+        let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
+        let valid: &mut [bool; ROW] = (&mut out.valid[n * ROW..(n + 1) * ROW]).try_into().unwrap();
+        let v: [&[f64; ROW]; 3] =
+            std::array::from_fn(|c| raw[c][r * ROW..(r + 1) * ROW].try_into().unwrap());
+        // Valid: both directions above the horizon and no channel missing (negative; a NaN
+        // is a value, refused below as out of range).
+        for k in 0..ROW {
+            valid[k] = mu[ROW - k] > 0.0
+                && mu[k] > 0.0
+                && !(v[0][k] < 0.0)
+                && !(v[1][k] < 0.0)
+                && !(v[2][k] < 0.0);
+        }
+        let mut x = [[0.0f32; ROW]; 3];
+        for c in 0..3 {
+            let scale = crate::merl::SCALE[c];
+            for k in 0..ROW {
+                // x = f_r cos θi
+                let xk = (v[c][k] * scale * mu[ROW - k] as f64) as f32;
+                x[c][k] = if valid[k] { xk } else { 0.0 };
+            }
+            let log_x: &mut [f32; ROW] = (&mut out.log_x[(3 * n + c) * ROW..(3 * n + c + 1) * ROW])
+                .try_into()
+                .unwrap();
+            for k in 0..ROW {
+                log_x[k] = ln_1p(x[c][k]);
+            }
+            sum[c] = x[c].iter().map(|&x| x as f64).sum();
+        }
+        *count = valid.iter().filter(|&&v| v).count() as u16;
+        if bad.is_none() {
+            bad = (0..ROW)
+                .find(|&k| valid[k] && x.iter().any(|x| !(x[k].abs() <= MAX_X)))
+                .map(|k| (r * ROW + k, std::array::from_fn(|c| x[c][k])));
+        }
+    }
+    bad
+}
+
+/// Σ of a row's values in eight f32 lanes (a fixed order, whatever the vector width), in f64.
+#[inline(always)]
+fn lanes_sum(v: &[f32; PADDED]) -> f64 {
+    let mut acc = [0.0f32; 8];
+    for c in v.chunks_exact(8) {
+        for l in 0..8 {
+            acc[l] += c[l];
+        }
+    }
+    acc.iter().map(|&a| a as f64).sum()
+}
+
+/// G2 / (4 cos θo) of a model at the 180 bins of row `r`: Λ(μ) = (Λ cos θ)(μ) / μ at the
+/// row's 181 cosines, then G2 = 1 / (1 + max(Λi, Λo) + λ(φ) min(Λi, Λo)). Bins below the
+/// horizon get meaningless values: callers mask them.
+#[inline(always)]
+fn row_ideal(t: &IsoTables, geo: &MerlGeometry, r: usize, out: &mut [f32; PADDED]) {
+    let table: &[f32; LAMBDA_TABLE] = &t.lambda_cos;
+    let scale = (LAMBDA_TABLE - 1) as f32;
+    let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
+    let corr: &[f32; ROW] = geo.corr_row(r).try_into().unwrap();
+    let mut lambda = [0.0f32; MU_ROW];
+    for k in 0..MU_ROW {
+        let m = mu[k];
+        // max before min: a NaN would become 0, so x is a finite number in [0, scale].
+        let x = (m * scale).max(0.0).min(scale);
+        // SAFETY: x is finite and in [0, 4095], well inside i32 (`as` would saturate, and its
+        // checks keep the loop from vectorising).
+        let at = unsafe { x.to_int_unchecked::<i32>() }.min(LAMBDA_TABLE as i32 - 2) as usize;
+        let w = x - at as f32;
+        let (a, b) = (table[at], table[at + 1]);
+        lambda[k] = (a + w * (b - a)) / m;
+    }
+    // Λi of bin k is Λ at μ_(180−k).
+    let mut lambda_i = [0.0f32; ROW];
+    for k in 0..ROW {
+        lambda_i[k] = lambda[ROW - k];
+    }
+    for k in 0..ROW {
+        let (li, lo) = (lambda_i[k], lambda[k]);
+        let (hi, lo) = if li > lo { (li, lo) } else { (lo, li) };
+        let g2 = 1.0 / (1.0 + hi + corr[k] * lo);
+        out[k] = 0.25 * g2 / mu[k];
+    }
+}
