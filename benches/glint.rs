@@ -66,7 +66,8 @@ fn queries(c: &mut Criterion) {
     let gamma = 1f64.to_radians();
     let p = dpf(&ndf(), wi, wo, gamma);
     let mut g = c.benchmark_group("glint_query");
-    for r in [1e-4, 1e-3, 1e-2] {
+    // About 30, 3000 and 300 000 flakes: r = √(N / (π · density)).
+    for r in [9.8e-4, 9.8e-3, 9.8e-2] {
         let fp = Footprint {
             center: DVec2::splat(0.3),
             a: DVec2::new(r, 0.0),
