@@ -9,6 +9,7 @@
 // Set from Rust (facet_glint::lit), written once there.
 override LIT_EXACT_MEAN: f32;
 override SPLIT_EXACT_MAX: u32;
+override BLEND_BAND: f32;
 
 // Chains of lit counts in one walk: 2 queries × 4 direction cells.
 const CHAINS: u32 = 8u;
@@ -258,20 +259,34 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
     return acc;
 }
 
-// The four direction cells around coords and their bilinear weights (facet_glint::lit::blend_cells);
-// without blending, the one cell coords is in, weight 1.
+// One axis of the blend (facet_glint::lit::blend_axis): (cell, neighbour across the nearer
+// edge) offsets from floor(x), and their weights.
+fn blend_axis(x: f32) -> vec4<f32> {
+    let f = x - floor(x);
+    let half = 0.5 * BLEND_BAND;
+    if (f < half) {
+        return vec4<f32>(0.0, -1.0, 0.5 + f / BLEND_BAND, 0.5 - f / BLEND_BAND);
+    }
+    if (f > 1.0 - half) {
+        let g = 1.0 - f;
+        return vec4<f32>(0.0, 1.0, 0.5 + g / BLEND_BAND, 0.5 - g / BLEND_BAND);
+    }
+    return vec4<f32>(0.0, 1.0, 1.0, 0.0);
+}
+
+// The cells coords reads and their weights (facet_glint::lit::blend_cells); without blending,
+// the one cell coords is in, weight 1.
 fn cell_keys(coords: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, weights: ptr<function, array<f32, CHAINS>>, first: u32) {
     let base = floor(coords);
-    let f = coords - base;
     let bx = i32(base.x) + (1 << 24u);
     let by = i32(base.y) + (1 << 24u);
+    let ax = blend_axis(coords.x);
+    let ay = blend_axis(coords.y);
     for (var k = 0u; k < 4u; k++) {
-        let dx = k & 1u;
-        let dy = k >> 1u;
-        (*keys)[first + k] = tea(u32(bx + i32(dx)), u32(by + i32(dy)));
-        let wx = select(1.0 - f.x, f.x, dx == 1u);
-        let wy = select(1.0 - f.y, f.y, dy == 1u);
-        (*weights)[first + k] = select(select(0.0, 1.0, k == 0u), wx * wy, field.blend != 0u);
+        let i = k & 1u;
+        let j = k >> 1u;
+        (*keys)[first + k] = tea(u32(bx + i32(ax[i])), u32(by + i32(ay[j])));
+        (*weights)[first + k] = select(select(0.0, 1.0, k == 0u), ax[2u + i] * ay[2u + j], field.blend != 0u);
     }
 }
 

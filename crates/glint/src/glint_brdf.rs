@@ -21,7 +21,8 @@ pub struct GlintConfig {
     pub threshold: f64,
     /// Whether the mean may replace the count at all.
     pub filtered: bool,
-    /// Blend the counts of the four direction cells around the half vector (bilinear weights),
+    /// Blend the counts of the direction cells around the half vector ([`blend_cells`]: the cell
+    /// and, near an edge, its neighbours, weights continuous in the half vector),
     /// so that counts do not pop when the half vector crosses a cell edge; without it, the
     /// count of the one cell it is in.
     pub blend: bool,

@@ -242,7 +242,7 @@ impl GlintQuery {
 /// The override constants of the flake shaders (TEA and the quadtree), from Rust.
 pub fn flake_constants() -> Vec<(&'static str, f64)> {
     use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
-    use crate::lit::{LIT_EXACT_MEAN, SPLIT_EXACT_MAX};
+    use crate::lit::{BLEND_BAND, LIT_EXACT_MEAN, SPLIT_EXACT_MAX};
     let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
     constants.extend([
         ("LEAF_FLAKES", LEAF_FLAKES as f64),
@@ -250,6 +250,7 @@ pub fn flake_constants() -> Vec<(&'static str, f64)> {
         ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
         ("LIT_EXACT_MEAN", LIT_EXACT_MEAN),
         ("SPLIT_EXACT_MAX", SPLIT_EXACT_MAX as f64),
+        ("BLEND_BAND", BLEND_BAND),
     ]);
     constants
 }

@@ -273,21 +273,41 @@ impl FlakeField {
     }
 }
 
-/// The four direction cells around a query and their bilinear weights: cells are the unit
-/// squares of [`crate::flakes::direction_coords`], each read at its lower corner, so the weights
-/// are continuous in the half vector and a count blended with them does not pop at cell edges
-/// (in the manner of Deliot & Belcour 2023).
+/// Width, in cells, of the band around a cell edge over which blended counts fade from one cell
+/// to its neighbour; inside a cell, away from its edges, one cell's count is the count. Half a
+/// cell: a query reads (1 + ½)² = 2.25 cells on average instead of bilinear's 4.
+pub const BLEND_BAND: f64 = 0.5;
+
+/// One axis of [`blend_cells`]: the cell x lies in and the neighbour across the nearer edge, with
+/// weights that are 1 and 0 away from the edge and fade linearly to ½ and ½ at it.
+fn blend_axis(x: f64) -> [(i64, f64); 2] {
+    let c = x.floor();
+    let f = x - c;
+    let half = 0.5 * BLEND_BAND;
+    if f < half {
+        [
+            (c as i64, 0.5 + f / BLEND_BAND),
+            (c as i64 - 1, 0.5 - f / BLEND_BAND),
+        ]
+    } else if f > 1.0 - half {
+        let g = 1.0 - f;
+        [
+            (c as i64, 0.5 + g / BLEND_BAND),
+            (c as i64 + 1, 0.5 - g / BLEND_BAND),
+        ]
+    } else {
+        [(c as i64, 1.0), (c as i64 + 1, 0.0)]
+    }
+}
+
+/// The direction cells a query reads and their weights: the cell of
+/// [`crate::flakes::direction_coords`] and, within [`BLEND_BAND`] of an edge, the neighbour
+/// across it (four cells near a corner), weights continuous in the half vector and summing to
+/// 1, so a count blended with them does not pop at cell edges (in the manner of Deliot & Belcour
+/// 2023). Entries of weight 0 are not read.
 pub fn blend_cells(coords: DVec2) -> [((u32, u32), f64); 4] {
-    let base = coords.floor();
-    let f = coords - base;
-    let cell = |dx: i64, dy: i64| {
-        let q = |x: f64, d: i64| (x as i64 + d + (1 << 24)) as u32;
-        (q(base.x, dx), q(base.y, dy))
-    };
-    [
-        (cell(0, 0), (1.0 - f.x) * (1.0 - f.y)),
-        (cell(1, 0), f.x * (1.0 - f.y)),
-        (cell(0, 1), (1.0 - f.x) * f.y),
-        (cell(1, 1), f.x * f.y),
-    ]
+    let (ax, ay) = (blend_axis(coords.x), blend_axis(coords.y));
+    let q = |c: i64| (c + (1 << 24)) as u32;
+    let cell = |i: usize, j: usize| ((q(ax[i].0), q(ay[j].0)), ax[i].1 * ay[j].1);
+    [cell(0, 0), cell(1, 0), cell(0, 1), cell(1, 1)]
 }
