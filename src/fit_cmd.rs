@@ -4,6 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::extract::Stopping;
 use facet_fit::fit::{Backend, FitConfig, Models, fit_material_on};
+use facet_fit::fresnel_fit::FresnelChoice;
 use facet_fit::gpu::GpuFitter;
 use facet_fit::input::same_file;
 use facet_fit::material::FittedMaterial;
@@ -86,6 +87,14 @@ fn fitter<'g>(gpu: &'g Option<Gpu>, arg: BackendArg) -> Result<Option<GpuFitter<
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum FresnelArg {
+    Table,
+    Conductor,
+    Dielectric,
+    Schlick,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum QuadratureArg {
     UniformTheta,
     SqrtMidpoint,
@@ -125,6 +134,19 @@ pub struct FitArgs {
     /// Output folder for NAME.json and the tables.
     #[arg(long, default_value = "out")]
     out: PathBuf,
+    /// The paper's single specular lobe: no Lambertian term, F averaged per θd bin and not
+    /// clipped to [0, 1], no refinement (default: a diffuse lobe ρd with every model, F in
+    /// [0, 1], the tabulated NDF refined in the metric's space). --aniso fits a single lobe.
+    #[arg(long)]
+    no_diffuse: bool,
+    /// Keep the extracted NDF as the power iteration gives it (with the diffuse lobe).
+    #[arg(long)]
+    no_refine: bool,
+    /// The Fresnel every model renders with: its table F(θd), or the conductor (η, k per
+    /// channel), dielectric (η) or Schlick (F0) curve fitted to it. All three are fitted and
+    /// recorded with their errors either way (not with --no-diffuse or --aniso).
+    #[arg(long, value_enum, default_value = "table")]
+    fresnel: FresnelArg,
     /// Neural proxy file for `nbrdf:` inputs (default: `$FACET_NBRDF`, else the MERL-100
     /// proxies embedded in Facet).
     #[arg(long)]
@@ -140,6 +162,19 @@ impl FitArgs {
         };
         if let Some(n) = self.resolution {
             cfg.extract.resolution = n;
+        }
+        cfg.diffuse &= !self.no_diffuse;
+        cfg.refine &= !self.no_refine && cfg.diffuse;
+        cfg.fresnel = match self.fresnel {
+            FresnelArg::Table => FresnelChoice::Table,
+            FresnelArg::Conductor => FresnelChoice::Conductor,
+            FresnelArg::Dielectric => FresnelChoice::Dielectric,
+            FresnelArg::Schlick => FresnelChoice::Schlick,
+        };
+        if self.fresnel != FresnelArg::Table && (!cfg.diffuse || self.aniso) {
+            bail!(
+                "--fresnel other than table needs the diffuse lobe (not --no-diffuse or --aniso)"
+            );
         }
         if self.aniso {
             cfg.extract.phi_resolution = self.phi_resolution;
@@ -357,8 +392,16 @@ fn print_summary(rows: &[FittedMaterial]) {
     let mut out = std::io::stdout().lock();
     let _ = writeln!(
         out,
-        "{:<28} {:>5} {:>9}  {:>17} {:>8}  {:>17} {:>8}  {:>8}",
-        "material", "iters", "tab err", "ggx αx/αy", "ggx err", "beckmann αx/αy", "beck err", "ms"
+        "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8}",
+        "material",
+        "iters",
+        "tab err",
+        "tab ρd",
+        "ggx αx/αy",
+        "ggx err",
+        "beckmann αx/αy",
+        "beck err",
+        "ms"
     );
     for f in rows {
         let r = &f.record;
@@ -372,10 +415,16 @@ fn print_summary(rows: &[FittedMaterial]) {
         let (ga, ge) = param(&r.ggx);
         let (ba, be) = param(&r.beckmann);
         let te = r.tabulated.error.map_or("-".into(), |e| format!("{e:.4}"));
+        let kd = r.tabulated.diffuse;
+        let kd = if r.diffuse_lobe {
+            format!("{:.3}/{:.3}/{:.3}", kd[0], kd[1], kd[2])
+        } else {
+            "-".into()
+        };
         let _ = writeln!(
             out,
-            "{:<28} {:>5} {:>9}  {:>17} {:>8}  {:>17} {:>8}  {:>8.1}",
-            r.name, r.iterations, te, ga, ge, ba, be, r.timings_ms.total
+            "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8.1}",
+            r.name, r.iterations, te, kd, ga, ge, ba, be, r.timings_ms.total
         );
     }
 }

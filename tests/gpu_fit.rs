@@ -73,7 +73,8 @@ fn gpu_and_cpu_fits_agree() {
     };
     let fitter = GpuFitter::new(&gpu).unwrap();
     println!("adapter: {}", gpu.describe());
-    let mut iso = FitConfig::isotropic();
+    // The single lobe: the GPU runs both the extraction and the Fresnel average.
+    let mut iso = FitConfig::single_lobe();
     iso.models.beckmann = false;
     for spec in [
         "ggx?alpha=0.05&f0=0.04",
@@ -169,6 +170,43 @@ fn without_an_adapter_gpu_tests_skip_or_fail_as_asked() {
     let _ = std::fs::remove_file(&log);
 }
 
+/// With the diffuse lobe the GPU runs every extraction of the separation (the F and ρd solves
+/// run on the CPU): the answers agree with the CPU's to the extraction's f32 precision.
+#[test]
+fn gpu_and_cpu_diffuse_fits_agree() {
+    let Some(gpu) = gpu_for_tests("gpu_and_cpu_diffuse_fits_agree") else {
+        return;
+    };
+    let fitter = GpuFitter::new(&gpu).unwrap();
+    let src = merl_from_spec("ggx?alpha=0.2&f0=0.04&kd=0.3,0.1,0.05");
+    let mut cfg = FitConfig::isotropic();
+    cfg.models.beckmann = false;
+    let g = fit_material_on(&src, "gpu", &cfg, Backend::Gpu(&fitter))
+        .unwrap()
+        .record;
+    let c = fit_material_on(&src, "cpu", &cfg, Backend::Cpu)
+        .unwrap()
+        .record;
+    assert!(!g.backend.starts_with("cpu"), "{}", g.backend);
+    let (gp, cp) = (g.ggx.unwrap(), c.ggx.unwrap());
+    println!(
+        "ρd gpu {:?} cpu {:?}; tabulated {:?} / {:?}; α {} / {}",
+        g.tabulated.diffuse,
+        c.tabulated.diffuse,
+        g.tabulated.error,
+        c.tabulated.error,
+        gp.alpha_x,
+        cp.alpha_x
+    );
+    // GGX's fit does not depend on the extraction beyond its moment start: equal to 1e-4.
+    assert!((gp.alpha_x / cp.alpha_x - 1.0).abs() < 1e-4);
+    for k in 0..3 {
+        assert!((g.tabulated.diffuse[k] - c.tabulated.diffuse[k]).abs() < 1e-3);
+    }
+    let (ge, ce) = (g.tabulated.error.unwrap(), c.tabulated.error.unwrap());
+    assert!((ge - ce).abs() < 0.05 * ce + 1e-5, "{ge} vs {ce}");
+}
+
 #[test]
 fn a_gpu_failure_falls_back_to_the_cpu_and_says_so() {
     let Some(_) = gpu_for_tests("a_gpu_failure_falls_back_to_the_cpu_and_says_so") else {
@@ -180,7 +218,8 @@ fn a_gpu_failure_falls_back_to_the_cpu_and_says_so() {
     let gpu = facet_gpu::Gpu::with_options(&opts).unwrap();
     let fitter = GpuFitter::new(&gpu).unwrap();
     let src = merl_from_spec("ggx?alpha=0.2&f0=0.04");
-    let mut cfg = FitConfig::isotropic();
+    // The single lobe uploads the grid samples for the GPU's Fresnel average.
+    let mut cfg = FitConfig::single_lobe();
     cfg.models.beckmann = false;
     let fell_back = fit_material_on(&src, "gpu", &cfg, Backend::Gpu(&fitter))
         .unwrap()

@@ -1,9 +1,11 @@
 // Shading stage of one glint material (Wang et al. 2018 over Jakob et al. 2014), dispatched once
 // per glint material with its own DPF pyramid levels:
-//   f = F(θd) G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo)   (glint/glint_brdf.inc.wgsl),
+//   f = F(θd) G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo) + ρd/π   (glint/glint_brdf.inc.wgsl;
+//   ρd the fit's diffuse lobe),
 // the light sample's and the BSDF sample's counts from one walk over the flakes,
 // the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
-// N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals.
+// N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals, mixed with
+// the cosine lobe by albedo where the fit has a diffuse term (as shade_microfacet.wgsl).
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -35,6 +37,8 @@ struct Bsdf {
     center: vec2<f32>,
     a: vec2<f32>,
     b: vec2<f32>,
+    diffuse: vec3<f32>,
+    p_spec: f32,
 }
 
 // A world vector in the tangent plane to UV: least squares through J = [dP/du dP/dv],
@@ -65,6 +69,11 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
         b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
     }
     b.center = s.uv;
+    b.diffuse = m.diffuse.xyz;
+    // Lobe choice by albedo, as for the smooth microfacet class.
+    let spec = luminance(fresnel_table(m, 1.0));
+    let diff = luminance(b.diffuse);
+    b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
     // The cone's circle of radius w/2 around the ray, projected onto the tangent plane: an
     // ellipse with semi-axes r (across the ray) and r / |cos θ| (along it).
     let d = path_get(R_DIR, slot).xyz;
@@ -104,6 +113,10 @@ fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -
     if (k.y > 0.0) {
         f[1] = fresnel_table(m, dot(wi_bsdf, normalize(wi_bsdf + wo))) * k.y;
     }
+    if (wo.z > 0.0) {
+        f[0] += select(vec3<f32>(0.0), b.diffuse / PI, wi_light.z > 0.0);
+        f[1] += select(vec3<f32>(0.0), b.diffuse / PI, wi_bsdf.z > 0.0);
+    }
     return f;
 }
 
@@ -124,13 +137,19 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
         return 0.0;
     }
     let h = normalize(wi + wo);
+    var spec: f32;
     if (params.ndf_kind == NDF_TABULATED) {
-        return tab_pdf_visible(b.tab, wo, h) / (4.0 * abs(dot(wo, h)));
+        spec = tab_pdf_visible(b.tab, wo, h) / (4.0 * abs(dot(wo, h)));
+    } else {
+        spec = lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
     }
-    return lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
+    return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
 }
 
 fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
+    if (u.z >= b.p_spec) {
+        return sample_cosine(u.xy);
+    }
     var h: vec3<f32>;
     if (params.ndf_kind == NDF_TABULATED) {
         h = tab_sample_visible(b.tab, wo, u.xy);
@@ -142,10 +161,11 @@ fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
 
 fn bsdf_roughness(b: Bsdf) -> f32 {
     // m.roughness: the fit's effective α (GGX) for a table, √(αx αy) for an analytic NDF.
+    var r = sqrt(b.ndf.alpha_x * b.ndf.alpha_y);
     if (params.ndf_kind == NDF_TABULATED) {
-        return materials[b.material].roughness;
+        r = materials[b.material].roughness;
     }
-    return sqrt(b.ndf.alpha_x * b.ndf.alpha_y);
+    return mix(1.0, r, b.p_spec);
 }
 
 @compute @workgroup_size(WG)

@@ -165,11 +165,11 @@ pub fn sweep(src: &MerlBrdf) {
     let ex = extract_isotropic(src, &Default::default()).unwrap();
     for kind in NdfKind::ALL {
         let start = fit_moments(kind, &ex.ndf);
-        let reference = fit_least_squares(start, false, &set).alpha_x;
+        let reference = fit_least_squares(start, false, false, &set).alpha_x;
         for stride in [1, 4, 12, 48, 192] {
             let search = set.subsample(stride);
             let t = Instant::now();
-            let a = fit_least_squares(start, false, &search);
+            let a = fit_least_squares(start, false, false, &search);
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let e = microfacet_error(&model_with_fresnel("m", a, &set), &set);
             println!(

@@ -1,17 +1,23 @@
 //! The whole fit of one source: extraction, G1, Fresnel, parameter fits and errors.
 
 use crate::brdf::Brdf;
+use crate::brdf::Rgb;
+use crate::diffuse::{separate, tabulated_model};
 use crate::error::FitError;
 use crate::extract::{CpuSolver, ExtractConfig, Solver, extract_with};
 use crate::fresnel::{Fresnel, FresnelTable};
+use crate::fresnel_fit::{FresnelChoice, FresnelFits};
 #[cfg(feature = "gpu")]
 use crate::gpu::{GpuFitter, gpu_error};
 #[cfg(feature = "gpu")]
 use crate::grid::IsoTables;
-use crate::grid::{GridSamples, fresnel_and_error, fresnel_average, microfacet_error};
+use crate::grid::{
+    GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error, microfacet_error,
+};
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::params::{fit_least_squares, fit_moments, refine_on_full_grid};
+use crate::refine::{model_of, refine, tabulate};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -55,6 +61,16 @@ pub struct FitConfig {
     /// of an anisotropic one); an isotropic fit then takes its final steps on the full grid
     /// ([`crate::params::refine_on_full_grid`]), and the reported errors use every sample.
     pub search_stride: usize,
+    /// Fit a Lambertian lobe ρd with every model and keep F in [0, 1] ([`crate::diffuse`]);
+    /// false: the paper's single specular lobe with F averaged. Isotropic fits only: an
+    /// anisotropic fit always takes the single lobe.
+    pub diffuse: bool,
+    /// Refine the tabulated NDF in the metric's space after the extraction ([`crate::refine`]),
+    /// and tabulate the best analytic fit's NDF when it fits better (diffuse fits only).
+    pub refine: bool,
+    /// The Fresnel each model renders with: its table, or the conductor, dielectric or Schlick
+    /// curve fitted to it ([`crate::fresnel_fit`]; diffuse fits only, where F lies in [0, 1]).
+    pub fresnel: FresnelChoice,
 }
 
 impl FitConfig {
@@ -65,6 +81,18 @@ impl FitConfig {
             anisotropic: false,
             models: Models::ALL,
             search_stride: 48,
+            diffuse: true,
+            refine: true,
+            fresnel: FresnelChoice::Table,
+        }
+    }
+
+    /// The paper's pipeline: isotropic, one specular lobe, F averaged, no refinement.
+    pub const fn single_lobe() -> Self {
+        FitConfig {
+            diffuse: false,
+            refine: false,
+            ..Self::isotropic()
         }
     }
 
@@ -75,6 +103,9 @@ impl FitConfig {
             anisotropic: true,
             models: Models::ALL,
             search_stride: 64,
+            diffuse: false,
+            refine: false,
+            fresnel: FresnelChoice::Table,
         }
     }
 }
@@ -172,10 +203,12 @@ fn fit_with(
             ),
         });
     }
+    // The diffuse lobe is solved on the isotropic grid, on the CPU.
+    let diffuse = cfg.diffuse && !cfg.anisotropic && set.iso.is_some();
     // The GPU averages Fresnel over isotropic sample sets, uploaded once for all models.
     #[cfg(feature = "gpu")]
     let uploaded = match gpu {
-        Some(g) if set.rotations.len() == 1 => Some((
+        Some(g) if set.rotations.len() == 1 && !diffuse => Some((
             g,
             g.fresnel
                 .upload(g.gpu, &set)
@@ -193,73 +226,81 @@ fn fit_with(
         }
         Ok(fresnel_average(model, &set))
     };
-    let mut tabulated = MicrofacetBrdf {
-        name: format!("{}-tabulated", src.name()),
-        ndf: Ndf::Tabulated(Arc::new(ex.ndf.clone())),
-        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
-        diffuse: [0.0; 3],
+    // F (and with a diffuse lobe ρd) for a model's own D and G, and its error on `set`.
+    let solve = |m: &MicrofacetBrdf| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
+        if diffuse && let Some(r) = fresnel_diffuse_and_error(m, &set) {
+            return Ok(r);
+        }
+        if gpu.is_some() {
+            let f = average(m)?;
+            let with = MicrofacetBrdf {
+                fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                ..m.clone()
+            };
+            return Ok((f, [0.0; 3], microfacet_error(&with, &set)));
+        }
+        let (f, e) = fresnel_and_error(m, &set);
+        Ok((f, [0.0; 3], e))
     };
-    // On the CPU the tabulated model's error shares G2 with its Fresnel average.
-    let (rgb, fused_error) = if gpu.is_none() && cfg.models.tabulated {
-        let (f, e) = fresnel_and_error(&tabulated, &set);
-        (f, Some(e))
+    // The paper's tabulated model: one lobe, F averaged for the extraction's D and G.
+    let single = if diffuse {
+        None
     } else {
-        (average(&tabulated)?, None)
+        let model = tabulated_model(&ex);
+        // On the CPU the tabulated model's error shares G2 with its Fresnel average.
+        Some(if gpu.is_none() && cfg.models.tabulated {
+            let (f, e) = fresnel_and_error(&model, &set);
+            (f, Some(e))
+        } else {
+            (average(&model)?, None)
+        })
     };
-    let fresnel = FresnelTable::on_merl_bins(rgb);
-    tabulated.fresnel = Fresnel::Table(fresnel.clone());
-    let fresnel_ms = ms(t);
+    let mut fresnel_ms = ms(t);
+
+    // With a diffuse lobe, the physical Fresnel curves fitted to a model's table, each with its
+    // full-grid error.
+    let physical = |m: &MicrofacetBrdf, table: &FresnelTable, albedo: Rgb| {
+        diffuse.then(|| {
+            let mut fits = FresnelFits::of(table, |fresnel| {
+                let with = MicrofacetBrdf {
+                    fresnel: fresnel.clone(),
+                    diffuse: albedo,
+                    ..m.clone()
+                };
+                microfacet_error(&with, &set)
+            });
+            fits.used = cfg.fresnel;
+            fits
+        })
+    };
 
     let t = Instant::now();
-    let tab_error = fused_error.or_else(|| {
-        cfg.models
-            .tabulated
-            .then(|| microfacet_error(&tabulated, &set))
-    });
     let search = set.subsample(cfg.search_stride);
     let fit_kind = |kind: NdfKind| -> Result<ParamRecord, FitError> {
         let moments = fit_moments(kind, &ex.ndf);
-        let lsq = fit_least_squares(moments, cfg.anisotropic, &search);
-        // The paper's estimate: α by moments with the Fresnel of the extraction.
-        let moment_model = MicrofacetBrdf {
-            name: "moments".into(),
-            ndf: Ndf::Analytic(moments),
-            fresnel: Fresnel::Table(fresnel.clone()),
-            diffuse: [0.0; 3],
-        };
-        // The least-squares model with a Fresnel table averaged for its own D and G.
-        let lsq_model = |ndf: AnalyticNdf| -> Result<(f64, MicrofacetBrdf), FitError> {
-            let mut m = MicrofacetBrdf {
-                name: "lsq".into(),
-                ndf: Ndf::Analytic(ndf),
-                fresnel: Fresnel::Schlick { f0: [1.0; 3] },
-                diffuse: [0.0; 3],
-            };
-            let (f, e) = if gpu.is_some() {
-                let f = average(&m)?;
-                m.fresnel = Fresnel::Table(FresnelTable::on_merl_bins(f));
-                (None, microfacet_error(&m, &set))
-            } else {
-                let (f, e) = fresnel_and_error(&m, &set);
-                (Some(f), e)
-            };
-            if let Some(f) = f {
-                m.fresnel = Fresnel::Table(FresnelTable::on_merl_bins(f));
-            }
-            Ok((e, m))
-        };
+        let lsq = fit_least_squares(moments, cfg.anisotropic, diffuse, &search);
+        let model = |ndf: AnalyticNdf| MicrofacetBrdf::ideal("lsq", Ndf::Analytic(ndf));
         // Isotropic: the final steps on the full grid (coarse to fine).
-        let (lsq, error, lsq_model) = if cfg.anisotropic {
-            let (e, m) = lsq_model(lsq)?;
-            (lsq, e, m)
+        let (lsq, (lsq_fresnel, lsq_diffuse, error)) = if cfg.anisotropic {
+            (lsq, solve(&model(lsq))?)
         } else {
-            let (t, e, m) = refine_on_full_grid(lsq.alpha_x.ln(), |t| {
-                lsq_model(AnalyticNdf::isotropic(kind, t.exp()))
+            let (t, e, (f, kd)) = refine_on_full_grid(lsq.alpha_x.ln(), |t| {
+                let (f, kd, e) = solve(&model(AnalyticNdf::isotropic(kind, t.exp())))?;
+                Ok::<_, FitError>((e, (f, kd)))
             })?;
-            (AnalyticNdf::isotropic(kind, t.exp()), e, m)
+            (AnalyticNdf::isotropic(kind, t.exp()), (f, kd, e))
         };
-        let Fresnel::Table(lsq_fresnel) = lsq_model.fresnel else {
-            unreachable!("the least-squares model has a Fresnel table")
+        // The paper's estimate: α by moments with the Fresnel of the extraction; with a
+        // diffuse lobe, with F and ρd solved for it.
+        let moments_error = match &single {
+            Some((f, _)) => microfacet_error(
+                &MicrofacetBrdf {
+                    fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                    ..model(moments)
+                },
+                &set,
+            ),
+            None => solve(&model(moments))?.2,
         };
         let params = |n: &AnalyticNdf, e| Params {
             alpha_x: n.alpha_x,
@@ -267,15 +308,20 @@ fn fit_with(
             rotation: n.rotation,
             error: e,
         };
-        let moments = params(&moments, microfacet_error(&moment_model, &set));
         Ok(ParamRecord {
             alpha_x: lsq.alpha_x,
             alpha_y: lsq.alpha_y,
             rotation: lsq.rotation,
             error,
             method: "least_squares".into(),
-            moments,
-            fresnel: lsq_fresnel,
+            moments: params(&moments, moments_error),
+            fresnel_fits: physical(
+                &model(lsq),
+                &FresnelTable::on_merl_bins(lsq_fresnel.clone()),
+                lsq_diffuse,
+            ),
+            fresnel: FresnelTable::on_merl_bins(lsq_fresnel),
+            diffuse: lsq_diffuse,
         })
     };
     let ggx = cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx)).transpose()?;
@@ -285,6 +331,67 @@ fn fit_with(
         .then(|| fit_kind(NdfKind::Beckmann))
         .transpose()?;
     let fit_ms = ms(t);
+
+    let t = Instant::now();
+    // The best analytic fit: the separation's seed and the refinement's other start.
+    let best_analytic = [(NdfKind::Ggx, &ggx), (NdfKind::Beckmann, &beckmann)]
+        .into_iter()
+        .filter_map(|(k, p)| p.as_ref().map(|p| (k, p)))
+        .min_by(|a, b| a.1.error.total_cmp(&b.1.error));
+    let mut separation_rounds = 1;
+    let mut refine_rounds = 0;
+    let (ex, tab) = match single {
+        Some((f, e)) => {
+            let error = e.or_else(|| {
+                cfg.models.tabulated.then(|| {
+                    let with = MicrofacetBrdf {
+                        fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                        ..tabulated_model(&ex)
+                    };
+                    microfacet_error(&with, &set)
+                })
+            });
+            let ndf = ex.ndf.clone();
+            (ex, (ndf, f, [0.0; 3], error, "power_iteration"))
+        }
+        None => {
+            let seed = best_analytic.map_or([0.0; 3], |(_, p)| p.diffuse);
+            let sep = separate(src, &search, seed, ex, |b| {
+                extract_with(b, &cfg.extract, false, solver)
+            })?;
+            separation_rounds = sep.rounds;
+            let ex = sep.extraction;
+            let (f, kd, e) = solve(&tabulated_model(&ex))?;
+            let mut best = (ex.ndf.clone(), f, kd, e, "power_iteration");
+            if cfg.refine {
+                if let Some(r) = refine(&best.0, e, &set) {
+                    refine_rounds = r.rounds;
+                    best = (r.ndf, r.fresnel, r.albedo, r.error, "power_iteration");
+                }
+                // Where an analytic fit is still better, its NDF tabulated is the start.
+                if let Some((kind, p)) = best_analytic.filter(|(_, p)| p.error < best.3) {
+                    let analytic = AnalyticNdf::isotropic(kind, p.alpha_x);
+                    let t = ex.ndf.tables();
+                    if let Some(ndf) = tabulate(analytic, t.nu, t.ng) {
+                        let (f, kd, e) = solve(&model_of(&ndf))?;
+                        let mut start = (ndf, f, kd, e, kind.name());
+                        if let Some(r) = refine(&start.0, e, &set) {
+                            refine_rounds += r.rounds;
+                            start = (r.ndf, r.fresnel, r.albedo, r.error, kind.name());
+                        }
+                        if start.3 < best.3 {
+                            best = start;
+                        }
+                    }
+                }
+            }
+            (ex, (best.0, best.1, best.2, Some(best.3), best.4))
+        }
+    };
+    let (ndf, tab_fresnel, tab_diffuse, tab_error, origin) = tab;
+    let fresnel = FresnelTable::on_merl_bins(tab_fresnel);
+    let fresnel_fits = physical(&model_of(&ndf), &fresnel, tab_diffuse);
+    fresnel_ms += ms(t);
 
     let record = FitRecord {
         name: src.name().to_owned(),
@@ -303,12 +410,18 @@ fn fit_with(
         eigenvalue: ex.eigenvalue,
         tabulated: TabulatedRecord {
             error: tab_error,
-            stretch: ex.ndf.stretch,
-            tables: ex.ndf.tables().clone(),
+            stretch: ndf.stretch,
+            tables: ndf.tables().clone(),
+            diffuse: tab_diffuse,
+            origin: origin.into(),
         },
         ggx,
         beckmann,
         fresnel,
+        fresnel_fits,
+        diffuse_lobe: diffuse,
+        separation_rounds,
+        refine_rounds,
         timings_ms: Timings {
             load: 0.0,
             extract: extract_ms,
@@ -322,6 +435,7 @@ fn fit_with(
             name: src.name().into(),
             problem,
         })?;
-    material.tabulated = tabulated; // the same model, without rebuilding the sampler
+    // The same NDF, without rebuilding its sampler.
+    material.tabulated.ndf = Ndf::Tabulated(Arc::new(ndf));
     Ok(material)
 }

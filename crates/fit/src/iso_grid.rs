@@ -10,11 +10,15 @@
 
 use crate::brdf::Brdf;
 use crate::brdf::Rgb;
+use crate::diffuse::LinearSums;
 use crate::grid::{IsoTables, LAMBDA_TABLE, MAX_X, fresnel_from_sums, ln_1p};
 use crate::merl::{THETA_D_RES, THETA_H_RES};
 use crate::merl_geometry::{MU_ROW, MerlGeometry, ROW, ROWS, merl_geometry};
 use rayon::prelude::*;
 use std::sync::Arc;
+
+/// Scales per θh bin that one refinement scan evaluates.
+pub(crate) const SCAN: usize = 9;
 
 /// Bins per row rounded up to the sums' eight lanes.
 const PADDED: usize = ROW.div_ceil(8) * 8;
@@ -23,6 +27,8 @@ const PADDED: usize = ROW.div_ceil(8) * 8;
 pub(crate) struct IsoData {
     /// ln(1 + x) per bin, row r channel c at `(3 r + c) · ROW`; 0 where invalid.
     log_x: Vec<f32>,
+    /// x itself, laid out as `log_x` (the weighted sums of the diffuse solve need it).
+    x: Vec<f32>,
     /// Whether the bin holds a valid sample (both directions above the horizon, a value).
     valid: Vec<bool>,
     /// Σ x per channel over the row's valid bins (x as stored, f32, summed in f64).
@@ -50,22 +56,26 @@ impl IsoSamples {
         let geo = merl_geometry();
         let per_i = THETA_D_RES;
         let mut log_x = vec![0.0f32; 3 * ROWS * ROW];
+        let mut x = vec![0.0f32; 3 * ROWS * ROW];
         let mut valid = vec![false; ROWS * ROW];
         crate::huge_pages::advise(&mut log_x);
+        crate::huge_pages::advise(&mut x);
         crate::huge_pages::advise(&mut valid);
         let mut sum_x = vec![[0.0f64; 3]; ROWS];
         let mut count = vec![0u16; ROWS];
         let channels = [table.channel(0), table.channel(1), table.channel(2)];
         let out_of_range = log_x
             .par_chunks_mut(3 * per_i * ROW)
+            .zip(x.par_chunks_mut(3 * per_i * ROW))
             .zip(valid.par_chunks_mut(per_i * ROW))
             .zip(sum_x.par_chunks_mut(per_i))
             .zip(count.par_chunks_mut(per_i))
             .enumerate()
-            .map(|(i, (((log_x, valid), sum_x), count))| {
+            .map(|(i, ((((log_x, x), valid), sum_x), count))| {
                 let rows = RowsOut {
                     first: i * per_i,
                     log_x,
+                    x,
                     valid,
                     sum_x,
                     count,
@@ -78,6 +88,7 @@ impl IsoSamples {
             .next();
         let data = IsoData {
             log_x,
+            x,
             valid,
             sum_x,
             count,
@@ -162,20 +173,59 @@ impl IsoSamples {
         let (den, ideal) = self.run(&IdealRows { set: self, tables });
         let num = self.fresnel_numerators(tables);
         let fresnel = fresnel_from_sums(&num.into_iter().zip(den).collect::<Vec<_>>());
-        let mut at = vec![0u32; ROWS];
-        for (p, &r) in self.rows.iter().enumerate() {
-            at[r as usize] = p as u32;
-        }
         let tables = IsoTables {
             fresnel: std::array::from_fn(|j| fresnel[j]),
             ..tables.clone()
         };
-        let e = self.run(&ErrorSum {
-            set: self,
-            tables: &tables,
-            cached: Some((&ideal, &at)),
-        });
+        let e = self.error_with_rows(&tables, &ideal);
         (fresnel, e)
+    }
+
+    /// The weighted normal equations of F per θd bin and ρd/π for a model's D and G
+    /// ([`LinearSums`]), with each row's G2 / (4 cos θo) kept for [`Self::error_with_rows`].
+    pub fn linear_sums(&self, tables: &IsoTables) -> (LinearSums, Vec<f32>) {
+        self.run(&WeightedRows { set: self, tables })
+    }
+
+    /// F per θd bin and ρd/π solved for a model's D and G ([`LinearSums::solve`]), and the
+    /// error sum of the model with them: two passes.
+    pub fn fresnel_diffuse_and_error_sum(&self, tables: &IsoTables) -> (Vec<Rgb>, Rgb, f64) {
+        let (sums, ideal) = self.linear_sums(tables);
+        let (fresnel, kd) = sums.solve();
+        let tables = IsoTables {
+            fresnel: std::array::from_fn(|j| fresnel[j]),
+            diffuse: kd,
+            ..tables.clone()
+        };
+        let e = self.error_with_rows(&tables, &ideal);
+        (fresnel, kd, e)
+    }
+
+    /// The error sum of a model whose rows' G2 / (4 cos θo) were kept by an earlier pass.
+    fn error_with_rows(&self, tables: &IsoTables, ideal: &[f32]) -> f64 {
+        let mut at = vec![0u32; ROWS];
+        for (p, &r) in self.rows.iter().enumerate() {
+            at[r as usize] = p as u32;
+        }
+        self.run(&ErrorSum {
+            set: self,
+            tables,
+            cached: Some((ideal, &at)),
+        })
+    }
+
+    /// The error sum of each θh bin with D of bin i scaled by each of `scales[i]`, everything
+    /// else held: the refinement's scan ([`crate::refine`]).
+    pub fn bin_scan(
+        &self,
+        tables: &IsoTables,
+        scales: &[[f32; SCAN]; THETA_H_RES],
+    ) -> Vec<[f64; SCAN]> {
+        self.run(&BinScan {
+            set: self,
+            tables,
+            scales,
+        })
     }
 
     /// A pass over this set's rows, a θh bin's rows per task.
@@ -278,6 +328,100 @@ impl RowPass for IdealRows<'_> {
     }
 }
 
+/// The weighted sums of the F / ρd solve, and each row's G2 / (4 cos θo) kept (`PADDED` per
+/// row, in row order). Per bin w = 1 / (1 + x)², m = D G2 / (4 cos θo) (0 where D ≤ 0),
+/// μ = cos θi.
+struct WeightedRows<'a> {
+    set: &'a IsoSamples,
+    tables: &'a IsoTables,
+}
+
+impl RowPass for WeightedRows<'_> {
+    type Acc = (LinearSums, Vec<f32>);
+
+    fn init() -> Self::Acc {
+        (LinearSums::zero(), Vec::new())
+    }
+
+    #[inline(always)]
+    fn row(&self, acc: &mut Self::Acc, r: usize) {
+        let data = &self.set.data;
+        let mut ideal = [0.0f32; PADDED];
+        row_ideal(self.tables, merl_geometry(), r, &mut ideal);
+        acc.1.extend_from_slice(&ideal);
+        let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
+        let d = self.tables.d32[i];
+        let d = if d > 0.0 { d } else { 0.0 };
+        let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
+        let valid = &data.valid[r * ROW..(r + 1) * ROW];
+        let (mut m, mut mu_i) = ([0.0f32; PADDED], [0.0f32; PADDED]);
+        for k in 0..ROW {
+            m[k] = if valid[k] { d * ideal[k] } else { 0.0 };
+            mu_i[k] = if valid[k] { mu[ROW - k] } else { 0.0 };
+        }
+        for c in 0..3 {
+            let x: &[f32; ROW] = data.x[(3 * r + c) * ROW..(3 * r + c + 1) * ROW]
+                .try_into()
+                .unwrap();
+            let mut s = [[0.0f32; PADDED]; 5];
+            for k in 0..ROW {
+                // w = 1 / (1 + x)²: d ln(1 + x) = dx / (1 + x)
+                let w = 1.0 / ((1.0 + x[k]) * (1.0 + x[k]));
+                let (wm, wu) = (w * m[k], w * mu_i[k]);
+                s[0][k] = wm * m[k];
+                s[1][k] = wm * mu_i[k];
+                s[2][k] = wm * x[k];
+                s[3][k] = wu * mu_i[k];
+                s[4][k] = wu * x[k];
+            }
+            let b = &mut acc.0.bins[j][c];
+            (0..3).for_each(|n| b[n] += lanes_sum(&s[n]));
+            let e = &mut acc.0.diffuse[c];
+            e[0] += lanes_sum(&s[3]);
+            e[1] += lanes_sum(&s[4]);
+        }
+    }
+
+    fn merge(a: &mut Self::Acc, b: Self::Acc) {
+        a.0.add(&b.0);
+        a.1.extend_from_slice(&b.1);
+    }
+}
+
+/// The error sum per θh bin with that bin's D scaled by each of its `SCAN` scales.
+struct BinScan<'a> {
+    set: &'a IsoSamples,
+    tables: &'a IsoTables,
+    scales: &'a [[f32; SCAN]; THETA_H_RES],
+}
+
+impl RowPass for BinScan<'_> {
+    type Acc = Vec<[f64; SCAN]>;
+
+    fn init() -> Self::Acc {
+        vec![[0.0; SCAN]; THETA_H_RES]
+    }
+
+    #[inline(always)]
+    fn row(&self, acc: &mut Self::Acc, r: usize) {
+        let t = self.tables;
+        let mut ideal = [0.0f32; PADDED];
+        row_ideal(t, merl_geometry(), r, &mut ideal);
+        let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
+        let kd = t.diffuse.map(|k| k as f32);
+        for (m, &s) in self.scales[i].iter().enumerate() {
+            let f = t.fresnel[j].map(|f| f as f32 * t.d32[i] * s);
+            acc[i][m] += row_error(&self.set.data, r, f, kd, &ideal);
+        }
+    }
+
+    fn merge(a: &mut Self::Acc, b: Self::Acc) {
+        for (a, b) in a.iter_mut().zip(b) {
+            (0..SCAN).for_each(|m| a[m] += b[m]);
+        }
+    }
+}
+
 /// Σ of the error over samples and channels.
 struct ErrorSum<'a> {
     set: &'a IsoSamples,
@@ -306,34 +450,8 @@ impl RowPass for ErrorSum<'_> {
             }
             None => row_ideal(t, geo, r, &mut ideal),
         }
-        let d = t.d32[i];
-        let f = t.fresnel[j].map(|f| f as f32 * d);
-        let kd = t.diffuse.map(|k| k as f32);
-        let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
-        let mut e = [0.0f32; PADDED];
-        for c in 0..3 {
-            let log_x: &[f32; ROW] = data.log_x[(3 * r + c) * ROW..(3 * r + c + 1) * ROW]
-                .try_into()
-                .unwrap();
-            let (f, kd) = (f[c], kd[c]);
-            if kd != 0.0 {
-                for k in 0..ROW {
-                    // x = F D (G2 / (4 cos θo)) + ρd/π cos θi
-                    let x = f * ideal[k] + kd * mu[ROW - k];
-                    e[k] += (ln_1p(x) - log_x[k]).abs();
-                }
-            } else {
-                for k in 0..ROW {
-                    e[k] += (ln_1p(f * ideal[k]) - log_x[k]).abs();
-                }
-            }
-        }
-        let valid = &data.valid[r * ROW..(r + 1) * ROW];
-        for (e, &v) in e.iter_mut().zip(valid) {
-            *e = if v { *e } else { 0.0 };
-        }
-        e[ROW..].fill(0.0);
-        *acc += lanes_sum(&e);
+        let f = t.fresnel[j].map(|f| f as f32 * t.d32[i]);
+        *acc += row_error(data, r, f, t.diffuse.map(|k| k as f32), &ideal);
     }
 
     fn merge(a: &mut f64, b: f64) {
@@ -385,6 +503,7 @@ fn run_rows_avx512<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
 struct RowsOut<'a> {
     first: usize,
     log_x: &'a mut [f32],
+    x: &'a mut [f32],
     valid: &'a mut [bool],
     sum_x: &'a mut [[f64; 3]],
     count: &'a mut [u16],
@@ -447,6 +566,7 @@ fn build_rows_baseline(
             for k in 0..ROW {
                 log_x[k] = ln_1p(x[c][k]);
             }
+            out.x[(3 * n + c) * ROW..(3 * n + c + 1) * ROW].copy_from_slice(&x[c]);
             sum[c] = x[c].iter().map(|&x| x as f64).sum();
         }
         *count = valid.iter().filter(|&&v| v).count() as u16;
@@ -469,6 +589,37 @@ fn lanes_sum(v: &[f32; PADDED]) -> f64 {
         }
     }
     acc.iter().map(|&a| a as f64).sum()
+}
+
+/// Σ over a row's valid bins and channels of |ln(1 + x_model) − ln(1 + x_data)|, with
+/// x_model = fd_c (G2 / (4 cos θo)) + kd_c cos θi: `fd` is F D of the row, `kd` ρd/π.
+#[inline(always)]
+fn row_error(data: &IsoData, r: usize, fd: [f32; 3], kd: [f32; 3], ideal: &[f32; PADDED]) -> f64 {
+    let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
+    let mut e = [0.0f32; PADDED];
+    for c in 0..3 {
+        let log_x: &[f32; ROW] = data.log_x[(3 * r + c) * ROW..(3 * r + c + 1) * ROW]
+            .try_into()
+            .unwrap();
+        let (f, kd) = (fd[c], kd[c]);
+        if kd != 0.0 {
+            for k in 0..ROW {
+                // x = F D (G2 / (4 cos θo)) + ρd/π cos θi
+                let x = f * ideal[k] + kd * mu[ROW - k];
+                e[k] += (ln_1p(x) - log_x[k]).abs();
+            }
+        } else {
+            for k in 0..ROW {
+                e[k] += (ln_1p(f * ideal[k]) - log_x[k]).abs();
+            }
+        }
+    }
+    let valid = &data.valid[r * ROW..(r + 1) * ROW];
+    for (e, &v) in e.iter_mut().zip(valid) {
+        *e = if v { *e } else { 0.0 };
+    }
+    e[ROW..].fill(0.0);
+    lanes_sum(&e)
 }
 
 /// G2 / (4 cos θo) of a model at the 180 bins of row `r`: Λ(μ) = (Λ cos θ)(μ) / μ at the

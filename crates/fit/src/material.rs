@@ -4,6 +4,7 @@
 use crate::brdf::{Brdf, Rgb};
 use crate::error::FitError;
 use crate::fresnel::{Fresnel, FresnelTable};
+use crate::fresnel_fit::FresnelFits;
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::tabulated::{NdfTables, Stretch, TabulatedNdf};
 use glam::DVec3;
@@ -41,8 +42,16 @@ pub struct ParamRecord {
     pub method: String,
     /// The paper's estimate by slope moments, with its error.
     pub moments: Params,
-    /// F(θd) averaged for this model's own D and G.
+    /// F(θd) for this model's own D and G: averaged (the paper), or with a diffuse lobe solved
+    /// together with `diffuse` and kept in [0, 1].
     pub fresnel: FresnelTable,
+    /// The Lambertian albedo ρd (f = ρd/π) fitted with this model; zero without a diffuse lobe.
+    #[serde(default)]
+    pub diffuse: Rgb,
+    /// Conductor, dielectric and Schlick curves fitted to `fresnel`, and which one the renderer
+    /// uses (absent: the table; fits without a diffuse lobe have none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fresnel_fits: Option<FresnelFits>,
 }
 
 /// The extracted (tabulated) model of a fit.
@@ -54,6 +63,18 @@ pub struct TabulatedRecord {
     pub stretch: Stretch,
     /// The extracted D and G1 tables.
     pub tables: NdfTables,
+    /// The Lambertian albedo ρd (f = ρd/π) of the tabulated model; zero without a diffuse lobe.
+    #[serde(default)]
+    pub diffuse: Rgb,
+    /// Where the tables come from: `power_iteration` (the extraction, refined when the fit
+    /// refines), or `ggx` / `beckmann` when that fit's NDF, tabulated and refined, fitted
+    /// better than every extraction.
+    #[serde(default = "power_iteration")]
+    pub origin: String,
+}
+
+fn power_iteration() -> String {
+    "power_iteration".into()
 }
 
 /// Wall-clock times of a fit's phases, milliseconds.
@@ -102,6 +123,20 @@ pub struct FitRecord {
     pub beckmann: Option<ParamRecord>,
     /// F(θd) of the tabulated model.
     pub fresnel: FresnelTable,
+    /// Physical curves fitted to `fresnel` and the one the renderer uses (see
+    /// [`ParamRecord::fresnel_fits`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fresnel_fits: Option<FresnelFits>,
+    /// Whether the models carry a fitted diffuse lobe (`--no-diffuse` and anisotropic fits:
+    /// false, the paper's single lobe).
+    #[serde(default)]
+    pub diffuse_lobe: bool,
+    /// Extractions run to separate the diffuse lobe from the tabulated NDF (1 without one).
+    #[serde(default)]
+    pub separation_rounds: usize,
+    /// Rounds of the refinement of the tabulated NDF in the metric's space (0: none).
+    #[serde(default)]
+    pub refine_rounds: usize,
     /// How long each phase took.
     pub timings_ms: Timings,
 }
@@ -150,11 +185,12 @@ impl FittedMaterial {
         let st = record.tabulated.stretch;
         check_alpha("tabulated.stretch", st.alpha_x, st.alpha_y, st.rotation)?;
         let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)?;
+        check_albedo("tabulated.diffuse", record.tabulated.diffuse)?;
         let tabulated = MicrofacetBrdf {
             name: format!("{}-tabulated", record.name),
             ndf: Ndf::Tabulated(Arc::new(ndf)),
-            fresnel: Fresnel::Table(record.fresnel.clone()),
-            diffuse: [0.0; 3],
+            fresnel: used_fresnel("fresnel_fits", &record.fresnel_fits, &record.fresnel)?,
+            diffuse: record.tabulated.diffuse,
         };
         let param =
             |kind: NdfKind, p: &Option<ParamRecord>| -> Result<Option<MicrofacetBrdf>, String> {
@@ -166,6 +202,7 @@ impl FittedMaterial {
                     p.alpha_y,
                     p.rotation,
                 )?;
+                check_albedo(&format!("{}.diffuse", kind.name()), p.diffuse)?;
                 Ok(Some(MicrofacetBrdf {
                     name: format!("{}-{}", record.name, kind.name()),
                     ndf: Ndf::Analytic(AnalyticNdf {
@@ -174,8 +211,12 @@ impl FittedMaterial {
                         alpha_y: p.alpha_y,
                         rotation: p.rotation,
                     }),
-                    fresnel: Fresnel::Table(p.fresnel.clone()),
-                    diffuse: [0.0; 3],
+                    fresnel: used_fresnel(
+                        &format!("{}.fresnel_fits", kind.name()),
+                        &p.fresnel_fits,
+                        &p.fresnel,
+                    )?,
+                    diffuse: p.diffuse,
                 }))
             };
         let ggx = param(NdfKind::Ggx, &record.ggx)?;
@@ -251,6 +292,31 @@ fn check_alpha(field: &str, alpha_x: f64, alpha_y: f64, rotation: f64) -> Result
         "{field}: α = ({alpha_x}, {alpha_y}), rotation {rotation} (α must lie in [{:e}, {}], the rotation be finite)",
         range.start(),
         range.end()
+    ))
+}
+
+/// The Fresnel a model renders with: its table, or the fit that `fits.used` names.
+fn used_fresnel(
+    field: &str,
+    fits: &Option<FresnelFits>,
+    table: &FresnelTable,
+) -> Result<Fresnel, String> {
+    match fits {
+        None => Ok(Fresnel::Table(table.clone())),
+        Some(f) => {
+            f.validate(field)?;
+            Ok(f.fresnel(f.used, table))
+        }
+    }
+}
+
+/// An albedo in [0, 1] per channel, or an error naming the field and the values.
+fn check_albedo(field: &str, albedo: Rgb) -> Result<(), String> {
+    if albedo.iter().all(|a| (0.0..=1.0).contains(a)) {
+        return Ok(());
+    }
+    Err(format!(
+        "{field}: ρd = {albedo:?} (each channel must lie in [0, 1])"
     ))
 }
 

@@ -221,6 +221,17 @@ pub struct MicrofacetBrdf {
 }
 
 impl MicrofacetBrdf {
+    /// The model of `ndf` with F = 1 and no diffuse term: the start of a Fresnel (and ρd)
+    /// solve for its D and G.
+    pub fn ideal(name: &str, ndf: Ndf) -> Self {
+        MicrofacetBrdf {
+            name: name.to_owned(),
+            ndf,
+            fresnel: crate::fresnel::Fresnel::Schlick { f0: [1.0; 3] },
+            diffuse: [0.0; 3],
+        }
+    }
+
     /// D(h) G2(wi, wo) / (4 cos θi cos θo): the BRDF with F = 1 and no diffuse term.
     pub fn eval_ideal(&self, wi: DVec3, wo: DVec3) -> f64 {
         let h = (wi + wo).normalize();

@@ -3,7 +3,8 @@
 
 use crate::fresnel::{Fresnel, FresnelTable};
 use crate::grid::{
-    GridSamples, IsoTables, fresnel_and_error, fresnel_average, microfacet_error, tables_error,
+    GridSamples, IsoTables, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error,
+    microfacet_error, tables_error,
 };
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::tabulated::TabulatedNdf;
@@ -74,24 +75,20 @@ pub fn fit_moments(kind: NdfKind, ndf: &TabulatedNdf) -> AnalyticNdf {
 
 /// A parametric model together with the Fresnel table averaged for it.
 pub fn model_with_fresnel(name: &str, ndf: AnalyticNdf, set: &GridSamples) -> MicrofacetBrdf {
-    let mut model = MicrofacetBrdf {
-        name: name.to_owned(),
-        ndf: Ndf::Analytic(ndf),
-        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
-        diffuse: [0.0; 3],
-    };
+    let mut model = MicrofacetBrdf::ideal(name, Ndf::Analytic(ndf));
     model.fresnel = Fresnel::Table(FresnelTable::on_merl_bins(fresnel_average(&model, set)));
     model
 }
 
-/// The error of a parametric model whose Fresnel is re-averaged for it.
-fn error_of(name: &str, ndf: AnalyticNdf, set: &GridSamples) -> f64 {
-    let model = MicrofacetBrdf {
-        name: name.to_owned(),
-        ndf: Ndf::Analytic(ndf),
-        fresnel: Fresnel::Schlick { f0: [1.0; 3] },
-        diffuse: [0.0; 3],
-    };
+/// The error of a parametric model whose Fresnel is re-averaged for it, or with `diffuse`
+/// whose F and ρd are solved for it ([`fresnel_diffuse_and_error`], isotropic sets).
+fn error_of(name: &str, ndf: AnalyticNdf, diffuse: bool, set: &GridSamples) -> f64 {
+    let model = MicrofacetBrdf::ideal(name, Ndf::Analytic(ndf));
+    if diffuse {
+        if let Some((_, _, e)) = fresnel_diffuse_and_error(&model, set) {
+            return e;
+        }
+    }
     match IsoTables::new(&model).filter(|_| set.rotations.len() == 1) {
         Some(_) if set.iso.is_some() => fresnel_and_error(&model, set).1,
         Some(mut tables) => {
@@ -104,11 +101,17 @@ fn error_of(name: &str, ndf: AnalyticNdf, set: &GridSamples) -> f64 {
 }
 
 /// α (and rotation when anisotropic) minimising the error metric on `set`, from `start`.
-/// Isotropic: Brent's method on ln α. Anisotropic: Nelder–Mead on (ln αx, ln αy, ρ).
-pub fn fit_least_squares(start: AnalyticNdf, anisotropic: bool, set: &GridSamples) -> AnalyticNdf {
+/// Isotropic: Brent's method on ln α. Anisotropic: Nelder–Mead on (ln αx, ln αy, ρ). With
+/// `diffuse`, each candidate's F and ρd are solved for it ([`crate::diffuse`]).
+pub fn fit_least_squares(
+    start: AnalyticNdf,
+    anisotropic: bool,
+    diffuse: bool,
+    set: &GridSamples,
+) -> AnalyticNdf {
     let kind = start.kind;
     if !anisotropic {
-        let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), set);
+        let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), diffuse, set);
         let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
         let x0 = start.alpha_x.clamp(ALPHA_MIN, ALPHA_MAX).ln();
         let t = brent(f, (x0 - 3.0).max(lo), x0, (x0 + 1.5).min(hi), 2e-4);
@@ -122,7 +125,7 @@ pub fn fit_least_squares(start: AnalyticNdf, anisotropic: bool, set: &GridSample
     };
     let p0 = [start.alpha_x.ln(), start.alpha_y.ln(), start.rotation];
     let p = nelder_mead(
-        |p| error_of("lsq", make(p), set),
+        |p| error_of("lsq", make(p), diffuse, set),
         p0,
         [0.3, 0.3, 0.3],
         1e-5,
@@ -202,7 +205,7 @@ fn canonical(mut n: AnalyticNdf) -> AnalyticNdf {
 
 /// Brent's minimisation on [lo, hi] starting from `start` (Numerical Recipes `brent`, golden sections
 /// with parabolic steps), to a relative tolerance `tol` in x.
-fn brent(f: impl Fn(f64) -> f64, lo: f64, start: f64, hi: f64, tol: f64) -> f64 {
+pub(crate) fn brent(f: impl Fn(f64) -> f64, lo: f64, start: f64, hi: f64, tol: f64) -> f64 {
     const CGOLD: f64 = 0.381_966_011_250_105;
     let (mut a, mut b) = (lo.min(hi), lo.max(hi));
     let mut x = start.clamp(a, b);

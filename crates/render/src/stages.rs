@@ -105,12 +105,21 @@ fn pipeline(
     constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, GpuError> {
     let groups: Vec<Option<&wgpu::BindGroupLayout>> = groups.iter().map(|g| Some(*g)).collect();
+    // An adapter below the stage's needs (a GL adapter allows fewer storage buffers per stage
+    // than Vulkan) is an error that says so, not wgpu's panic.
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(entry),
         bind_group_layouts: &groups,
         immediate_size: 0,
     });
-    shader::compute_pipeline_with_layout(device, file, entry, Some(&layout), constants)
+    let built = shader::compute_pipeline_with_layout(device, file, entry, Some(&layout), constants);
+    if let Some(e) = pollster::block_on(scope.pop()) {
+        return Err(GpuError::Validation(format!(
+            "the adapter cannot build the render stage {entry}: {e}"
+        )));
+    }
+    built
 }
 
 impl Stage {

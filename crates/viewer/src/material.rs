@@ -66,15 +66,15 @@ impl Default for GlintEdit {
     }
 }
 
-/// The loaded fit and the edits on it. `record` holds the edited α and rotation of every
-/// model; `tint` multiplies every Fresnel table when the record is written out.
+/// The loaded fit and the edits on it. `record` holds the edited α, rotation and diffuse
+/// albedo ρd of every model; `tint` multiplies every Fresnel table when the record is written out.
 #[derive(Clone, Debug)]
 pub struct EditedMaterial {
     /// The fit as loaded or fitted (the "data's fit" of the plots).
     pub base: Arc<FittedMaterial>,
     /// Where it came from (file path or source spec).
     pub source: String,
-    /// The record with edited α and rotation.
+    /// The record with edited α, rotation and ρd.
     pub record: FitRecord,
     /// Which model the preview shows.
     pub shown: Shown,
@@ -178,7 +178,42 @@ impl EditedMaterial {
         }
     }
 
-    /// The edited record as saved: edited α, Fresnel tables times the tint.
+    /// The diffuse albedo ρd of the shown model (`None` for the measured data).
+    pub fn diffuse(&self) -> Option<[f64; 3]> {
+        let r = &self.record;
+        match self.lobe() {
+            Shown::Measured => None,
+            Shown::Tabulated => Some(r.tabulated.diffuse),
+            Shown::Ggx | Shown::Glint => r.ggx.as_ref().map(|p| p.diffuse),
+            Shown::Beckmann => r.beckmann.as_ref().map(|p| p.diffuse),
+        }
+    }
+
+    /// Sets ρd of the shown model, each channel clamped to [0, 1].
+    pub fn set_diffuse(&mut self, albedo: [f64; 3]) {
+        let albedo = albedo.map(|a| a.clamp(0.0, 1.0));
+        let lobe = self.lobe();
+        let r = &mut self.record;
+        match lobe {
+            Shown::Measured => {}
+            Shown::Tabulated => r.tabulated.diffuse = albedo,
+            Shown::Ggx | Shown::Glint => r.ggx.iter_mut().for_each(|p| p.diffuse = albedo),
+            Shown::Beckmann => r.beckmann.iter_mut().for_each(|p| p.diffuse = albedo),
+        }
+    }
+
+    /// ρd of the shown model as fitted (what "reset" restores).
+    pub fn fitted_diffuse(&self) -> Option<[f64; 3]> {
+        let r = &self.base.record;
+        match self.lobe() {
+            Shown::Measured => None,
+            Shown::Tabulated => Some(r.tabulated.diffuse),
+            Shown::Ggx | Shown::Glint => r.ggx.as_ref().map(|p| p.diffuse),
+            Shown::Beckmann => r.beckmann.as_ref().map(|p| p.diffuse),
+        }
+    }
+
+    /// The edited record as saved: edited α and ρd, Fresnel tables times the tint.
     pub fn edited_record(&self) -> FitRecord {
         let mut r = self.record.clone();
         let tint = |t: &mut facet_fit::fresnel::FresnelTable| {
@@ -231,13 +266,23 @@ impl EditedMaterial {
     /// What the renderer's material depends on, for change detection (cheap to compare).
     pub fn key(&self) -> MaterialKey {
         let p = |p: &Option<facet_fit::material::ParamRecord>| {
-            p.as_ref().map(|p| [p.alpha_x, p.alpha_y, p.rotation])
+            p.as_ref().map(|p| {
+                [
+                    p.alpha_x,
+                    p.alpha_y,
+                    p.rotation,
+                    p.diffuse[0],
+                    p.diffuse[1],
+                    p.diffuse[2],
+                ]
+            })
         };
         let s = self.record.tabulated.stretch;
         MaterialKey {
             base: Arc::as_ptr(&self.base) as usize,
             shown: self.shown,
             stretch: [s.alpha_x, s.alpha_y, s.rotation],
+            tabulated_diffuse: self.record.tabulated.diffuse,
             ggx: p(&self.record.ggx),
             beckmann: p(&self.record.beckmann),
             tint: self.tint,
@@ -255,10 +300,12 @@ pub struct MaterialKey {
     pub shown: Shown,
     /// αx, αy, rotation of the tabulated stretch.
     pub stretch: [f64; 3],
-    /// αx, αy, rotation of GGX.
-    pub ggx: Option<[f64; 3]>,
-    /// αx, αy, rotation of Beckmann.
-    pub beckmann: Option<[f64; 3]>,
+    /// ρd of the tabulated model.
+    pub tabulated_diffuse: [f64; 3],
+    /// αx, αy, rotation and ρd of GGX.
+    pub ggx: Option<[f64; 6]>,
+    /// αx, αy, rotation and ρd of Beckmann.
+    pub beckmann: Option<[f64; 6]>,
     /// The Fresnel tint.
     pub tint: [f64; 3],
     /// Glint settings, when glints are shown.

@@ -118,6 +118,24 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     } else {
         ui.label("The measured data are shown as extracted (no edits).");
     }
+    if let (Some(albedo), Some(fitted)) = (m.diffuse(), m.fitted_diffuse()) {
+        ui.label("Diffuse albedo ρd (f = ρd/π):");
+        let old = albedo.map(|v| v as f32);
+        let mut rgb = old;
+        ui.horizontal(|ui| {
+            ui.color_edit_button_rgb(&mut rgb);
+            ui.label(format!(
+                "{:.3} {:.3} {:.3}",
+                albedo[0], albedo[1], albedo[2]
+            ));
+            if ui.small_button("fitted").clicked() {
+                rgb = fitted.map(|v| v as f32);
+            }
+        });
+        if rgb != old {
+            m.set_diffuse(rgb.map(|v| v as f64));
+        }
+    }
     ui.label("Fresnel tint:");
     let tint0 = m.tint.map(|v| v as f32);
     let mut tint = tint0;
