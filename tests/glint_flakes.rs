@@ -163,14 +163,20 @@ fn filtered_value_is_the_unfiltered_mean() {
 
 #[test]
 fn large_footprints_converge_to_the_smooth_brdf() {
-    let model = MicrofacetBrdf {
-        name: "beckmann".into(),
-        ndf: ndf(),
-        fresnel: Fresnel::Schlick {
-            f0: [0.04, 0.5, 0.9],
-        },
-        diffuse: [0.0; 3],
-    };
+    // Without and with a diffuse lobe (which lies under the flakes in both models).
+    for diffuse in [[0.0; 3], [0.3, 0.1, 0.05]] {
+        large_footprint_limit(MicrofacetBrdf {
+            name: "beckmann".into(),
+            ndf: ndf(),
+            fresnel: Fresnel::Schlick {
+                f0: [0.04, 0.5, 0.9],
+            },
+            diffuse,
+        });
+    }
+}
+
+fn large_footprint_limit(model: MicrofacetBrdf) {
     let field = FlakeField {
         density: 1.0e9,
         seed: 1,

@@ -4,6 +4,7 @@
 //! writes `DIR/<name>.binary` MERL files (a gold GGX of α = 0.2 and the named MERL neural
 //! proxies; once, reused afterwards), then fits each `REPEATS` times (default 15) with all models
 //! and with the tabulated model only, and prints the median times (ms) and the results.
+//! `SINGLE_LOBE=1` times the paper's pipeline (`FitConfig::single_lobe`) instead of the default.
 
 use facet_fit::Brdf;
 use facet_fit::analytic::parse_analytic;
@@ -86,7 +87,12 @@ fn main() {
             sweep(&src);
             continue;
         }
-        let all = FitConfig::isotropic();
+        // SINGLE_LOBE=1: the paper's pipeline (`--no-diffuse`) instead of the default fit.
+        let all = if std::env::var_os("SINGLE_LOBE").is_some() {
+            FitConfig::single_lobe()
+        } else {
+            FitConfig::isotropic()
+        };
         let tab_only = FitConfig {
             models: Models {
                 tabulated: true,

@@ -37,6 +37,8 @@ pub(crate) struct LinearSums {
     pub bins: Vec<[[f64; 3]; 3]>,
     /// Per channel: [Σ w μ², Σ w μ x] over every sample.
     pub diffuse: [[f64; 2]; 3],
+    /// The error sum of the model the weights came from (IRLS passes only).
+    pub error: f64,
 }
 
 impl LinearSums {
@@ -45,6 +47,7 @@ impl LinearSums {
         LinearSums {
             bins: vec![[[0.0; 3]; 3]; THETA_D_RES],
             diffuse: [[0.0; 2]; 3],
+            error: 0.0,
         }
     }
 
@@ -54,6 +57,7 @@ impl LinearSums {
             (0..3).for_each(|c| (0..3).for_each(|n| a[c][n] += b[c][n]));
         }
         (0..3).for_each(|c| (0..2).for_each(|n| self.diffuse[c][n] += other.diffuse[c][n]));
+        self.error += other.error;
     }
 
     /// F per θd bin in [0, 1] (bins without specular samples interpolated) and q = ρd/π in
@@ -162,7 +166,7 @@ pub fn separate(
 ) -> Result<Separation, FitError> {
     let score = |ex: &Extraction| -> f64 {
         let model = tabulated_model(ex);
-        fresnel_diffuse_and_error(&model, search).map_or(f64::INFINITY, |(_, _, e)| e)
+        fresnel_diffuse_and_error(&model, search, 0).map_or(f64::INFINITY, |(_, _, e)| e)
     };
     let first_error = score(&first);
     let best = RefCell::new(Separation {
@@ -237,8 +241,8 @@ mod tests {
             for n in 0..40 {
                 let m = 0.01 * (1.0 + n as f64).powi(2) / (1.0 + j as f64);
                 let mu = 0.05 + 0.9 * ((n * 7 + j) % 40) as f64 / 40.0;
-                for c in 0..3 {
-                    let x = f(j) * m + q[c] * mu;
+                for (c, qc) in q.iter().enumerate() {
+                    let x = f(j) * m + qc * mu;
                     let w = 1.0 / (1.0 + x).powi(2);
                     let b = &mut sums.bins[j][c];
                     b[0] += w * m * m;

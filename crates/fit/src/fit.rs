@@ -116,6 +116,12 @@ impl Default for FitConfig {
     }
 }
 
+/// Reweighted steps of the F / ρd solves on the full grid (the final steps and the reported
+/// errors; the searches take none).
+const FINAL_IRLS: usize = 2;
+/// The rows of the analytic fits' final steps with a diffuse lobe (every 4th row).
+const FINAL_STRIDE: usize = 4;
+
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -226,21 +232,31 @@ fn fit_with(
         }
         Ok(fresnel_average(model, &set))
     };
-    // F (and with a diffuse lobe ρd) for a model's own D and G, and its error on `set`.
-    let solve = |m: &MicrofacetBrdf| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
-        if diffuse && let Some(r) = fresnel_diffuse_and_error(m, &set) {
-            return Ok(r);
-        }
-        if gpu.is_some() {
-            let f = average(m)?;
-            let with = MicrofacetBrdf {
-                fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
-                ..m.clone()
-            };
-            return Ok((f, [0.0; 3], microfacet_error(&with, &set)));
-        }
-        let (f, e) = fresnel_and_error(m, &set);
-        Ok((f, [0.0; 3], e))
+    // F (and with a diffuse lobe ρd) for a model's own D and G, and its error on `on` (the
+    // full grid, or with a diffuse lobe the final steps' subsample).
+    let solve_on =
+        |m: &MicrofacetBrdf, on: &GridSamples| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
+            if diffuse && let Some(r) = fresnel_diffuse_and_error(m, on, FINAL_IRLS) {
+                return Ok(r);
+            }
+            if gpu.is_some() {
+                let f = average(m)?;
+                let with = MicrofacetBrdf {
+                    fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                    ..m.clone()
+                };
+                return Ok((f, [0.0; 3], microfacet_error(&with, &set)));
+            }
+            let (f, e) = fresnel_and_error(m, on);
+            Ok((f, [0.0; 3], e))
+        };
+    let solve = |m: &MicrofacetBrdf| solve_on(m, &set);
+    // The final steps of the analytic fits: with a diffuse lobe (each step six passes), on every
+    // `FINAL_STRIDE`-th row, then one full-grid solve at the α found.
+    let final_steps = if diffuse {
+        set.subsample(FINAL_STRIDE)
+    } else {
+        set.subsample(1)
     };
     // The paper's tabulated model: one lobe, F averaged for the extraction's D and G.
     let single = if diffuse {
@@ -285,10 +301,15 @@ fn fit_with(
             (lsq, solve(&model(lsq))?)
         } else {
             let (t, e, (f, kd)) = refine_on_full_grid(lsq.alpha_x.ln(), |t| {
-                let (f, kd, e) = solve(&model(AnalyticNdf::isotropic(kind, t.exp())))?;
+                let m = model(AnalyticNdf::isotropic(kind, t.exp()));
+                let (f, kd, e) = solve_on(&m, &final_steps)?;
                 Ok::<_, FitError>((e, (f, kd)))
             })?;
-            (AnalyticNdf::isotropic(kind, t.exp()), (f, kd, e))
+            let ndf = AnalyticNdf::isotropic(kind, t.exp());
+            match diffuse {
+                true => (ndf, solve(&model(ndf))?),
+                false => (ndf, (f, kd, e)),
+            }
         };
         // The paper's estimate: α by moments with the Fresnel of the extraction; with a
         // diffuse lobe, with F and ρd solved for it.

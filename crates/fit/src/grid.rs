@@ -395,14 +395,16 @@ pub fn fresnel_and_error(model: &MicrofacetBrdf, set: &GridSamples) -> (Vec<Rgb>
 }
 
 /// F per θd bin in [0, 1] and the diffuse albedo ρd solved for a model's D and G
-/// ([`crate::diffuse`]), and the error of the model with them; `None` unless both the set and
-/// the model are isotropic (the diffuse lobe is fitted on the isotropic grid only).
+/// ([`crate::diffuse`]; `irls` reweighted steps towards the metric's L1 minimum), and the error
+/// of the model with them; `None` unless both the set and the model are isotropic (the diffuse
+/// lobe is fitted on the isotropic grid only).
 pub fn fresnel_diffuse_and_error(
     model: &MicrofacetBrdf,
     set: &GridSamples,
+    irls: usize,
 ) -> Option<(Vec<Rgb>, Rgb, f64)> {
     let (iso, tables) = (set.iso.as_ref()?, IsoTables::new(model)?);
-    let (f, q, e) = iso.fresnel_diffuse_and_error_sum(&tables);
+    let (f, q, e) = iso.fresnel_diffuse_and_error_sum(&tables, irls);
     Some((f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64))
 }
 

@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use std::sync::Arc;
 
 /// Scales per θh bin that one refinement scan evaluates.
-pub(crate) const SCAN: usize = 9;
+pub(crate) const SCAN: usize = 7;
 
 /// Bins per row rounded up to the sums' eight lanes.
 const PADDED: usize = ROW.div_ceil(8) * 8;
@@ -181,32 +181,65 @@ impl IsoSamples {
         (fresnel, e)
     }
 
-    /// The weighted normal equations of F per θd bin and ρd/π for a model's D and G
-    /// ([`LinearSums`]), with each row's G2 / (4 cos θo) kept for [`Self::error_with_rows`].
-    pub fn linear_sums(&self, tables: &IsoTables) -> (LinearSums, Vec<f32>) {
-        self.run(&WeightedRows { set: self, tables })
-    }
-
     /// F per θd bin and ρd/π solved for a model's D and G ([`LinearSums::solve`]), and the
-    /// error sum of the model with them: two passes.
-    pub fn fresnel_diffuse_and_error_sum(&self, tables: &IsoTables) -> (Vec<Rgb>, Rgb, f64) {
-        let (sums, ideal) = self.linear_sums(tables);
-        let (fresnel, kd) = sums.solve();
-        let tables = IsoTables {
-            fresnel: std::array::from_fn(|j| fresnel[j]),
-            diffuse: kd,
-            ..tables.clone()
-        };
-        let e = self.error_with_rows(&tables, &ideal);
-        (fresnel, kd, e)
+    /// error sum of the model with them. The weighted least-squares solve (two passes) is
+    /// followed by `irls` steps of iteratively reweighted least squares towards the metric's L1
+    /// minimum (one pass each, which also measures the error of the step before); the best
+    /// solution measured is returned.
+    pub fn fresnel_diffuse_and_error_sum(
+        &self,
+        tables: &IsoTables,
+        irls: usize,
+    ) -> (Vec<Rgb>, Rgb, f64) {
+        let (sums, ideal) = self.run(&WeightedRows {
+            set: self,
+            tables,
+            l1: false,
+            cached: None,
+        });
+        let at = self.row_places();
+        let mut tables = tables.clone();
+        let (mut fresnel, mut kd) = sums.solve();
+        let mut best: Option<(Vec<Rgb>, Rgb, f64)> = None;
+        for _ in 0..irls {
+            tables.set_fresnel(&fresnel);
+            tables.diffuse = kd;
+            let (sums, _) = self.run(&WeightedRows {
+                set: self,
+                tables: &tables,
+                l1: true,
+                cached: Some((&ideal, &at)),
+            });
+            if best.as_ref().is_none_or(|b| sums.error < b.2) {
+                best = Some((fresnel.clone(), kd, sums.error));
+            }
+            (fresnel, kd) = sums.solve();
+        }
+        tables.set_fresnel(&fresnel);
+        tables.diffuse = kd;
+        let e = self.run(&ErrorSum {
+            set: self,
+            tables: &tables,
+            cached: Some((&ideal, &at)),
+        });
+        match best {
+            Some(b) if b.2 < e => b,
+            _ => (fresnel, kd, e),
+        }
     }
 
-    /// The error sum of a model whose rows' G2 / (4 cos θo) were kept by an earlier pass.
-    fn error_with_rows(&self, tables: &IsoTables, ideal: &[f32]) -> f64 {
+    /// Each row's place in this set's row order (the index of its kept G2 / (4 cos θo)).
+    fn row_places(&self) -> Vec<u32> {
         let mut at = vec![0u32; ROWS];
         for (p, &r) in self.rows.iter().enumerate() {
             at[r as usize] = p as u32;
         }
+        at
+    }
+
+    /// The error sum of a model whose rows' G2 / (4 cos θo) were kept by an earlier pass.
+    fn error_with_rows(&self, tables: &IsoTables, ideal: &[f32]) -> f64 {
+        let at = self.row_places();
         self.run(&ErrorSum {
             set: self,
             tables,
@@ -329,12 +362,20 @@ impl RowPass for IdealRows<'_> {
 }
 
 /// The weighted sums of the F / ρd solve, and each row's G2 / (4 cos θo) kept (`PADDED` per
-/// row, in row order). Per bin w = 1 / (1 + x)², m = D G2 / (4 cos θo) (0 where D ≤ 0),
-/// μ = cos θi.
+/// row, in row order) unless given. Per bin w = 1 / (1 + x)², m = D G2 / (4 cos θo) (0 where
+/// D ≤ 0), μ = cos θi. With `l1`, a step of iteratively reweighted least squares for the
+/// metric's L1 norm: w is also divided by the current model's |ln(1 + x_model) − ln(1 + x)|
+/// (at least `IRLS_FLOOR`; F and ρd/π from `tables`), whose sum the pass gathers.
 struct WeightedRows<'a> {
     set: &'a IsoSamples,
     tables: &'a IsoTables,
+    l1: bool,
+    cached: Option<(&'a [f32], &'a [u32])>,
 }
+
+/// The smallest residual an IRLS weight divides by: 10⁻³ in ln(1 + x), about the f32 error
+/// of a sum of a row's terms and far below any real material's mean error.
+const IRLS_FLOOR: f32 = 1e-3;
 
 impl RowPass for WeightedRows<'_> {
     type Acc = (LinearSums, Vec<f32>);
@@ -345,12 +386,20 @@ impl RowPass for WeightedRows<'_> {
 
     #[inline(always)]
     fn row(&self, acc: &mut Self::Acc, r: usize) {
-        let data = &self.set.data;
+        let (t, data) = (self.tables, &self.set.data);
         let mut ideal = [0.0f32; PADDED];
-        row_ideal(self.tables, merl_geometry(), r, &mut ideal);
-        acc.1.extend_from_slice(&ideal);
+        match self.cached {
+            Some((rows, at)) => {
+                let p = at[r] as usize * PADDED;
+                ideal.copy_from_slice(&rows[p..p + PADDED]);
+            }
+            None => {
+                row_ideal(t, merl_geometry(), r, &mut ideal);
+                acc.1.extend_from_slice(&ideal);
+            }
+        }
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
-        let d = self.tables.d32[i];
+        let d = t.d32[i];
         let d = if d > 0.0 { d } else { 0.0 };
         let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
         let valid = &data.valid[r * ROW..(r + 1) * ROW];
@@ -360,13 +409,25 @@ impl RowPass for WeightedRows<'_> {
             mu_i[k] = if valid[k] { mu[ROW - k] } else { 0.0 };
         }
         for c in 0..3 {
-            let x: &[f32; ROW] = data.x[(3 * r + c) * ROW..(3 * r + c + 1) * ROW]
-                .try_into()
-                .unwrap();
+            let range = (3 * r + c) * ROW..(3 * r + c + 1) * ROW;
+            let x: &[f32; ROW] = data.x[range.clone()].try_into().unwrap();
+            let mut inv_r = [1.0f32; ROW];
+            if self.l1 {
+                let log_x: &[f32; ROW] = data.log_x[range].try_into().unwrap();
+                let (f, kd) = (t.fresnel[j][c] as f32, t.diffuse[c] as f32);
+                let mut e = [0.0f32; PADDED];
+                for k in 0..ROW {
+                    // x_model = F D (G2 / (4 cos θo)) + ρd/π cos θi, masked bins 0
+                    let res = (ln_1p(f * m[k] + kd * mu_i[k]) - log_x[k]).abs();
+                    e[k] = if valid[k] { res } else { 0.0 };
+                    inv_r[k] = 1.0 / res.max(IRLS_FLOOR);
+                }
+                acc.0.error += lanes_sum(&e);
+            }
             let mut s = [[0.0f32; PADDED]; 5];
             for k in 0..ROW {
                 // w = 1 / (1 + x)²: d ln(1 + x) = dx / (1 + x)
-                let w = 1.0 / ((1.0 + x[k]) * (1.0 + x[k]));
+                let w = inv_r[k] / ((1.0 + x[k]) * (1.0 + x[k]));
                 let (wm, wu) = (w * m[k], w * mu_i[k]);
                 s[0][k] = wm * m[k];
                 s[1][k] = wm * mu_i[k];

@@ -2,7 +2,9 @@
 //!
 //! Extracts the normal distribution function of a measured material by power iterations on the
 //! backscattering slice (Dupuy et al., EGSR 2015), tabulates G1 and the Fresnel curve, and fits
-//! GGX and Beckmann parameters, on the CPU in f64.
+//! GGX and Beckmann parameters, on the CPU in f64. Isotropic fits add a Lambertian lobe to every
+//! model ([`diffuse`]), refine the tabulated NDF in the metric's space and fit physical Fresnel
+//! curves to the tables ([`fresnel_fit`]).
 //!
 //! ```
 //! use facet_fit::analytic::parse_analytic;

@@ -36,7 +36,8 @@ pub struct ParamRecord {
     pub alpha_y: f64,
     /// Rotation of the α axes, radians.
     pub rotation: f64,
-    /// The error metric of the least-squares model (with its own Fresnel table).
+    /// The error metric of the least-squares model with its own Fresnel table (and ρd); a
+    /// physical Fresnel's error is in `fresnel_fits`.
     pub error: f64,
     /// How `alpha_x`, `alpha_y` and `rotation` were found (`"least_squares"`).
     pub method: String,
@@ -82,11 +83,12 @@ fn power_iteration() -> String {
 pub struct Timings {
     /// Reading the source (0 when the caller did not time it).
     pub load: f64,
-    /// The power iteration and the D / G1 tables.
+    /// The first power iteration and its D / G1 tables.
     pub extract: f64,
-    /// The Fresnel average of the tabulated model.
+    /// The grid samples and the tabulated model's F (and ρd): with a diffuse lobe, its
+    /// separation (more extractions), refinement and physical Fresnel fits included.
     pub fresnel: f64,
-    /// The error metrics and the GGX / Beckmann fits.
+    /// The GGX / Beckmann fits with their errors (and physical Fresnel fits).
     pub fit: f64,
     /// The whole fit.
     pub total: f64,

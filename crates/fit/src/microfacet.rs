@@ -204,7 +204,12 @@ pub fn correlation(phi: f64) -> f64 {
 /// G2 = 1 / (1 + max(Λi, Λo) + λ(φ) min(Λi, Λo)). G2(o, o) = G1(o) since λ(0) = 0, which is
 /// what the backscattering inversion assumes.
 pub fn g2(lambda_i: f64, lambda_o: f64, correlation: f64) -> f64 {
-    1.0 / (1.0 + lambda_i.max(lambda_o) + correlation * lambda_i.min(lambda_o))
+    let (hi, lo) = (lambda_i.max(lambda_o), lambda_i.min(lambda_o));
+    // Both directions on the horizon: Λ = ∞ twice, and λ(φ) · ∞ would be NaN for λ = 0.
+    if hi == f64::INFINITY {
+        return 0.0;
+    }
+    1.0 / (1.0 + hi + correlation * lo)
 }
 
 /// A microfacet BRDF with an optional Lambertian term.

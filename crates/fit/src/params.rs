@@ -84,10 +84,8 @@ pub fn model_with_fresnel(name: &str, ndf: AnalyticNdf, set: &GridSamples) -> Mi
 /// whose F and ρd are solved for it ([`fresnel_diffuse_and_error`], isotropic sets).
 fn error_of(name: &str, ndf: AnalyticNdf, diffuse: bool, set: &GridSamples) -> f64 {
     let model = MicrofacetBrdf::ideal(name, Ndf::Analytic(ndf));
-    if diffuse {
-        if let Some((_, _, e)) = fresnel_diffuse_and_error(&model, set) {
-            return e;
-        }
+    if diffuse && let Some((_, _, e)) = fresnel_diffuse_and_error(&model, set, 0) {
+        return e;
     }
     match IsoTables::new(&model).filter(|_| set.rotations.len() == 1) {
         Some(_) if set.iso.is_some() => fresnel_and_error(&model, set).1,

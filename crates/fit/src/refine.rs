@@ -4,7 +4,7 @@
 //! held the metric splits into 90 problems of one unknown: the scale s_i of D in bin i. A round
 //! scans `SCAN` scales per bin around the current one (one pass, [`IsoSamples::bin_scan`]),
 //! keeps the best with a parabolic step between its neighbours, and solves F and ρd again for
-//! the new D; the scan's span halves every round. The rounds run on a third of the grid's rows
+//! the new D; the scan's span halves every round. The rounds run on a quarter of the grid's rows
 //! and stop when a round gains less than `MIN_GAIN`. The bin scales, interpolated in θ, then
 //! multiply the D table, which is renormalised (∫ D cos θh dω = 1); G1 is either recomputed by
 //! Smith's relation from the new D or held, whichever fits better. The result is kept only if its
@@ -25,9 +25,12 @@ use std::sync::Arc;
 /// Rounds at most.
 const ROUNDS: usize = 8;
 /// The rounds' rows: every `STRIDE`-th row of the full grid.
-const STRIDE: usize = 3;
+const STRIDE: usize = 4;
 /// The first scan spans ln s ∈ [−SPAN, SPAN].
 const SPAN: f64 = 0.5;
+/// Reweighted steps of each F / ρd solve (towards the metric's L1 minimum, which the bin
+/// scans minimise: a plain weighted least-squares solve would undo part of their gain).
+const IRLS: usize = 2;
 /// A round that lowers the error by less than this fraction ends the refinement.
 const MIN_GAIN: f64 = 1e-3;
 
@@ -58,7 +61,7 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
     let mut tables = IsoTables::new(&model_of(ndf))?;
     let d0 = tables.d32;
     let solve = |tables: &mut IsoTables| {
-        let (f, q, e) = sub.fresnel_diffuse_and_error_sum(tables);
+        let (f, q, e) = sub.fresnel_diffuse_and_error_sum(tables, IRLS);
         tables.set_fresnel(&f);
         tables.diffuse = q;
         e
@@ -113,7 +116,7 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
                 ..t.clone()
             };
             let ndf = TabulatedNdf::new(tables, Stretch::IDENTITY).ok()?;
-            let (fresnel, albedo, error) = fresnel_diffuse_and_error(&model_of(&ndf), set)?;
+            let (fresnel, albedo, error) = fresnel_diffuse_and_error(&model_of(&ndf), set, IRLS)?;
             Some(Refined {
                 ndf,
                 fresnel,
@@ -211,6 +214,7 @@ pub(crate) fn tabulate(ndf: AnalyticNdf, nu: usize, ng: usize) -> Option<Tabulat
     let n = Ndf::Analytic(ndf);
     let dir = |th: f64| DVec3::new(th.sin(), 0.0, th.cos());
     let d = (0..nu).map(|k| n.d(dir(u_node_theta(k, nu)))).collect();
+    // G1 = 1 / (1 + Λ), 0 at θ = π/2 where Λ is infinite (G1 ∝ cos θ there, as extracted).
     let g1 = (0..ng)
         .map(|k| {
             let th = theta_node(k, ng);

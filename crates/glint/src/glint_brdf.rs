@@ -79,8 +79,8 @@ pub fn glint_count_at(
         .sum()
 }
 
-/// f(ωi, ωo) of the glint model; `model` gives F and G2 (its NDF is the one the DPF was built
-/// from).
+/// f(ωi, ωo) of the glint model plus the model's diffuse lobe ρd/π; `model` gives F, G2 and ρd
+/// (its NDF is the one the DPF was built from).
 pub fn glint_eval(
     model: &MicrofacetBrdf,
     field: &FlakeField,
@@ -95,8 +95,10 @@ pub fn glint_eval(
     }
     let h = (wi + wo).normalize();
     let count = glint_count(field, fp, wi, wo, p, cfg);
+    // The fit's diffuse lobe ρd/π lies under the flakes.
+    let diffuse = model.diffuse.map(|k| k / std::f64::consts::PI);
     if count == 0.0 {
-        return [0.0; 3];
+        return diffuse;
     }
     let phi = facet_fit::geometry::azimuth_between(wi, wo);
     let g = g2(model.ndf.lambda(wi), model.ndf.lambda(wo), correlation(phi));
@@ -104,7 +106,7 @@ pub fn glint_eval(
     let scale = g * h.dot(wo) * count
         / (field.density * fp.area() * cone_solid_angle(cfg.gamma) * wi.z * h.z)
         / wo.z;
-    f.map(|c| c * scale)
+    std::array::from_fn(|c| f[c] * scale + diffuse[c])
 }
 
 /// Samples ωi for a given ωo from the smooth lobe (a normal visible from ωo, ωo reflected about

@@ -229,3 +229,33 @@ fn a_gltf_scene_opens_and_a_bad_one_is_an_error() {
     assert_eq!(h.state().material.record, before);
     let _ = std::fs::remove_file(&bad);
 }
+
+#[test]
+fn diffuse_albedo_edits_reach_the_renderer_and_reset_to_the_fit() {
+    for shown in [Shown::Tabulated, Shown::Ggx] {
+        let mut h = harness();
+        h.state_mut().material.shown = shown;
+        h.run_steps(2);
+        let fitted = h.state().material.fitted_diffuse().unwrap();
+        let gen0 = h.state().generation;
+        h.state_mut().material.set_diffuse([0.2, 0.3, 1.5]);
+        h.run_steps(2);
+        let app = h.state();
+        let m = app.material.render_material().unwrap().facet.unwrap();
+        let choice = match shown {
+            Shown::Tabulated => facet_fit::material::ModelChoice::Tabulated,
+            _ => facet_fit::material::ModelChoice::Ggx,
+        };
+        // Clamped to [0, 1]; the renderer's model carries it.
+        assert_eq!(
+            m.fit.model(choice).unwrap().diffuse,
+            [0.2, 0.3, 1.0],
+            "{shown:?}"
+        );
+        assert!(app.generation > gen0, "{shown:?}: generation not bumped");
+        assert_eq!(app.sent_key.as_ref(), Some(&app.material.key()));
+        h.get_by_role_and_label(Role::Button, "fitted").click();
+        h.run_steps(2);
+        assert_eq!(h.state().material.diffuse(), Some(fitted), "{shown:?}");
+    }
+}

@@ -120,20 +120,23 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     }
     if let (Some(albedo), Some(fitted)) = (m.diffuse(), m.fitted_diffuse()) {
         ui.label("Diffuse albedo ρd (f = ρd/π):");
-        let old = albedo.map(|v| v as f32);
-        let mut rgb = old;
+        let mut rgb = albedo.map(|v| v as f32);
+        // Only an edit counts: the picker's colour-space round trip moves the value by ~1e-7.
+        let mut edited = None;
         ui.horizontal(|ui| {
-            ui.color_edit_button_rgb(&mut rgb);
+            if ui.color_edit_button_rgb(&mut rgb).changed() {
+                edited = Some(rgb.map(|v| v as f64));
+            }
             ui.label(format!(
                 "{:.3} {:.3} {:.3}",
                 albedo[0], albedo[1], albedo[2]
             ));
             if ui.small_button("fitted").clicked() {
-                rgb = fitted.map(|v| v as f32);
+                edited = Some(fitted);
             }
         });
-        if rgb != old {
-            m.set_diffuse(rgb.map(|v| v as f64));
+        if let Some(albedo) = edited {
+            m.set_diffuse(albedo);
         }
     }
     ui.label("Fresnel tint:");
