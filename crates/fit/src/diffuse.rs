@@ -142,7 +142,7 @@ impl Brdf for WithoutDiffuse<'_> {
 pub struct Separation {
     /// The extraction from f − ρd/π that fitted best.
     pub extraction: Extraction,
-    /// ρd removed before that extraction (the solved ρd is [`Self::albedo`]).
+    /// ρd removed before that extraction (the model's own ρd is solved with its F).
     pub removed: Rgb,
     /// The search grid's error of that model.
     pub error: f64,

@@ -65,7 +65,7 @@ pub struct FitConfig {
     /// false: the paper's single specular lobe with F averaged. Isotropic fits only: an
     /// anisotropic fit always takes the single lobe.
     pub diffuse: bool,
-    /// Refine the tabulated NDF in the metric's space after the extraction ([`crate::refine`]),
+    /// Refine the tabulated NDF in the metric's space after the extraction (`refine.rs`),
     /// and tabulate the best analytic fit's NDF when it fits better (diffuse fits only).
     pub refine: bool,
     /// The Fresnel each model renders with: its table, or the conductor, dielectric or Schlick
