@@ -104,7 +104,7 @@ pub enum QuadratureArg {
 #[derive(Args)]
 #[command(allow_negative_numbers = true)]
 pub struct FitArgs {
-    /// MERL .binary file, `nbrdf:NAME`, `analytic:ggx?alpha=0.2&f0=0.04`, or a fit .json.
+    /// MERL .binary file, RGL .bsdf, `nbrdf:NAME`, `analytic:ggx?alpha=0.2&f0=0.04`, or a fit .json.
     #[arg(required = true)]
     inputs: Vec<String>,
     /// Models to fit and report (the tabulated NDF is always extracted).

@@ -2,6 +2,7 @@
 
 mod args;
 mod bench_cmd;
+mod convert_cmd;
 mod demo_cmd;
 mod dpf_cmd;
 mod fit_cmd;
@@ -25,6 +26,9 @@ struct Cli {
 enum Command {
     /// Extract the NDF of each input and fit tabulated, GGX and Beckmann models.
     Fit(fit_cmd::FitArgs),
+    /// A material from one format to another: MERL .binary, RGL .bsdf, fit .json (by OUT's
+    /// extension; the neural proxies and analytic models as inputs).
+    Convert(convert_cmd::ConvertArgs),
     /// The glint model's Directional Probability Function: one query, or the tables as EXR.
     Dpf(dpf_cmd::DpfArgs),
     /// Path-trace a glTF scene (wavefront, on the GPU) to PNG and EXR.
@@ -41,6 +45,7 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Fit(args)) => fit_cmd::run(&args),
+        Some(Command::Convert(args)) => convert_cmd::run(&args),
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),

@@ -24,6 +24,15 @@ pub enum FitError {
         /// What is wrong with it.
         problem: String,
     },
+    /// A file that is not a usable RGL `.bsdf` (tensor file damaged, fields missing or of the
+    /// wrong shape, densities that are not densities), or a source that cannot be written as one.
+    #[error("{path}: RGL .bsdf: {problem}")]
+    Bsdf {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
     /// A neural-proxy file (or an entry of it) of the wrong shape, or a name it does not hold.
     #[error("{path}: neural BRDF file: {problem}")]
     Nbrdf {

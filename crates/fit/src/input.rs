@@ -46,6 +46,8 @@ impl Cap {
     pub const NBRDF: Cap = Cap::new("neural BRDF file", 256 * MIB);
     /// A MERL `.binary` (exactly 12 + 3 · 8 · 1 458 000 bytes when valid).
     pub const MERL: Cap = Cap::new("MERL file", 64 * MIB);
+    /// An RGL `.bsdf` tensor file (the database's spectral files are tens of MiB).
+    pub const BSDF: Cap = Cap::new("RGL .bsdf file", 1024 * MIB);
     /// A glTF JSON or a whole `.glb`.
     pub const GLTF: Cap = Cap::new("glTF file", 4096 * MIB);
     /// A glTF `.bin` buffer.

@@ -20,7 +20,8 @@
 //! println!("GGX α = {:.4}, error {:.5}", ggx.alpha_x, ggx.error);
 //! ```
 //!
-//! Sources implement [`brdf::Brdf`]: MERL files ([`merl::MerlBrdf`]), the neural proxies
+//! Sources implement [`brdf::Brdf`]: MERL files ([`merl::MerlBrdf`]), RGL `.bsdf` files
+//! ([`rgl::RglBsdf`], written by [`rgl::write_rgl`]), the neural proxies
 //! ([`nbrdf::NbrdfLibrary`]), analytic models ([`analytic::parse_analytic`]) and fits themselves
 //! ([`material::FittedMaterial`]). [`fit::fit_material`] runs the whole pipeline;
 //! [`extract`] holds the power iteration, [`tabulated`] the stretched tabulated NDF with its
@@ -43,6 +44,7 @@ pub mod albedo;
 pub mod analytic;
 pub mod brdf;
 pub mod chi2;
+pub mod cie;
 pub mod diffuse;
 pub mod error;
 pub mod extract;
@@ -64,10 +66,13 @@ pub mod nbrdf;
 pub mod params;
 pub mod quadrature;
 pub(crate) mod refine;
+pub mod rgl;
 pub mod source;
 pub mod tabulated;
+pub mod tensor_file;
 pub(crate) mod visible_normals;
 pub mod visible_tables;
+pub mod warp2d;
 
 pub use brdf::{Brdf, Rgb};
 pub use error::FitError;

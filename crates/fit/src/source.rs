@@ -6,9 +6,11 @@ use crate::error::FitError;
 use crate::material::FittedMaterial;
 use crate::merl::MerlBrdf;
 use crate::nbrdf::NbrdfLibrary;
+use crate::rgl::RglBsdf;
 use std::path::Path;
 
-/// An input: `nbrdf:NAME`, `analytic:SPEC`, a fit `.json` (its tabulated model) or a MERL file.
+/// An input: `nbrdf:NAME`, `analytic:SPEC`, a fit `.json` (its tabulated model), an RGL
+/// `.bsdf` or a MERL file (any other name).
 /// `nbrdf` is the network file used for `nbrdf:` inputs (`None`: the embedded MERL-100
 /// proxies), opened on first use.
 pub fn open_source(
@@ -28,6 +30,9 @@ pub fn open_source(
     let path = Path::new(input);
     if path.extension().is_some_and(|e| e == "json") {
         return Ok(Box::new(FittedMaterial::load(path)?));
+    }
+    if path.extension().is_some_and(|e| e == "bsdf") {
+        return Ok(Box::new(RglBsdf::open(path)?));
     }
     Ok(Box::new(MerlBrdf::open(path)?))
 }
