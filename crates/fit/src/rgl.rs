@@ -321,6 +321,8 @@ impl Brdf for RglBsdf {
 pub struct BsdfResolution {
     /// θi slices, uniform in θi from 0 to [`MAX_THETA_I`].
     pub theta_i: usize,
+    /// φi slices over [−π, π] of an anisotropic material (an isotropic one takes one).
+    pub phi_i: usize,
     /// The sample space's side (the `rgb` and `luminance` grids).
     pub sample: usize,
     /// The VNDF grid's side.
@@ -334,10 +336,12 @@ pub struct BsdfResolution {
 pub const MAX_THETA_I: f64 = 89.0;
 
 impl BsdfResolution {
-    /// 16 θi slices, a 64 × 64 sample space and VNDF, 128 NDF columns (0.8 MB).
+    /// 16 θi slices (and 16 φi slices when anisotropic), a 64 × 64 sample space and VNDF,
+    /// 128 NDF nodes: 1.25 MiB isotropic, 20 MiB anisotropic.
     pub const fn standard() -> Self {
         BsdfResolution {
             theta_i: 16,
+            phi_i: 16,
             sample: 64,
             vndf: 64,
             ndf: 128,
@@ -348,6 +352,7 @@ impl BsdfResolution {
     pub fn validate(&self) -> Result<(), String> {
         for (name, n) in [
             ("theta_i", self.theta_i),
+            ("phi_i", self.phi_i),
             ("sample", self.sample),
             ("vndf", self.vndf),
             ("ndf", self.ndf),
@@ -384,77 +389,97 @@ fn projected_area(d: &dyn Fn(f64) -> f64, theta_i: f64) -> f64 {
 }
 
 /// The NDF the format parameterises its sample space with: the power-iteration NDF of the
-/// source's backscattering (Dupuy & Jakob's, the paper's first step).
+/// source's backscattering (Dupuy & Jakob's, the paper's first step), on a (θ, φ) grid when the
+/// source is anisotropic.
 pub fn sampling_ndf(brdf: &dyn Brdf) -> Result<Ndf, FitError> {
-    let ex = crate::extract::extract_isotropic(brdf, &crate::extract::ExtractConfig::isotropic())?;
+    use crate::extract::{ExtractConfig, extract_anisotropic, extract_isotropic};
+    let ex = if brdf.is_isotropic() {
+        extract_isotropic(brdf, &ExtractConfig::isotropic())?
+    } else {
+        extract_anisotropic(brdf, &ExtractConfig::anisotropic())?
+    };
     Ok(Ndf::Tabulated(std::sync::Arc::new(ex.ndf)))
 }
 
-/// The tensor fields of an isotropic `brdf` with the visible normals of `ndf` as the sample
-/// space (`description` goes into the file).
+/// The tensor fields of `brdf` with the visible normals of `ndf` as the sample space
+/// (`description` goes into the file). An isotropic source takes one φi slice and φm relative
+/// to φi; an anisotropic one (or an anisotropic NDF) takes `res.phi_i` slices over [−π, π].
 pub fn rgl_tensor(
     brdf: &dyn Brdf,
     ndf: &Ndf,
     res: BsdfResolution,
     description: &str,
 ) -> Result<(TensorWriter, usize), String> {
+    use crate::geometry::spherical;
     res.validate()?;
-    if !brdf.is_isotropic() || !ndf.is_isotropic() {
-        return Err("only isotropic materials are written as .bsdf".into());
+    let aniso = !(brdf.is_isotropic() && ndf.is_isotropic());
+    let nodes = |n: usize| (0..n).map(move |j| j as f64 / (n - 1) as f64);
+    let thetas: Vec<f64> = nodes(res.theta_i)
+        .map(|t| MAX_THETA_I.to_radians() * t)
+        .collect();
+    let phis: Vec<f64> = if aniso {
+        nodes(res.phi_i).map(u2phi).collect()
+    } else {
+        vec![0.0]
+    };
+    // D and σ on u = (θ, φ) nodes; an isotropic D takes two identical rows (the tables are 2D).
+    let rows = if aniso { res.ndf } else { 2 };
+    let d_iso = |t: f64| ndf.d(spherical(t, 0.0));
+    let (mut d_tab, mut s_tab) = (Vec::new(), Vec::new());
+    for y in nodes(rows) {
+        for x in nodes(res.ndf) {
+            let (t, phi) = (u2theta(x), u2phi(y));
+            d_tab.push(ndf.d(spherical(t, phi)));
+            s_tab.push(if aniso {
+                // Smith: σ = cos θ (1 + Λ), its limit taken just inside the horizon.
+                let t = t.min(FRAC_PI_2 - 1e-4);
+                t.cos() * (1.0 + ndf.lambda(spherical(t, phi)))
+            } else {
+                projected_area(&d_iso, t)
+            });
+        }
     }
-    let d = |theta: f64| ndf.d(crate::geometry::spherical(theta, 0.0));
-    let thetas: Vec<f64> = (0..res.theta_i)
-        .map(|k| MAX_THETA_I.to_radians() * k as f64 / (res.theta_i - 1) as f64)
-        .collect();
-    // D and σ on u nodes, two identical rows (the format's tables are 2D; D is isotropic).
-    let u_nodes = |n: usize| (0..n).map(move |j| j as f64 / (n - 1) as f64);
-    let d_row: Vec<f64> = u_nodes(res.ndf).map(|u| d(u2theta(u))).collect();
-    let s_row: Vec<f64> = u_nodes(res.ndf)
-        .map(|u| projected_area(&d, u2theta(u)))
-        .collect();
-    if d_row
+    if d_tab
         .iter()
-        .chain(&s_row)
+        .chain(&s_tab)
         .any(|v| !(v.is_finite() && *v >= 0.0))
-        || !(s_row[0] > 0.0)
+        || !(s_tab[0] > 0.0)
     {
         return Err("the NDF is not a finite, non-negative distribution".into());
     }
-    let twice = |row: &[f64]| [row, row].concat();
-    let ndf_table = Warp2D::interpolant([res.ndf, 2], &twice(&d_row), vec![])?;
-    let sigma_table = Warp2D::interpolant([res.ndf, 2], &twice(&s_row), vec![])?;
-    // The VNDF of each slice over u(m), φm relative to φi = 0.
+    let ndf_table = Warp2D::interpolant([res.ndf, rows], &d_tab, vec![])?;
+    let sigma_table = Warp2D::interpolant([res.ndf, rows], &s_tab, vec![])?;
+    let slices: Vec<(f64, f64)> = phis
+        .iter()
+        .flat_map(|&p| thetas.iter().map(move |&t| (p, t)))
+        .collect();
+    // The VNDF of each slice over u(m) (φm relative to φi = 0 when isotropic).
     let nv = res.vndf;
-    let mut vndf = Vec::with_capacity(res.theta_i * nv * nv);
-    for &ti in &thetas {
-        let wi = crate::geometry::spherical(ti, 0.0);
-        for y in u_nodes(nv) {
-            for x in u_nodes(nv) {
+    let mut vndf = Vec::with_capacity(slices.len() * nv * nv);
+    for &(pi, ti) in &slices {
+        let wi = spherical(ti, pi);
+        for y in nodes(nv) {
+            for x in nodes(nv) {
                 let tm = u2theta(x);
-                let m = crate::geometry::spherical(tm, u2phi(y));
-                vndf.push(wi.dot(m).max(0.0) * d(tm) * x * tm.sin());
+                let m = spherical(tm, u2phi(y));
+                vndf.push(wi.dot(m).max(0.0) * ndf.d(m) * x * tm.sin());
             }
         }
     }
-    let params = vec![vec![0.0], thetas.clone()];
-    let vndf_warp = Warp2D::distribution([nv, nv], &vndf, params)?;
+    let vndf_warp = Warp2D::distribution([nv, nv], &vndf, vec![phis.clone(), thetas.clone()])?;
     // The data and the luminance on the sample space.
     let ns = res.sample;
-    let mut rgb = vec![0.0f32; res.theta_i * 3 * ns * ns];
-    let mut lum = vec![0.0f32; res.theta_i * ns * ns];
+    let mut rgb = vec![0.0f32; slices.len() * 3 * ns * ns];
+    let mut lum = vec![0.0f32; slices.len() * ns * ns];
     let mut missing = 0;
-    for (k, &ti) in thetas.iter().enumerate() {
-        let wi = crate::geometry::spherical(ti, 0.0);
-        let u_wi = [theta2u(ti), phi2u(0.0)];
-        let sigma = sigma_table.eval(u_wi, &[]);
+    for (k, &(pi, ti)) in slices.iter().enumerate() {
+        let wi = spherical(ti, pi);
+        let sigma = sigma_table.eval([theta2u(ti), phi2u(pi)], &[]);
         let mut slice_lum = vec![0.0; ns * ns];
         for (p, l) in slice_lum.iter_mut().enumerate() {
-            let s = [
-                (p % ns) as f64 / (ns - 1) as f64,
-                (p / ns) as f64 / (ns - 1) as f64,
-            ];
-            let (u_m, _) = vndf_warp.sample(s, &[0.0, ti]);
-            let m = crate::geometry::spherical(u2theta(u_m[0]), u2phi(u_m[1]));
+            let s = [(p % ns) as f64, (p / ns) as f64].map(|v| v / (ns - 1) as f64);
+            let (u_m, _) = vndf_warp.sample(s, &[pi, ti]);
+            let m = spherical(u2theta(u_m[0]), u2phi(u_m[1]));
             let wo = 2.0 * m.dot(wi) * m - wi;
             let dm = ndf_table.eval(u_m, &[]);
             if wo.z <= 0.0 || !(dm > 0.0) {
@@ -464,6 +489,7 @@ pub fn rgl_tensor(
                 missing += 1;
                 continue;
             };
+            // The data: f · 4σ / D, with σ and D as the reader interpolates them.
             let value: Rgb = std::array::from_fn(|c| f[c] * 4.0 * sigma / dm);
             for c in 0..3 {
                 rgb[(k * 3 + c) * ns * ns + p] = value[c] as f32;
@@ -481,16 +507,17 @@ pub fn rgl_tensor(
         return Err("the source gave values that are not finite".into());
     }
     let f32s = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+    let (np, nt) = (phis.len(), thetas.len());
     let mut w = TensorWriter::default();
     w.u8s("description", description.as_bytes());
     w.u8s("jacobian", &[1]);
-    w.f32s("theta_i", &[res.theta_i], &f32s(&thetas));
-    w.f32s("phi_i", &[1], &[0.0]);
-    w.f32s("ndf", &[2, res.ndf], &f32s(&twice(&d_row)));
-    w.f32s("sigma", &[2, res.ndf], &f32s(&twice(&s_row)));
-    w.f32s("vndf", &[1, res.theta_i, nv, nv], &f32s(&vndf));
-    w.f32s("luminance", &[1, res.theta_i, ns, ns], &lum);
-    w.f32s("rgb", &[1, res.theta_i, 3, ns, ns], &rgb);
+    w.f32s("theta_i", &[nt], &f32s(&thetas));
+    w.f32s("phi_i", &[np], &f32s(&phis));
+    w.f32s("ndf", &[rows, res.ndf], &f32s(&d_tab));
+    w.f32s("sigma", &[rows, res.ndf], &f32s(&s_tab));
+    w.f32s("vndf", &[np, nt, nv, nv], &f32s(&vndf));
+    w.f32s("luminance", &[np, nt, ns, ns], &lum);
+    w.f32s("rgb", &[np, nt, 3, ns, ns], &rgb);
     Ok((w, missing))
 }
 
@@ -506,9 +533,6 @@ pub fn write_rgl(
         path: path.to_owned(),
         problem,
     };
-    if !brdf.is_isotropic() {
-        return Err(bad("only isotropic materials are written as .bsdf".into()));
-    }
     let ndf = sampling_ndf(brdf)?;
     let (tensor, missing) = rgl_tensor(brdf, &ndf, res, description).map_err(bad)?;
     let bytes = tensor.to_bytes();
@@ -537,6 +561,7 @@ mod tests {
     fn small() -> BsdfResolution {
         BsdfResolution {
             theta_i: 10,
+            phi_i: 8,
             sample: 24,
             vndf: 32,
             ndf: 64,
@@ -611,5 +636,41 @@ mod tests {
                 "θ {ti}: {got} against {smith}"
             );
         }
+    }
+
+    #[test]
+    fn an_anisotropic_source_is_written_with_phi_slices_and_read_back() {
+        let src = parse_analytic("ggx?alpha_x=0.15&alpha_y=0.4&rotation=30&f0=0.9").unwrap();
+        let res = BsdfResolution {
+            theta_i: 12,
+            phi_i: 24,
+            sample: 48,
+            vndf: 48,
+            ndf: 96,
+        };
+        let (w, _) = rgl_tensor(&src, &src.ndf, res, "").unwrap();
+        let file = RglBsdf::parse("t", w.to_bytes()).unwrap();
+        assert!(!file.is_isotropic());
+        // Relative errors over the lobe (f cos θo above 5 % of the peak) at scattered pairs.
+        let mut errors = Vec::new();
+        for k in 0..3000 {
+            let r = |a: f64| (k as f64 * a).fract();
+            let wi = crate::geometry::spherical(1.2 * r(0.618_034), 2.0 * PI * r(0.754_878));
+            let wo = crate::geometry::spherical(1.2 * r(0.569_840), 2.0 * PI * r(0.913_099));
+            let f = src.eval(wi, wo).unwrap()[0];
+            if f * wo.z > 0.05 * 1.0 {
+                errors.push((file.eval(wi, wo).unwrap()[0] / f - 1.0).abs());
+            }
+        }
+        errors.sort_by(f64::total_cmp);
+        let median = errors[errors.len() / 2];
+        // Measured 0.32 % (p90 0.9 %): linear interpolation over φi, θi and the sample space
+        // between nodes where the file is exact; 1 % leaves room, a wrong fold or a relative
+        // φ where an absolute one belongs gives tens of per cent.
+        assert!(
+            errors.len() > 100 && median < 0.01,
+            "{} pairs, median {median}",
+            errors.len()
+        );
     }
 }
