@@ -24,7 +24,7 @@ pub struct ConvertArgs {
     #[arg(long)]
     pub force: bool,
     /// The .bsdf grids: θi slices, the sample space's side and the VNDF's side, each 2 to
-    /// 1024 (default 16 64 64: 1.25 MiB).
+    /// 1024 (default 24 64 64: 1.9 MiB).
     #[arg(long, num_args = 3, value_names = ["THETA_I", "SAMPLE", "VNDF"])]
     pub bsdf_resolution: Option<Vec<usize>>,
     /// Neural proxy file for `nbrdf:` inputs (default: `$FACET_NBRDF`, else the embedded

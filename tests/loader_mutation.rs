@@ -1,6 +1,6 @@
 //! Seeded, bounded mutation test of every loader that reads outside input: MERL tables, fit
-//! JSON, neural BRDF JSON, glTF scenes (JSON and `.glb`, buffers embedded) and OpenEXR
-//! environment maps.
+//! JSON, neural BRDF JSON, RGL `.bsdf` tensor files (RGB, spectral, anisotropic), glTF scenes
+//! (JSON and `.glb`, buffers embedded) and OpenEXR environment maps.
 //!
 //! Each loader gets valid seed inputs, built here, and thousands of mutated versions of them:
 //! bit flips, bytes and words overwritten with interesting values, truncations, insertions,
@@ -19,11 +19,14 @@
 //! case before its call (for a case that aborts the process, as a failed allocation does);
 //! `LOADER_MUTATION_SCALE=N` runs N times the cases and `LOADER_MUTATION_SEED=S` other ones.
 
+mod common;
+
 use facet_fit::Brdf;
 use facet_fit::analytic::parse_analytic;
 use facet_fit::material::{FittedMaterial, ModelChoice};
 use facet_fit::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
 use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::rgl::{BsdfResolution, RglBsdf, rgl_tensor};
 use facet_render::scene::data_uri::encode_base64;
 use facet_render::scene::{EnvironmentMap, LoadOptions, Scene};
 use glam::{DVec3, Vec2, Vec3};
@@ -1536,6 +1539,69 @@ fn exr_loader_survives_mutation() {
     });
 }
 
+// ---------------------------------------------------------------------------------------------
+// RGL .bsdf: tensor files, RGB, spectral and anisotropic.
+
+fn check_bsdf(path: &Path, bytes: &[u8]) -> Result<bool, String> {
+    match RglBsdf::from_bytes(path, bytes.to_vec()) {
+        Ok(file) => {
+            brdf_sane("the .bsdf", &file)?;
+            for (wi, wo) in direction_pairs() {
+                let pdf = file.pdf(wi, wo);
+                if !(pdf.is_finite() && pdf >= 0.0) {
+                    return Err(format!("accepted, but pdf({wi}, {wo}) = {pdf}"));
+                }
+            }
+            Ok(true)
+        }
+        Err(e) => refused(path, e),
+    }
+}
+
+/// Small `.bsdf` seeds (grids of 4 to 8): an RGB plastic, its spectral twin, an anisotropic
+/// metal.
+fn bsdf_seeds() -> Vec<(&'static str, Vec<u8>)> {
+    let res = BsdfResolution {
+        theta_i: 4,
+        phi_i: 5,
+        sample: 6,
+        vndf: 8,
+        ndf: 8,
+    };
+    let bytes = |spec: &str| {
+        let model = parse_analytic(spec).unwrap();
+        rgl_tensor(&model, &model.ndf, res, spec)
+            .unwrap()
+            .0
+            .to_bytes()
+    };
+    let rgb = bytes("ggx?alpha=0.3&f0=0.04&kd=0.3,0.1,0.05");
+    let spectral = common::spectral_from_rgb(&rgb);
+    vec![
+        ("rgb", rgb),
+        ("spectral", spectral),
+        ("aniso", bytes("ggx?alpha_x=0.1&alpha_y=0.3&f0=0.9")),
+    ]
+}
+
+#[test]
+fn bsdf_loader_survives_mutation() {
+    campaign("bsdf", 0x4253_4446, 20000, || {
+        let dir = save_dir();
+        Bytes::new(
+            bsdf_seeds()
+                .into_iter()
+                .map(|(name, bytes)| Seed {
+                    path: dir.join(format!("mutated-{name}.bsdf")),
+                    form: Form::Bytes(bytes),
+                    weight: 1,
+                })
+                .collect(),
+            check_bsdf,
+        )
+    });
+}
+
 /// The seeds themselves load: a mutation test whose seeds are refused tests nothing.
 #[test]
 fn seeds_are_accepted() {
@@ -1559,6 +1625,12 @@ fn seeds_are_accepted() {
     assert!(check_exr(&dir.join("seed.exr"), &tiny_exr()).unwrap());
     let sky = repo("assets/demo/sky.exr");
     assert!(check_exr(&sky, &std::fs::read(&sky).unwrap()).unwrap());
+    for (name, bytes) in bsdf_seeds() {
+        assert!(
+            check_bsdf(&dir.join(format!("seed-{name}.bsdf")), &bytes).unwrap(),
+            "{name}"
+        );
+    }
 }
 
 /// The fuzz targets' seeds, `fuzz/corpus/<target>/seed-*`: (target, file name, bytes).
