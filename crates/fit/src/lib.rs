@@ -45,6 +45,8 @@ pub mod brdf;
 pub mod chi2;
 pub mod diffuse;
 pub mod error;
+/// A fit's analytic model written for Mitsuba 3, pbrt-v4 or glTF 2.0, with what it approximates.
+pub mod export;
 pub mod extract;
 pub mod fit;
 pub mod fresnel;
