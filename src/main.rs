@@ -4,6 +4,7 @@ mod args;
 mod bench_cmd;
 mod demo_cmd;
 mod dpf_cmd;
+mod export_cmd;
 mod fit_cmd;
 mod output;
 mod render_cmd;
@@ -25,6 +26,8 @@ struct Cli {
 enum Command {
     /// Extract the NDF of each input and fit tabulated, GGX and Beckmann models.
     Fit(fit_cmd::FitArgs),
+    /// Write a fit's GGX (or Beckmann) model for Mitsuba 3, pbrt-v4 or glTF 2.0, with its error.
+    Export(export_cmd::ExportArgs),
     /// The glint model's Directional Probability Function: one query, or the tables as EXR.
     Dpf(dpf_cmd::DpfArgs),
     /// Path-trace a glTF scene (wavefront, on the GPU) to PNG and EXR.
@@ -41,6 +44,7 @@ fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Fit(args)) => fit_cmd::run(&args),
+        Some(Command::Export(args)) => export_cmd::run(&args),
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),
