@@ -33,7 +33,8 @@ pub enum ModelArg {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum KindArg {
-    /// A conductor when the fit's mean Schlick F0 is at least 0.2, else a plastic.
+    /// A conductor when the fit's mean Schlick F0 is at least 0.2, or when ρd ≤ 0.01 and the
+    /// conductor Fresnel's error is below 0.9 × the dielectric's (a coloured F); else a plastic.
     Auto,
     /// A conductor: η, k per channel (glTF: metallic, F0 as base colour); ρd is dropped.
     Conductor,

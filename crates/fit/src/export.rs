@@ -8,11 +8,18 @@
 //! model with its table for comparison, and what the target cannot represent ([`Report`]).
 //!
 //! The material is exported as a **conductor** or a **plastic** (a diffuse base under a
-//! dielectric interface). [`KindRequest::Auto`] takes a conductor when the Schlick F0 of the
-//! fit, averaged over the channels, is at least [`CONDUCTOR_MIN_F0`]: the conductor curve
-//! (η and k per channel) contains the dielectric one (k = 0), so its error is never much above
-//! the dielectric's and comparing the two tells little; F0 separates them instead, every
-//! common dielectric lying below 0.2 (η ≈ 2.6) and every metal above 0.5.
+//! dielectric interface). [`KindRequest::Auto`] takes a conductor when
+//!
+//! - the Schlick F0 of the fit, averaged over the channels, is at least [`CONDUCTOR_MIN_F0`]
+//!   (every common dielectric lies below 0.2, η ≈ 2.6, every metal above 0.5), or
+//! - ρd is at most [`CONDUCTOR_MAX_ALBEDO`] in every channel (a plastic would keep nothing but
+//!   its Fresnel) and the conductor curve's error is below [`CONDUCTOR_MARGIN`] × the
+//!   dielectric's (recorded errors, else the RMS distances to the table): a coloured F that one
+//!   η cannot make, as a metallic paint's.
+//!
+//! The error comparison alone decides nothing: the conductor curve (η and k per channel)
+//! contains the dielectric one (k = 0), so its error is never much above the dielectric's, and
+//! a colourless table fits both alike.
 
 use crate::brdf::Rgb;
 use crate::error::FitError;
@@ -26,6 +33,13 @@ use std::path::Path;
 
 /// The mean Schlick F0 from which [`KindRequest::Auto`] exports a conductor.
 pub const CONDUCTOR_MIN_F0: f64 = 0.2;
+
+/// The largest ρd (every channel) with which [`KindRequest::Auto`] weighs the Fresnel errors.
+pub const CONDUCTOR_MAX_ALBEDO: f64 = 0.01;
+
+/// How much lower than the dielectric's the conductor curve's error must be for
+/// [`KindRequest::Auto`] to take a conductor below [`CONDUCTOR_MIN_F0`].
+pub const CONDUCTOR_MARGIN: f64 = 0.9;
 
 /// The renderer an export is written for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -80,7 +94,9 @@ pub enum ModelRequest {
 /// How to export the material.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum KindRequest {
-    /// A conductor when the mean Schlick F0 is at least [`CONDUCTOR_MIN_F0`], else a plastic.
+    /// A conductor when the mean Schlick F0 is at least [`CONDUCTOR_MIN_F0`], or when ρd is
+    /// at most [`CONDUCTOR_MAX_ALBEDO`] and the conductor curve fits clearly better than the
+    /// dielectric ([`CONDUCTOR_MARGIN`]); else a plastic.
     #[default]
     Auto,
     /// A conductor (η, k per channel; ρd dropped).
@@ -258,10 +274,18 @@ pub fn export(
         });
     }
     let mean_f0 = fits.schlick_f0.iter().sum::<f64>() / 3.0;
+    let known = |q: FitQuality| recorded.then_some(q.error).filter(|e| e.is_finite());
+    let (c, d) = (fits.conductor, fits.dielectric);
+    let conductor_fits_better = match (known(c), known(d)) {
+        (Some(c), Some(d)) => c < CONDUCTOR_MARGIN * d,
+        _ => c.rms < CONDUCTOR_MARGIN * d.rms,
+    };
+    let no_diffuse = p.diffuse.iter().all(|&a| a <= CONDUCTOR_MAX_ALBEDO);
     let kind = match options.kind {
         KindRequest::Conductor => Kind::Conductor,
         KindRequest::Plastic => Kind::Plastic,
         KindRequest::Auto if mean_f0 >= CONDUCTOR_MIN_F0 => Kind::Conductor,
+        KindRequest::Auto if no_diffuse && conductor_fits_better => Kind::Conductor,
         KindRequest::Auto => Kind::Plastic,
     };
     let quality = |c: FresnelChoice| match c {
@@ -284,7 +308,6 @@ pub fn export(
         },
         quality: quality(choice),
     };
-    let known = |q: FitQuality| recorded.then_some(q.error).filter(|e| e.is_finite());
     let (ax, ay, rot) = (p.alpha_x, p.alpha_y, p.rotation);
     let max_kd = p.diffuse.iter().cloned().fold(0.0, f64::max);
     if kind == Kind::Conductor && max_kd > 0.0 {
@@ -293,21 +316,14 @@ pub fn export(
             p.diffuse
         ));
     }
-    if kind == Kind::Plastic {
-        let (c, d) = (fits.conductor, fits.dielectric);
-        let better = match (known(c), known(d)) {
-            (Some(c), Some(d)) => c < 0.8 * d,
-            _ => c.rms < 0.8 * d.rms,
-        };
-        if better {
-            notes.push(format!(
-                "a dielectric's Fresnel is one colourless curve: the conductor fit (η {:?}, k {:?}) is closer (error {}, RMS {:.2e}); exported with the conductor kind it is kept, without ρd",
-                fits.conductor_eta,
-                fits.conductor_k,
-                fmt_error(known(c)),
-                c.rms
-            ));
-        }
+    if kind == Kind::Plastic && conductor_fits_better {
+        notes.push(format!(
+            "a dielectric's Fresnel is one colourless curve: the conductor fit (η {:?}, k {:?}) is closer (error {}, RMS {:.2e}); exported with the conductor kind it is kept, without ρd",
+            fits.conductor_eta,
+            fits.conductor_k,
+            fmt_error(known(c)),
+            c.rms
+        ));
     }
     if kind == Kind::Plastic && target != Target::Gltf {
         let (f0_eta, f0) = (dielectric_f0(fits.dielectric_eta), mean_f0);
@@ -513,6 +529,9 @@ fn xml_attr(s: &str) -> String {
         .replace('"', "&quot;")
 }
 
+/// The least `int_ior` written for Mitsuba (which refuses an interface of index 1).
+const MITSUBA_MIN_IOR: f64 = 1.0001;
+
 fn mitsuba(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
     let dist = report.distribution;
     let mut body = vec![format!(
@@ -548,7 +567,14 @@ fn mitsuba(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -
                 ));
                 a
             };
-            let eta = fits.dielectric_eta;
+            // Mitsuba refuses int_ior = ext_ior; the dielectric fit's η lies in [1, 4].
+            let eta = fits.dielectric_eta.max(MITSUBA_MIN_IOR);
+            if eta != fits.dielectric_eta {
+                report.notes.push(format!(
+                    "roughplastic needs int_ior ≠ ext_ior: the dielectric fit's η {} is written as {eta}",
+                    fits.dielectric_eta
+                ));
+            }
             report.notes.push(format!(
                 "roughplastic's diffuse term is ρ t(θi) t(θo) / (π η² (1 − R_int)) (internal scattering under the interface, nonlinear = false), not ρd/π: with ρ = ρd it is about {:.3} × ρd/π at normal incidence (smooth-interface estimate) and falls to 0 at grazing",
                 plastic_diffuse_ratio(eta)
@@ -1090,6 +1116,41 @@ mod tests {
                 .unwrap()
                 .contains(&"KHR_materials_specular".into())
         );
+    }
+
+    /// The automatic kind: F0 ≥ 0.2 is a conductor whatever ρd; below, a conductor only with
+    /// no diffuse lobe and a conductor curve clearly better than the dielectric.
+    #[test]
+    fn auto_kind_rule() {
+        let kind = |f: &Fresnel, kd: Rgb, tie: bool| {
+            let mut p = param(0.2, 0.2, 0.0, f, kd, true);
+            if tie {
+                let fits = p.fresnel_fits.as_mut().unwrap();
+                fits.conductor.error = fits.dielectric.error;
+            }
+            run(&material(Some(p), None), Target::Mitsuba, ModelRequest::Ggx)
+                .unwrap()
+                .report
+        };
+        // Gold with a diffuse lobe: a conductor, ρd dropped and said so.
+        let r = kind(&Fresnel::GOLD, [0.1; 3], false);
+        assert_eq!(r.kind, Kind::Conductor);
+        assert!(
+            r.notes.iter().any(|n| n.contains("dropped")),
+            "{:?}",
+            r.notes
+        );
+        // A colourless black dielectric: the curves tie, a plastic.
+        let glass = Fresnel::Dielectric { eta: 1.5 };
+        assert_eq!(kind(&glass, [0.0; 3], true).kind, Kind::Plastic);
+        // A coloured F of low F0 and no diffuse lobe (a metallic paint): the conductor fits
+        // better (the made-up errors: 0.011 against 0.022), a conductor; with ρd, a plastic.
+        let paint = Fresnel::Conductor {
+            eta: [2.75, 2.2, 1.07],
+            k: [0.0; 3],
+        };
+        assert_eq!(kind(&paint, [0.0; 3], false).kind, Kind::Conductor);
+        assert_eq!(kind(&paint, [0.05; 3], false).kind, Kind::Plastic);
     }
 
     /// A plastic's diffuse in Mitsuba at η = 1.5 is within a few percent of ρd/π at normal
