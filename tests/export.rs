@@ -461,3 +461,76 @@ fn single_lobe_fit_exports_with_unknown_error() {
     assert!(!ok && stderr.contains("no Beckmann model"), "{stderr}");
     assert!(stderr.contains(fit.file_name().unwrap().to_str().unwrap()));
 }
+
+/// An anisotropic fit (`--aniso`, small grid): Mitsuba gets alpha_u/alpha_v and a word on the
+/// rotation it cannot make; glTF's KHR_materials_anisotropy, inverted, gives αx, αy and the
+/// rotation back.
+#[test]
+fn anisotropic_fit_exports_both_alphas() {
+    let dir = common::scratch("export_aniso");
+    let (ok, stdout, stderr) = facet(
+        &dir,
+        &[
+            "fit",
+            "analytic:ggx?alpha_x=0.3&alpha_y=0.1&rotation=30&conductor=gold",
+            "--aniso",
+            "--resolution",
+            "16",
+            "--phi-resolution",
+            "16",
+            "--model",
+            "ggx",
+            "--backend",
+            "cpu",
+            "--out",
+            ".",
+        ],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    let fit = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .unwrap();
+    let rec = json(&fit);
+    let ggx = &rec["ggx"];
+    let (ax, ay, rot) = (
+        ggx["alpha_x"].as_f64().unwrap(),
+        ggx["alpha_y"].as_f64().unwrap(),
+        ggx["rotation"].as_f64().unwrap(),
+    );
+    assert!(
+        ax > ay && (rot.to_degrees() - 30.0).abs() < 1.0,
+        "{ax} {ay} {rot}"
+    );
+    let (xml, _) = export(&fit, "mitsuba", &[]);
+    assert_eq!(well_formed(&xml), Ok("bsdf".into()));
+    assert_eq!(
+        xml_value(&xml, "float", "alpha_u").parse::<f64>().unwrap(),
+        ax
+    );
+    assert_eq!(
+        xml_value(&xml, "float", "alpha_v").parse::<f64>().unwrap(),
+        ay
+    );
+    assert!(xml.contains("cannot rotate"), "{xml}");
+    let (text, _) = export(&fit, "gltf", &[]);
+    gltf::Gltf::from_slice(text.as_bytes()).expect("the glTF parses");
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let m = &v["materials"][0];
+    let r = m["pbrMetallicRoughness"]["roughnessFactor"]
+        .as_f64()
+        .unwrap();
+    let an = &m["extensions"]["KHR_materials_anisotropy"];
+    let s = an["anisotropyStrength"].as_f64().unwrap();
+    // glTF: α across = roughness², α along = mix(roughness², 1, strength²).
+    let (across, along) = (r * r, r * r + (1.0 - r * r) * s * s);
+    assert!((across / ay - 1.0).abs() < 1e-12 && (along / ax - 1.0).abs() < 1e-12);
+    assert_eq!(an["anisotropyRotation"].as_f64().unwrap(), rot);
+    assert!(
+        v["extensionsUsed"]
+            .as_array()
+            .unwrap()
+            .contains(&"KHR_materials_anisotropy".into())
+    );
+}

@@ -170,7 +170,7 @@ impl Report {
     pub fn summary(&self) -> String {
         let error = match self.fresnel_error {
             Some(e) => format!("error {e:.3e}"),
-            None => "error unknown (no recorded Fresnel fits)".into(),
+            None => "error unknown (fitted at export)".into(),
         };
         let alpha = if self.alpha_x == self.alpha_y {
             format!("α {:.4}", self.alpha_x)
