@@ -11,7 +11,7 @@ use std::process::ExitCode;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum TargetArg {
-    /// Mitsuba 3 XML: a `roughconductor` or `roughplastic` <bsdf> (`mi.load_file`, <include>).
+    /// Mitsuba 3 XML: a `roughconductor` or `roughplastic` `<bsdf>` (`mi.load_file`, `<include>`).
     Mitsuba,
     /// pbrt-v4: a `conductor` or `coateddiffuse` MakeNamedMaterial (Include it, then
     /// NamedMaterial).

@@ -1,4 +1,5 @@
-//! The targets: a Mitsuba 3 `<bsdf>`, a pbrt-v4 `MakeNamedMaterial`, a glTF 2.0 material.
+//! A fit's analytic model written for another renderer: a Mitsuba 3 `<bsdf>`, a pbrt-v4
+//! `MakeNamedMaterial`, or a glTF 2.0 material, with what it approximates.
 //!
 //! Each export takes one analytic fit (GGX by default; Beckmann on request, where the target
 //! has it), its α (αx, αy along the fit's rotated axes), its Lambertian albedo ρd and one of

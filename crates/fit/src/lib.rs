@@ -25,6 +25,8 @@
 //! ([`material::FittedMaterial`]). [`fit::fit_material`] runs the whole pipeline;
 //! [`extract`] holds the power iteration, [`tabulated`] the stretched tabulated NDF with its
 //! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid.
+//! [`export`] writes a fit's GGX or Beckmann model for Mitsuba 3, pbrt-v4 or glTF 2.0, with
+//! what the target approximates and its error in the metric.
 //!
 //! ## Features
 //!
@@ -45,7 +47,6 @@ pub mod brdf;
 pub mod chi2;
 pub mod diffuse;
 pub mod error;
-/// A fit's analytic model written for Mitsuba 3, pbrt-v4 or glTF 2.0, with what it approximates.
 pub mod export;
 pub mod extract;
 pub mod fit;
