@@ -5,6 +5,7 @@ mod bench_cmd;
 mod convert_cmd;
 mod demo_cmd;
 mod dpf_cmd;
+mod export_cmd;
 mod fit_cmd;
 mod output;
 mod render_cmd;
@@ -29,6 +30,8 @@ enum Command {
     /// A material from one format to another: MERL .binary, RGL .bsdf, fit .json (by OUT's
     /// extension; the neural proxies and analytic models as inputs).
     Convert(convert_cmd::ConvertArgs),
+    /// Write a fit's GGX (or Beckmann) model for Mitsuba 3, pbrt-v4 or glTF 2.0, with its error.
+    Export(export_cmd::ExportArgs),
     /// The glint model's Directional Probability Function: one query, or the tables as EXR.
     Dpf(dpf_cmd::DpfArgs),
     /// Path-trace a glTF scene (wavefront, on the GPU) to PNG and EXR.
@@ -46,6 +49,7 @@ fn main() -> std::process::ExitCode {
     let result = match cli.command {
         Some(Command::Fit(args)) => fit_cmd::run(&args),
         Some(Command::Convert(args)) => convert_cmd::run(&args),
+        Some(Command::Export(args)) => export_cmd::run(&args),
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         Some(Command::Render(args)) => render_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),

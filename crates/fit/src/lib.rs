@@ -26,6 +26,8 @@
 //! ([`material::FittedMaterial`]). [`fit::fit_material`] runs the whole pipeline;
 //! [`extract`] holds the power iteration, [`tabulated`] the stretched tabulated NDF with its
 //! sampling, [`grid`] the error metric and the Fresnel average over the MERL grid.
+//! [`export`] writes a fit's GGX or Beckmann model for Mitsuba 3, pbrt-v4 or glTF 2.0, with
+//! what the target approximates and its error in the metric.
 //!
 //! ## Features
 //!
@@ -47,6 +49,7 @@ pub mod chi2;
 pub mod cie;
 pub mod diffuse;
 pub mod error;
+pub mod export;
 pub mod extract;
 pub mod fit;
 pub mod fresnel;

@@ -1,0 +1,143 @@
+//! `facet export`: a fit's analytic model as a Mitsuba 3 `<bsdf>`, a pbrt-v4 material or a
+//! glTF 2.0 material, with what it approximates written inside.
+
+use anyhow::{Result, bail};
+use clap::{Args, ValueEnum};
+use facet_fit::export::{ExportOptions, KindRequest, ModelRequest, Target, export};
+use facet_fit::input::same_file;
+use facet_fit::material::FittedMaterial;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum TargetArg {
+    /// Mitsuba 3 XML: a `roughconductor` or `roughplastic` `<bsdf>` (`mi.load_file`, `<include>`).
+    Mitsuba,
+    /// pbrt-v4: a `conductor` or `coateddiffuse` MakeNamedMaterial (Include it, then
+    /// NamedMaterial).
+    Pbrt,
+    /// glTF 2.0 (.gltf): one metallic-roughness material, with KHR_materials_ior, _specular and
+    /// _anisotropy where they apply.
+    Gltf,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ModelArg {
+    /// The GGX fit.
+    Ggx,
+    /// The Beckmann fit (Mitsuba only; pbrt and glTF have only GGX and take the GGX fit).
+    Beckmann,
+    /// The fit of lower error among those the target has.
+    Best,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum KindArg {
+    /// A conductor when the fit's mean Schlick F0 is at least 0.2, or when ρd ≤ 0.01 and the
+    /// conductor Fresnel's error is below 0.9 × the dielectric's (a coloured F); else a plastic.
+    Auto,
+    /// A conductor: η, k per channel (glTF: metallic, F0 as base colour); ρd is dropped.
+    Conductor,
+    /// A diffuse base ρd under a dielectric interface of the fitted η.
+    Plastic,
+}
+
+#[derive(Args)]
+pub struct ExportArgs {
+    /// A fit JSON written by `facet fit`.
+    pub fit: PathBuf,
+    /// The renderer to write for.
+    #[arg(long, value_enum)]
+    pub to: TargetArg,
+    /// The output file (default: the fit's file name with .xml, .pbrt or .gltf, in the current
+    /// folder). An existing file is kept unless --force.
+    #[arg(short, long)]
+    pub out: Option<PathBuf>,
+    /// Which analytic fit to export.
+    #[arg(long, value_enum, default_value = "ggx")]
+    pub model: ModelArg,
+    /// Export as a conductor or a plastic.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub kind: KindArg,
+    /// Replace the output file when it exists (never the fit itself).
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl ExportArgs {
+    fn options(&self) -> ExportOptions {
+        ExportOptions {
+            target: match self.to {
+                TargetArg::Mitsuba => Target::Mitsuba,
+                TargetArg::Pbrt => Target::Pbrt,
+                TargetArg::Gltf => Target::Gltf,
+            },
+            model: match self.model {
+                ModelArg::Ggx => ModelRequest::Ggx,
+                ModelArg::Beckmann => ModelRequest::Beckmann,
+                ModelArg::Best => ModelRequest::Best,
+            },
+            kind: match self.kind {
+                KindArg::Auto => KindRequest::Auto,
+                KindArg::Conductor => KindRequest::Conductor,
+                KindArg::Plastic => KindRequest::Plastic,
+            },
+        }
+    }
+}
+
+/// `--out`, or the fit's file stem with the target's extension in the current folder.
+pub fn output_path(fit: &Path, out: Option<&Path>, target: Target) -> PathBuf {
+    match out {
+        Some(o) => o.to_owned(),
+        None => {
+            let stem = fit
+                .file_stem()
+                .map(|s| facet_fit::input::safe_file_stem(&s.to_string_lossy()))
+                .unwrap_or_else(|| "material".into());
+            PathBuf::from(format!("{stem}.{}", target.extension()))
+        }
+    }
+}
+
+pub fn run(args: &ExportArgs) -> Result<ExitCode> {
+    let options = args.options();
+    let out = output_path(&args.fit, args.out.as_deref(), options.target);
+    let fit = FittedMaterial::load(&args.fit)?;
+    if same_file(&args.fit, &out) {
+        bail!(
+            "{}: the output would replace the fit it is exported from; choose another --out",
+            out.display()
+        );
+    }
+    if out.is_dir() {
+        bail!("--out {}: is a folder, not a file", out.display());
+    }
+    if out.exists() && !args.force {
+        bail!(
+            "{}: exists; --force replaces it, or choose another --out",
+            out.display()
+        );
+    }
+    let exported = export(&fit, &args.fit, &options)?;
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        crate::output::folder(dir, "--out")?;
+    }
+    // Through a temporary file renamed into place, as `facet fit` writes its JSON.
+    let mut tmp = out.clone().into_os_string();
+    tmp.push(".partial");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, &exported.text)
+        .and_then(|_| std::fs::rename(&tmp, &out))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            anyhow::anyhow!(
+                "{}: cannot write: {}",
+                out.display(),
+                facet_fit::input::io_problem(&e)
+            )
+        })?;
+    println!("{}", exported.report.summary());
+    println!("wrote {}", out.display());
+    Ok(ExitCode::SUCCESS)
+}
