@@ -69,7 +69,7 @@ fn a_spectral_file_reads_as_its_rgb() {
     for (wi, wo) in [
         (d(0.3, 0.0), d(0.5, 3.0)),
         (d(1.0, 1.0), d(0.2, 2.0)),
-        (d(0.7, 0.0), d(0.7, 3.14)),
+        (d(0.7, 0.0), d(0.7, 3.0)),
     ] {
         let (a, b) = (rgb.eval(wi, wo).unwrap(), spectral.eval(wi, wo).unwrap());
         let grey = (a[0] + a[1] + a[2]) / 3.0;

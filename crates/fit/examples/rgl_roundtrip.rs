@@ -35,7 +35,9 @@ fn main() {
         .map(str::to_owned)
         .collect();
     println!("resolution {res:?}");
-    println!("material | MERL→bsdf error | fit→bsdf error | fit error | write ms | read ms | MiB | per sample space");
+    println!(
+        "material | MERL→bsdf error | fit→bsdf error | fit error | write ms | read ms | MiB | per sample space"
+    );
     let (mut merl_err, mut fit_err, mut write_ms, mut read_ms) = (vec![], vec![], vec![], vec![]);
     for name in &names {
         let net = lib.get(name).unwrap();
