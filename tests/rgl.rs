@@ -10,11 +10,11 @@ use facet_fit::grid::{GridSamples, error_metric};
 use facet_fit::rgl::{BsdfResolution, RglBsdf, write_rgl};
 use std::process::Command;
 
-/// A GGX plastic written as a MERL table, written as a `.bsdf` and read back: within 0.015 of
-/// the table in Facet's metric. Measured 0.0121 at the standard grids (0.0237 with 16 uniform
-/// θi slices, 0.0093 with 32 slices and a 128² sample space: the interpolation between slices
-/// dominates); an error in the format's conventions (a φ taken absolute, the Jacobian left
-/// out) costs more than 0.1.
+/// A GGX plastic written as a MERL table, written as a `.bsdf` and read back: within 0.01 of
+/// the table in Facet's metric. Measured 0.0036 (the better of the two sample spaces; the
+/// power iteration's alone gives 0.012, and 16 uniform θi slices 0.024: the interpolation
+/// between slices dominates); an error in the format's conventions (a φ taken absolute, the
+/// Jacobian or the cosine left out) costs more than 0.1.
 #[test]
 fn merl_to_bsdf_to_reader_stays_within_the_bound() {
     let dir = scratch("rgl_merl");
@@ -30,11 +30,11 @@ fn merl_to_bsdf_to_reader_stays_within_the_bound() {
     assert_eq!(back.description(), "plastic");
     let error = error_metric(&back, &GridSamples::new(&merl));
     println!("MERL → .bsdf error {error:.5}");
-    assert!(error < 0.015, "{error}");
+    assert!(error < 0.01, "{error}");
 }
 
 /// A fit's tabulated model through a `.bsdf`: within 0.01 of the fit in Facet's metric
-/// (measured 0.0049 for this gold).
+/// (measured 0.0028 for this gold).
 #[test]
 fn fit_to_bsdf_to_reader_stays_within_the_bound() {
     let dir = scratch("rgl_fit");

@@ -13,21 +13,22 @@
 //! | `vndf` | `[nφ, nθ, rows, cols]` | the visible-normal density per slice, over u of m |
 //! | `luminance` | `[nφ, nθ, n, n]` | the density of the sample space, for importance sampling |
 //! | `rgb` or `spectra` + `wavelengths` | `[nφ, nθ, 3 or nλ, n, n]` | the data on the sample space |
-//! | `jacobian` | `[1]` (u8) | whether the data is f · 4σ / D (1) or f itself (0) |
+//! | `jacobian` | `[1]` (u8) | whether the data is f cos θo · 4σ / D (1) or f cos θo (0) |
 //! | `description` | `[len]` (u8) | text |
 //!
 //! Evaluating f(ωi, ωo): m = (ωi + ωo)/|…|, u(m) with φm taken relative to φi when isotropic
 //! (`phi_i` has at most 2 entries), the sample-space point s = vndf⁻¹(u(m) | φi, θi), then
-//! f = data(s | φi, θi) · D(u(m)) / (4 σ(u(ωi))) when `jacobian` is set. Anisotropic files
+//! f cos θo = data(s | φi, θi) · D(u(m)) / (4 σ(u(ωi))) when `jacobian` is set (the readers'
+//! `eval` returns f cos θo, Mitsuba's convention; [`Brdf::eval`] divides by cos θo). Anisotropic files
 //! whose `phi_i` spans 2π / k (k = 2 or 4) are folded by the symmetry the format's readers
 //! apply. Spectral files are converted to linear Rec.709 as they are read ([`crate::cie`]),
 //! which commutes with the interpolation; negative (out-of-gamut) values are clipped at zero
 //! when evaluated, as brdf-loader does with `POWITACQ_CLIP_RGB`.
 //!
 //! Writing (`write_rgl`) samples the source where the format stores it: the VNDF of a given
-//! NDF at each θi node, the sample-space grid warped through it, the source's f there times
-//! 4σ / D with σ and D exactly as the reader interpolates them, so that the file reproduces
-//! the source at every node; `luminance` is Y(data) cos θo, the density that makes the
+//! NDF at each θi node, the sample-space grid warped through it, the source's f cos θo there
+//! times 4σ / D with σ and D exactly as the reader interpolates them, so that the file
+//! reproduces the source at every node; `luminance` is Y(data), the density that makes the
 //! sampling proportional to f cos θo.
 
 use crate::brdf::{Brdf, Rgb};
@@ -302,6 +303,7 @@ impl Brdf for RglBsdf {
         }
         let q = self.query(wi, wo);
         let (sample, _) = self.vndf.invert(q.u_m, &q.params);
+        // The data holds f cos θo (times 4σ / D with the Jacobian); the fold keeps θo.
         let scale = if self.jacobian {
             let sigma = self.sigma.eval(q.u_wi, &[]);
             if !(sigma > 0.0) {
@@ -310,7 +312,7 @@ impl Brdf for RglBsdf {
             self.ndf.eval(q.u_m, &[]) / (4.0 * sigma)
         } else {
             1.0
-        };
+        } / wo.z;
         Some(std::array::from_fn(|c| {
             (self.rgb[c].eval(sample, &q.params) * scale).max(0.0)
         }))
@@ -515,12 +517,13 @@ pub fn rgl_tensor(
                 missing += 1;
                 continue;
             };
-            // The data: f · 4σ / D, with σ and D as the reader interpolates them.
-            let value: Rgb = std::array::from_fn(|c| f[c] * 4.0 * sigma / dm);
+            // The data: f cos θo · 4σ / D, with σ and D as the reader interpolates them; its
+            // luminance is the sampling density ∝ f cos θo.
+            let value: Rgb = std::array::from_fn(|c| f[c] * wo.z * 4.0 * sigma / dm);
             for c in 0..3 {
                 rgb[(k * 3 + c) * ns * ns + p] = value[c] as f32;
             }
-            *l = luminance(value).max(0.0) * wo.z;
+            *l = luminance(value).max(0.0);
         }
         // A floor keeps every cell of the slice reachable by the sampler.
         let peak = slice_lum.iter().cloned().fold(0.0, f64::max);
