@@ -425,7 +425,7 @@ pub fn sampling_ndfs(brdf: &dyn Brdf) -> Result<Vec<(&'static str, Ndf)>, FitErr
         Ndf::Tabulated(std::sync::Arc::new(ex.ndf)),
     )];
     // The whole default fit: the refinement and a tabulated analytic NDF, where one fits
-    // better, sharpen the peak further (white-paint: 0.122 → 0.035 in the round trip).
+    // better, sharpen the peak further (white-paint: 0.103 → 0.035 in the round trip).
     let fit = crate::fit::fit_material(brdf, brdf.name(), &crate::fit::FitConfig::isotropic())?;
     out.push(("diffuse separated", fit.tabulated.ndf));
     Ok(out)
