@@ -8,10 +8,11 @@ use facet_fit::analytic::parse_analytic;
 use facet_fit::brdf::Brdf;
 use facet_fit::extract::{ExtractConfig, Stopping, extract_isotropic};
 use facet_fit::fit::{FitConfig, fit_material};
+use facet_fit::fresnel::Fresnel;
 use facet_fit::geometry::spherical;
-use facet_fit::grid::{GridSamples, error_metric, microfacet_error};
+use facet_fit::grid::{GridSamples, error_metric, microfacet_error, microfacet_errors};
 use facet_fit::material::{FittedMaterial, ModelChoice};
-use facet_fit::microfacet::{AnalyticNdf, NdfKind};
+use facet_fit::microfacet::{AnalyticNdf, MicrofacetBrdf, NdfKind};
 use facet_fit::tabulated::{Stretch, TabulatedNdf};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -133,6 +134,26 @@ fn grid_fast_path_matches_direct_evaluation() {
             (fast / direct - 1.0).abs() < 1e-3,
             "{spec}: {fast} vs {direct}"
         );
+    }
+    // The batched pass (one model's D, G and ρd with several Fresnels) gives each Fresnel's
+    // own error: the same f32 row sums, so equal up to the f64 order of the row totals.
+    let model = parse_analytic("ggx?alpha=0.2&f0=0.1&kd=0.1,0.2,0.3").unwrap();
+    let curves = [
+        Fresnel::Schlick { f0: [0.04; 3] },
+        Fresnel::Dielectric { eta: 1.5 },
+        Fresnel::Conductor {
+            eta: [0.18, 0.42, 1.37],
+            k: [3.42, 2.35, 1.77],
+        },
+    ];
+    let batched = microfacet_errors(&model, &curves, &set);
+    for (fresnel, b) in curves.iter().zip(batched) {
+        let one = MicrofacetBrdf {
+            fresnel: fresnel.clone(),
+            ..model.clone()
+        };
+        let e = microfacet_error(&one, &set);
+        assert!((b / e - 1.0).abs() < 1e-9, "{fresnel:?}: {b} vs {e}");
     }
 }
 

@@ -265,7 +265,7 @@ pub fn export(
     let (fit_kind, p) = choose(r, options, &mut notes).map_err(bad)?;
     let (fits, recorded) = match &p.fresnel_fits {
         Some(f) => (f.clone(), true),
-        None => (FresnelFits::of(&p.fresnel, |_| f64::NAN), false),
+        None => (FresnelFits::of(&p.fresnel, |_| [f64::NAN; 3]), false),
     };
     if !recorded {
         notes.push(if r.diffuse_lobe {
@@ -788,7 +788,7 @@ mod tests {
     fn param(ax: f64, ay: f64, rot: f64, f: &Fresnel, kd: Rgb, recorded: bool) -> ParamRecord {
         let table = table_of(f);
         let fits = recorded.then(|| {
-            let mut fits = FresnelFits::of(&table, |_| 0.0);
+            let mut fits = FresnelFits::of(&table, |_| [0.0; 3]);
             fits.conductor.error = 0.011;
             fits.dielectric.error = 0.022;
             fits.schlick.error = 0.033;
@@ -1082,7 +1082,7 @@ mod tests {
         let Fresnel::Conductor { eta, .. } = Fresnel::GOLD else {
             unreachable!()
         };
-        let fits = FresnelFits::of(&m.record.ggx.as_ref().unwrap().fresnel, |_| 0.0);
+        let fits = FresnelFits::of(&m.record.ggx.as_ref().unwrap().fresnel, |_| [0.0; 3]);
         assert!((fits.conductor_eta[0] / eta[0] - 1.0).abs() < 0.02);
         assert!(x.text.contains(&format!("{}", fits.conductor_eta[0])));
     }

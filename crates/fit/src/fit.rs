@@ -13,6 +13,7 @@ use crate::gpu::{GpuFitter, gpu_error};
 use crate::grid::IsoTables;
 use crate::grid::{
     GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error, microfacet_error,
+    microfacet_errors,
 };
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
@@ -58,8 +59,9 @@ pub struct FitConfig {
     pub models: Models,
     /// The least-squares searches run on a subsampled grid ([`GridSamples::subsample`]: every
     /// `search_stride`-th (θh, θd) row of an isotropic source, every `search_stride`-th sample
-    /// of an anisotropic one); an isotropic fit then takes its final steps on the full grid
-    /// ([`crate::params::refine_on_full_grid`]), and the reported errors use every sample.
+    /// of an anisotropic one); an isotropic fit then takes its final steps
+    /// ([`crate::params::refine_on_full_grid`]) on the full grid, or with a diffuse lobe on a
+    /// quarter of it ([`GridSamples::diagonal`]), and the reported errors use every sample.
     pub search_stride: usize,
     /// Fit a Lambertian lobe ρd with every model and keep F in [0, 1] ([`crate::diffuse`]);
     /// false: the paper's single specular lobe with F averaged. Isotropic fits only: an
@@ -116,10 +118,11 @@ impl Default for FitConfig {
     }
 }
 
-/// Reweighted steps of the F / ρd solves on the full grid (the final steps and the reported
-/// errors; the searches take none).
+/// Reweighted steps of the F / ρd solves of the final steps (the searches take none).
 const FINAL_IRLS: usize = 2;
-/// The rows of the analytic fits' final steps with a diffuse lobe (every 4th row).
+/// The rows of the final steps with a diffuse lobe: about one in 4 ([`GridSamples::diagonal`],
+/// which keeps every θh and θd bin). F and ρd of every reported model are solved on them; its
+/// reported error is then measured on the full grid.
 const FINAL_STRIDE: usize = 4;
 
 fn ms(t: Instant) -> f64 {
@@ -251,12 +254,29 @@ fn fit_with(
             Ok((f, [0.0; 3], e))
         };
     let solve = |m: &MicrofacetBrdf| solve_on(m, &set);
-    // The final steps of the analytic fits: with a diffuse lobe (each step six passes), on every
-    // `FINAL_STRIDE`-th row, then one full-grid solve at the α found.
+    // The final steps: with a diffuse lobe (each step four passes) on a quarter of the rows,
+    // and the reported error of the model found (its F and ρd from them) on the full grid.
     let final_steps = if diffuse {
-        set.subsample(FINAL_STRIDE)
+        set.diagonal(FINAL_STRIDE)
     } else {
         set.subsample(1)
+    };
+    let full_error = |m: &MicrofacetBrdf, f: &[Rgb], albedo: Rgb| {
+        let with = MicrofacetBrdf {
+            fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.to_vec())),
+            diffuse: albedo,
+            ..m.clone()
+        };
+        microfacet_error(&with, &set)
+    };
+    // F and ρd solved on the final steps' rows, the error measured on the full grid.
+    let solve_reported = |m: &MicrofacetBrdf| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
+        if !diffuse {
+            return solve(m);
+        }
+        let (f, kd, _) = solve_on(m, &final_steps)?;
+        let e = full_error(m, &f, kd);
+        Ok((f, kd, e))
     };
     // The paper's tabulated model: one lobe, F averaged for the extraction's D and G.
     let single = if diffuse {
@@ -277,13 +297,13 @@ fn fit_with(
     // full-grid error.
     let physical = |m: &MicrofacetBrdf, table: &FresnelTable, albedo: Rgb| {
         diffuse.then(|| {
-            let mut fits = FresnelFits::of(table, |fresnel| {
-                let with = MicrofacetBrdf {
-                    fresnel: fresnel.clone(),
-                    diffuse: albedo,
-                    ..m.clone()
-                };
-                microfacet_error(&with, &set)
+            let with = MicrofacetBrdf {
+                diffuse: albedo,
+                ..m.clone()
+            };
+            let mut fits = FresnelFits::of(table, |curves| {
+                let e = microfacet_errors(&with, curves, &set);
+                std::array::from_fn(|n| e[n])
             });
             fits.used = cfg.fresnel;
             fits
@@ -296,7 +316,8 @@ fn fit_with(
         let moments = fit_moments(kind, &ex.ndf);
         let lsq = fit_least_squares(moments, cfg.anisotropic, diffuse, &search);
         let model = |ndf: AnalyticNdf| MicrofacetBrdf::ideal("lsq", Ndf::Analytic(ndf));
-        // Isotropic: the final steps on the full grid (coarse to fine).
+        // Isotropic: the final steps on the final-step rows (coarse to fine), the error on the
+        // full grid.
         let (lsq, (lsq_fresnel, lsq_diffuse, error)) = if cfg.anisotropic {
             (lsq, solve(&model(lsq))?)
         } else {
@@ -307,7 +328,10 @@ fn fit_with(
             })?;
             let ndf = AnalyticNdf::isotropic(kind, t.exp());
             match diffuse {
-                true => (ndf, solve(&model(ndf))?),
+                true => {
+                    let e = full_error(&model(ndf), &f, kd);
+                    (ndf, (f, kd, e))
+                }
                 false => (ndf, (f, kd, e)),
             }
         };
@@ -321,7 +345,7 @@ fn fit_with(
                 },
                 &set,
             ),
-            None => solve(&model(moments))?.2,
+            None => solve_reported(&model(moments))?.2,
         };
         let params = |n: &AnalyticNdf, e| Params {
             alpha_x: n.alpha_x,
@@ -382,31 +406,39 @@ fn fit_with(
             })?;
             separation_rounds = sep.rounds;
             let ex = sep.extraction;
-            let (f, kd, e) = solve(&tabulated_model(&ex))?;
+            // The candidates compete on the final steps' rows; the one kept is measured on the
+            // full grid.
+            let (f, kd, e) = solve_on(&tabulated_model(&ex), &final_steps)?;
             let mut best = (ex.ndf.clone(), f, kd, e, "power_iteration");
+            let mut best_error = None;
             if cfg.refine {
-                if let Some(r) = refine(&best.0, e, &set) {
+                if let Some(r) = refine(&best.0, e, &final_steps) {
                     refine_rounds = r.rounds;
                     best = (r.ndf, r.fresnel, r.albedo, r.error, "power_iteration");
                 }
                 // Where an analytic fit is still better, its NDF tabulated is the start.
-                if let Some((kind, p)) = best_analytic.filter(|(_, p)| p.error < best.3) {
+                let error = full_error(&model_of(&best.0), &best.1, best.2);
+                best_error = Some(error);
+                if let Some((kind, p)) = best_analytic.filter(|(_, p)| p.error < error) {
                     let analytic = AnalyticNdf::isotropic(kind, p.alpha_x);
                     let t = ex.ndf.tables();
                     if let Some(ndf) = tabulate(analytic, t.nu, t.ng) {
-                        let (f, kd, e) = solve(&model_of(&ndf))?;
+                        let (f, kd, e) = solve_on(&model_of(&ndf), &final_steps)?;
                         let mut start = (ndf, f, kd, e, kind.name());
-                        if let Some(r) = refine(&start.0, e, &set) {
+                        if let Some(r) = refine(&start.0, e, &final_steps) {
                             refine_rounds += r.rounds;
                             start = (r.ndf, r.fresnel, r.albedo, r.error, kind.name());
                         }
-                        if start.3 < best.3 {
-                            best = start;
+                        let e = full_error(&model_of(&start.0), &start.1, start.2);
+                        if e < error {
+                            (best, best_error) = (start, Some(e));
                         }
                     }
                 }
             }
-            (ex, (best.0, best.1, best.2, Some(best.3), best.4))
+            let error =
+                best_error.unwrap_or_else(|| full_error(&model_of(&best.0), &best.1, best.2));
+            (ex, (best.0, best.1, best.2, Some(error), best.4))
         }
     };
     let (ndf, tab_fresnel, tab_diffuse, tab_error, origin) = tab;

@@ -75,8 +75,9 @@ pub struct FresnelFits {
 }
 
 impl FresnelFits {
-    /// The three fits of `table`; `error` gives the metric's error of a candidate Fresnel.
-    pub fn of(table: &FresnelTable, error: impl Fn(&Fresnel) -> f64) -> Self {
+    /// The three fits of `table`; `errors` gives the metric's errors of the candidate Fresnels
+    /// (Schlick, dielectric, conductor), all three at once so that one pass can measure them.
+    pub fn of(table: &FresnelTable, errors: impl FnOnce(&[Fresnel; 3]) -> [f64; 3]) -> Self {
         let bins: Vec<(f64, Rgb)> = table
             .theta_d
             .iter()
@@ -94,26 +95,32 @@ impl FresnelFits {
                 .sum();
             (s / (3 * bins.len().max(1)) as f64).sqrt()
         };
-        let quality = |fresnel: &Fresnel| FitQuality {
-            rms: rms(fresnel),
-            error: error(fresnel),
-        };
         let schlick_f0 = fit_schlick(&bins);
         let dielectric_eta = fit_dielectric(&bins);
         let (conductor_eta, conductor_k) = fit_conductor(&bins);
-        FresnelFits {
-            schlick_f0,
-            schlick: quality(&Fresnel::Schlick { f0: schlick_f0 }),
-            dielectric_eta,
-            dielectric: quality(&Fresnel::Dielectric {
+        let curves = [
+            Fresnel::Schlick { f0: schlick_f0 },
+            Fresnel::Dielectric {
                 eta: dielectric_eta,
-            }),
-            conductor_eta,
-            conductor_k,
-            conductor: quality(&Fresnel::Conductor {
+            },
+            Fresnel::Conductor {
                 eta: conductor_eta,
                 k: conductor_k,
-            }),
+            },
+        ];
+        let e = errors(&curves);
+        let quality = |n: usize| FitQuality {
+            rms: rms(&curves[n]),
+            error: e[n],
+        };
+        FresnelFits {
+            schlick_f0,
+            schlick: quality(0),
+            dielectric_eta,
+            dielectric: quality(1),
+            conductor_eta,
+            conductor_k,
+            conductor: quality(2),
             used: FresnelChoice::Table,
         }
     }
@@ -250,7 +257,7 @@ mod tests {
     #[test]
     fn fits_recover_their_own_curves() {
         let gold = table_of(&Fresnel::GOLD);
-        let fits = FresnelFits::of(&gold, |_| 0.0);
+        let fits = FresnelFits::of(&gold, |_| [0.0; 3]);
         assert!(fits.conductor.rms < 1e-4, "{fits:?}");
         let Fresnel::Conductor { eta, k } = Fresnel::GOLD else {
             unreachable!()
@@ -262,13 +269,13 @@ mod tests {
             );
             assert!((fits.conductor_k[c] / k[c] - 1.0).abs() < 0.02, "{fits:?}");
         }
-        let glass = FresnelFits::of(&table_of(&Fresnel::Dielectric { eta: 1.5 }), |_| 0.0);
+        let glass = FresnelFits::of(&table_of(&Fresnel::Dielectric { eta: 1.5 }), |_| [0.0; 3]);
         assert!((glass.dielectric_eta - 1.5).abs() < 1e-3, "{glass:?}");
         assert!(glass.dielectric.rms < 1e-6);
         let schlick = Fresnel::Schlick {
             f0: [0.04, 0.5, 0.9],
         };
-        let s = FresnelFits::of(&table_of(&schlick), |_| 0.0);
+        let s = FresnelFits::of(&table_of(&schlick), |_| [0.0; 3]);
         for (a, b) in s.schlick_f0.iter().zip([0.04, 0.5, 0.9]) {
             assert!((a - b).abs() < 1e-9, "{s:?}");
         }

@@ -8,6 +8,7 @@
 //! direct evaluation.
 
 use crate::brdf::{Brdf, Rgb};
+use crate::fresnel::Fresnel;
 use crate::geometry::{HalfDiff, azimuth_between, from_half_diff};
 use crate::iso_grid::IsoSamples;
 use crate::merl::{self, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles};
@@ -109,6 +110,20 @@ impl GridSamples {
                     .collect::<Vec<_>>(),
             ),
             iso: None,
+        }
+    }
+
+    /// About one (θh, θd) row in `stride` of an isotropic source such that every θh and every
+    /// θd bin keeps its share ([`IsoSamples::diagonal`]): the set on which per-bin F and ρd
+    /// are solved. Anisotropic sets: [`Self::subsample`].
+    pub fn diagonal(&self, stride: usize) -> GridSamples {
+        match &self.iso {
+            Some(iso) => GridSamples {
+                rotations: self.rotations.clone(),
+                samples: OnceLock::new(),
+                iso: Some(iso.diagonal(stride)),
+            },
+            None => self.subsample(stride),
         }
     }
 
@@ -373,6 +388,35 @@ pub fn microfacet_error(model: &MicrofacetBrdf, set: &GridSamples) -> f64 {
         return error_metric(model, set);
     };
     tables.log_error_sum(set) / (3 * set.len().max(1)) as f64
+}
+
+/// The errors of `model` with each of `fresnels` in place of its own Fresnel: on an isotropic
+/// set one pass, which forms each row's G2 / (4 cos θo) once for all of them.
+pub fn microfacet_errors(
+    model: &MicrofacetBrdf,
+    fresnels: &[Fresnel],
+    set: &GridSamples,
+) -> Vec<f64> {
+    let with = |f: &Fresnel| MicrofacetBrdf {
+        fresnel: f.clone(),
+        ..model.clone()
+    };
+    match (&set.iso, IsoTables::new(model)) {
+        (Some(iso), Some(tables)) => {
+            let per_bin: Vec<[Rgb; THETA_D_RES]> = fresnels
+                .iter()
+                .map(|f| std::array::from_fn(|j| f.eval(bin_angles(0, j, 0).theta_d.cos())))
+                .collect();
+            iso.log_error_sums(&tables, &per_bin)
+                .into_iter()
+                .map(|e| e / (3 * set.len().max(1)) as f64)
+                .collect()
+        }
+        _ => fresnels
+            .iter()
+            .map(|f| microfacet_error(&with(f), set))
+            .collect(),
+    }
 }
 
 /// The model with a Fresnel table averaged for its own D and G ([`fresnel_average`]), and

@@ -121,6 +121,33 @@ impl IsoSamples {
         }
     }
 
+    /// The rows of this set with (θh bin + θd bin) ≡ 0 mod `stride` (all of their φd bins): a
+    /// diagonal pattern, so that every θh bin and every θd bin keeps about 1/`stride` of its
+    /// rows and the per-bin unknowns (D of a θh bin, F of a θd bin) all stay determined.
+    /// ([`Self::subsample`] leaves the odd θd bins empty for an even stride, a row being
+    /// θd bin + 90 θh bin; it suits the α searches, which need every θh bin near the peak.)
+    pub fn diagonal(&self, stride: usize) -> Self {
+        let stride = stride.max(1);
+        let rows: Vec<u16> = self
+            .rows
+            .iter()
+            .copied()
+            .filter(|&r| {
+                let r = r as usize;
+                (r / THETA_D_RES + r % THETA_D_RES).is_multiple_of(stride)
+            })
+            .collect();
+        let count = rows
+            .iter()
+            .map(|&r| self.data.count[r as usize] as usize)
+            .sum();
+        IsoSamples {
+            data: self.data.clone(),
+            rows,
+            count,
+        }
+    }
+
     /// The valid bins of row `r` with ln(1 + x) per channel: (flat bin, ln(1 + x)).
     pub fn row_samples(&self, r: usize) -> impl Iterator<Item = (usize, [f32; 3])> + '_ {
         let d = &self.data;
@@ -164,6 +191,16 @@ impl IsoSamples {
             set: self,
             tables,
             cached: None,
+        })
+    }
+
+    /// The error sums of a model's D, G and ρd/π with each of `fresnels` (F per θd bin) in
+    /// place of its own F: one pass, each row's G2 / (4 cos θo) formed once for all of them.
+    pub fn log_error_sums(&self, tables: &IsoTables, fresnels: &[[Rgb; THETA_D_RES]]) -> Vec<f64> {
+        self.run(&ErrorSums {
+            set: self,
+            tables,
+            fresnels,
         })
     }
 
@@ -520,6 +557,42 @@ impl RowPass for ErrorSum<'_> {
     }
 }
 
+/// Σ of the error over samples and channels for each of several F tables.
+struct ErrorSums<'a> {
+    set: &'a IsoSamples,
+    tables: &'a IsoTables,
+    fresnels: &'a [[Rgb; THETA_D_RES]],
+}
+
+impl RowPass for ErrorSums<'_> {
+    type Acc = Vec<f64>;
+
+    fn init() -> Vec<f64> {
+        Vec::new()
+    }
+
+    #[inline(always)]
+    fn row(&self, acc: &mut Vec<f64>, r: usize) {
+        let t = self.tables;
+        let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
+        let mut ideal = [0.0f32; PADDED];
+        row_ideal(t, merl_geometry(), r, &mut ideal);
+        acc.resize(self.fresnels.len(), 0.0);
+        let kd = t.diffuse.map(|k| k as f32);
+        for (a, fresnel) in acc.iter_mut().zip(self.fresnels) {
+            let f = fresnel[j].map(|f| f as f32 * t.d32[i]);
+            *a += row_error(&self.set.data, r, f, kd, &ideal);
+        }
+    }
+
+    fn merge(a: &mut Vec<f64>, b: Vec<f64>) {
+        if a.len() < b.len() {
+            a.resize(b.len(), 0.0);
+        }
+        a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+    }
+}
+
 /// A pass's rows, compiled for AVX2 as well where the CPU has it: the loops of a pass are
 /// written for the compiler to vectorise, and the baseline x86-64 target gives it four lanes
 /// (SSE2) where AVX2 gives eight. The results do not depend on the path taken: no
@@ -714,5 +787,50 @@ fn row_ideal(t: &IsoTables, geo: &MerlGeometry, r: usize, out: &mut [f32; PADDED
         let (hi, lo) = if li > lo { (li, lo) } else { (lo, li) };
         let g2 = 1.0 / (1.0 + hi + corr[k] * lo);
         out[k] = 0.25 * g2 / mu[k];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analytic::parse_analytic;
+
+    /// The diagonal subsample keeps about 1/stride of every θh bin's and every θd bin's rows:
+    /// no per-bin unknown is left without samples (every `stride`-th row in order would drop
+    /// the odd θd bins).
+    #[test]
+    fn diagonal_subsample_keeps_every_bin() {
+        let src = parse_analytic("ggx?alpha=0.2&f0=0.5").unwrap();
+        let all = IsoSamples::new(&src);
+        let per_bin = |set: &IsoSamples, of: fn(usize) -> usize| {
+            let mut n = [0usize; THETA_D_RES];
+            set.rows.iter().for_each(|&r| n[of(r as usize)] += 1);
+            n
+        };
+        let (theta_h, theta_d): (fn(usize) -> usize, fn(usize) -> usize) =
+            (|r| r / THETA_D_RES, |r| r % THETA_D_RES);
+        for stride in [4, 8] {
+            let sub = all.diagonal(stride);
+            for of in [theta_h, theta_d] {
+                let (a, s) = (per_bin(&all, of), per_bin(&sub, of));
+                for b in 0..THETA_D_RES {
+                    // ⌊n / stride⌋ or ⌈n / stride⌉ of a bin's n rows, when n ≥ stride.
+                    if a[b] >= stride {
+                        assert!(
+                            s[b] + 1 >= a[b] / stride,
+                            "stride {stride} bin {b}: {} of {}",
+                            s[b],
+                            a[b]
+                        );
+                        assert!(s[b] <= a[b].div_ceil(stride) + 1, "stride {stride} bin {b}");
+                    }
+                }
+            }
+            let share = sub.count as f64 / all.count as f64;
+            assert!(
+                (share * stride as f64 - 1.0).abs() < 0.05,
+                "stride {stride}: {share}"
+            );
+        }
     }
 }
