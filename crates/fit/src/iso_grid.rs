@@ -770,9 +770,10 @@ fn row_ideal(t: &IsoTables, geo: &MerlGeometry, r: usize, out: &mut [f32; PADDED
         let m = mu[k];
         // max before min: a NaN would become 0, so x is a finite number in [0, scale].
         let x = (m * scale).max(0.0).min(scale);
-        // SAFETY: x is finite and in [0, 4095], well inside i32 (`as` would saturate, and its
-        // checks keep the loop from vectorising).
-        let at = unsafe { x.to_int_unchecked::<i32>() }.min(LAMBDA_TABLE as i32 - 2) as usize;
+        // SAFETY: x is finite and in [0, 4095], well inside u32 (`as` would saturate, and its
+        // checks keep the loop from vectorising). Unsigned, so that the bound below is all the
+        // compiler needs to drop the table's bounds checks and gather in vectors.
+        let at = unsafe { x.to_int_unchecked::<u32>() }.min(LAMBDA_TABLE as u32 - 2) as usize;
         let w = x - at as f32;
         let (a, b) = (table[at], table[at + 1]);
         lambda[k] = (a + w * (b - a)) / m;
@@ -802,17 +803,23 @@ mod tests {
     fn diagonal_subsample_keeps_every_bin() {
         let src = parse_analytic("ggx?alpha=0.2&f0=0.5").unwrap();
         let all = IsoSamples::new(&src);
-        let per_bin = |set: &IsoSamples, of: fn(usize) -> usize| {
+        // Rows per θh bin (`by_h`) or per θd bin.
+        let per_bin = |set: &IsoSamples, by_h: bool| {
             let mut n = [0usize; THETA_D_RES];
-            set.rows.iter().for_each(|&r| n[of(r as usize)] += 1);
+            for &r in &set.rows {
+                let r = r as usize;
+                n[if by_h {
+                    r / THETA_D_RES
+                } else {
+                    r % THETA_D_RES
+                }] += 1;
+            }
             n
         };
-        let (theta_h, theta_d): (fn(usize) -> usize, fn(usize) -> usize) =
-            (|r| r / THETA_D_RES, |r| r % THETA_D_RES);
         for stride in [4, 8] {
             let sub = all.diagonal(stride);
-            for of in [theta_h, theta_d] {
-                let (a, s) = (per_bin(&all, of), per_bin(&sub, of));
+            for by_h in [true, false] {
+                let (a, s) = (per_bin(&all, by_h), per_bin(&sub, by_h));
                 for b in 0..THETA_D_RES {
                     // ⌊n / stride⌋ or ⌈n / stride⌉ of a bin's n rows, when n ≥ stride.
                     if a[b] >= stride {
