@@ -114,8 +114,8 @@ impl GridSamples {
     }
 
     /// About one (θh, θd) row in `stride` of an isotropic source such that every θh and every
-    /// θd bin keeps its share ([`IsoSamples::diagonal`]): the set on which per-bin F and ρd
-    /// are solved. Anisotropic sets: [`Self::subsample`].
+    /// θd bin keeps its share: the rows with (θh bin + θd bin) ≡ 0 mod `stride`, the set on
+    /// which per-bin F and ρd are solved. Anisotropic sets: [`Self::subsample`].
     pub fn diagonal(&self, stride: usize) -> GridSamples {
         match &self.iso {
             Some(iso) => GridSamples {
