@@ -155,6 +155,18 @@ pub fn probe(src: &MerlBrdf) {
         std::hint::black_box(microfacet_error(&model, &set));
     }
     let t_e = t.elapsed().as_secs_f64() * 1e2;
+    for irls in [0, 1, 2] {
+        let t = Instant::now();
+        for _ in 0..10 {
+            std::hint::black_box(facet_fit::grid::fresnel_diffuse_and_error(
+                &model, &set, irls,
+            ));
+        }
+        println!(
+            "probe: solve irls {irls}: {:.2} ms",
+            t.elapsed().as_secs_f64() * 1e2
+        );
+    }
     println!(
         "probe: first set (with the grid geometry) {t_first:.2} ms, set {t_set:.2} ms, fresnel pass {t_f:.2} ms, error pass {t_e:.2} ms"
     );

@@ -181,7 +181,11 @@ impl IsoSamples {
 
     /// Σ over valid samples of x_ideal = D G2 / (4 cos θo) per θd bin (rows with D > 0).
     pub fn ideal_sums(&self, tables: &IsoTables) -> Vec<f64> {
-        self.run(&IdealSums { set: self, tables })
+        self.run(&IdealSums {
+            set: self,
+            tables,
+            cached: None,
+        })
     }
 
     /// Σ over samples of Σ_c |ln(1 + x_model) − ln(1 + x_data)|, x_model = F D G2 / (4 cos θo)
@@ -205,16 +209,25 @@ impl IsoSamples {
     }
 
     /// The Fresnel average of a model and the error sum of the model with it, G2 / (4 cos θo)
-    /// formed once: kept from the first pass (the sums) for the second (the error).
+    /// formed once ([`Self::ideals`]) for both passes.
     pub fn fresnel_and_error_sum(&self, tables: &IsoTables) -> (Vec<Rgb>, f64) {
-        let (den, ideal) = self.run(&IdealRows { set: self, tables });
+        let ideals = self.ideals(tables);
+        let den = self.run(&IdealSums {
+            set: self,
+            tables,
+            cached: Some(&ideals),
+        });
         let num = self.fresnel_numerators(tables);
         let fresnel = fresnel_from_sums(&num.into_iter().zip(den).collect::<Vec<_>>());
         let tables = IsoTables {
             fresnel: std::array::from_fn(|j| fresnel[j]),
             ..tables.clone()
         };
-        let e = self.error_with_rows(&tables, &ideal);
+        let e = self.run(&ErrorSum {
+            set: self,
+            tables: &tables,
+            cached: Some(&ideals),
+        });
         (fresnel, e)
     }
 
@@ -228,24 +241,34 @@ impl IsoSamples {
         tables: &IsoTables,
         irls: usize,
     ) -> (Vec<Rgb>, Rgb, f64) {
-        let (sums, ideal) = self.run(&WeightedRows {
+        self.fresnel_diffuse_and_error_sum_with(tables, irls, &self.ideals(tables))
+    }
+
+    /// [`Self::fresnel_diffuse_and_error_sum`] with the rows' G2 / (4 cos θo) formed already
+    /// ([`Self::ideals`] for the G of `tables`).
+    pub fn fresnel_diffuse_and_error_sum_with(
+        &self,
+        tables: &IsoTables,
+        irls: usize,
+        ideals: &RowIdeals,
+    ) -> (Vec<Rgb>, Rgb, f64) {
+        let sums = self.run(&WeightedRows {
             set: self,
             tables,
             l1: false,
-            cached: None,
+            ideals,
         });
-        let at = self.row_places();
         let mut tables = tables.clone();
         let (mut fresnel, mut kd) = sums.solve();
         let mut best: Option<(Vec<Rgb>, Rgb, f64)> = None;
         for _ in 0..irls {
             tables.set_fresnel(&fresnel);
             tables.diffuse = kd;
-            let (sums, _) = self.run(&WeightedRows {
+            let sums = self.run(&WeightedRows {
                 set: self,
                 tables: &tables,
                 l1: true,
-                cached: Some((&ideal, &at)),
+                ideals,
             });
             if best.as_ref().is_none_or(|b| sums.error < b.2) {
                 best = Some((fresnel.clone(), kd, sums.error));
@@ -257,7 +280,7 @@ impl IsoSamples {
         let e = self.run(&ErrorSum {
             set: self,
             tables: &tables,
-            cached: Some((&ideal, &at)),
+            cached: Some(ideals),
         });
         match best {
             Some(b) if b.2 < e => b,
@@ -265,52 +288,57 @@ impl IsoSamples {
         }
     }
 
-    /// Each row's place in this set's row order (the index of its kept G2 / (4 cos θo)).
-    fn row_places(&self) -> Vec<u32> {
-        let mut at = vec![0u32; ROWS];
-        for (p, &r) in self.rows.iter().enumerate() {
-            at[r as usize] = p as u32;
-        }
-        at
-    }
-
-    /// The error sum of a model whose rows' G2 / (4 cos θo) were kept by an earlier pass.
-    fn error_with_rows(&self, tables: &IsoTables, ideal: &[f32]) -> f64 {
-        let at = self.row_places();
-        self.run(&ErrorSum {
-            set: self,
-            tables,
-            cached: Some((ideal, &at)),
-        })
-    }
-
     /// The error sum of each θh bin with D of bin i scaled by each of `scales[i]`, everything
-    /// else held: the refinement's scan ([`crate::refine`]).
+    /// else held (G2 / (4 cos θo) of the rows given as `ideals`): the refinement's scan
+    /// ([`crate::refine`]).
     pub fn bin_scan(
         &self,
         tables: &IsoTables,
+        ideals: &RowIdeals,
         scales: &[[f32; SCAN]; THETA_H_RES],
     ) -> Vec<[f64; SCAN]> {
         self.run(&BinScan {
             set: self,
             tables,
+            ideals,
             scales,
+        })
+    }
+
+    /// G2 / (4 cos θo) of every row of this set for the G of `tables` (D, F and ρd play no
+    /// part): formed once in an exactly sized buffer and read by the passes that hold G.
+    pub fn ideals(&self, tables: &IsoTables) -> RowIdeals {
+        let mut values = vec![0.0f32; self.rows.len() * PADDED];
+        let bounds = self.bin_bounds();
+        let mut parts = Vec::with_capacity(THETA_H_RES);
+        let mut rest = values.as_mut_slice();
+        for i in 0..THETA_H_RES {
+            let (part, tail) = rest.split_at_mut((bounds[i + 1] - bounds[i]) * PADDED);
+            parts.push((&self.rows[bounds[i]..bounds[i + 1]], part));
+            rest = tail;
+        }
+        parts
+            .into_par_iter()
+            .for_each(|(rows, out)| fill_ideals(tables, rows, out));
+        RowIdeals(values)
+    }
+
+    /// Where each θh bin's rows start in `rows` (which are increasing), and the end.
+    fn bin_bounds(&self) -> [usize; THETA_H_RES + 1] {
+        std::array::from_fn(|i| {
+            self.rows
+                .partition_point(|&r| (r as usize) < i * THETA_D_RES)
         })
     }
 
     /// A pass over this set's rows, a θh bin's rows per task.
     fn run<P: RowPass>(&self, pass: &P) -> P::Acc {
-        // Rows are increasing: split them by θh bin.
-        let bounds: Vec<usize> = (0..=THETA_H_RES)
-            .map(|i| {
-                self.rows
-                    .partition_point(|&r| (r as usize) < i * THETA_D_RES)
-            })
-            .collect();
+        let bounds = self.bin_bounds();
         (0..THETA_H_RES)
             .into_par_iter()
             .fold(P::init, |mut acc, i| {
-                run_rows(pass, &mut acc, &self.rows[bounds[i]..bounds[i + 1]]);
+                let rows = &self.rows[bounds[i]..bounds[i + 1]];
+                run_rows(pass, &mut acc, rows, bounds[i]);
                 acc
             })
             .reduce(P::init, |mut a, b| {
@@ -324,14 +352,62 @@ impl IsoSamples {
 trait RowPass: Sync {
     type Acc: Send;
     fn init() -> Self::Acc;
-    fn row(&self, acc: &mut Self::Acc, r: usize);
+    /// Adds row `r`, the `p`-th row of the set.
+    fn row(&self, acc: &mut Self::Acc, r: usize, p: usize);
     fn merge(a: &mut Self::Acc, b: Self::Acc);
+}
+
+/// G2 / (4 cos θo) of a set's rows for one model's G, `PADDED` values per row in the set's row
+/// order ([`IsoSamples::ideals`]).
+pub(crate) struct RowIdeals(Vec<f32>);
+
+impl RowIdeals {
+    /// The `p`-th row's values.
+    #[inline(always)]
+    fn row(&self, p: usize) -> &[f32; PADDED] {
+        self.0[p * PADDED..(p + 1) * PADDED].try_into().unwrap()
+    }
+}
+
+/// A row's G2 / (4 cos θo) from `cached` (the `p`-th row of its set), or formed.
+#[inline(always)]
+fn ideal_of(cached: Option<&RowIdeals>, t: &IsoTables, r: usize, p: usize) -> [f32; PADDED] {
+    match cached {
+        Some(c) => *c.row(p),
+        None => {
+            let mut ideal = [0.0f32; PADDED];
+            row_ideal(t, merl_geometry(), r, &mut ideal);
+            ideal
+        }
+    }
+}
+
+/// Fills `out` (`PADDED` values per row) with G2 / (4 cos θo) of `rows` (vectorised as the
+/// passes are, [`run_rows`]).
+fn fill_ideals(tables: &IsoTables, rows: &[u16], out: &mut [f32]) {
+    // A pass whose accumulator is the output (run over given rows, never folded).
+    struct Fill<'t, 'o>(&'t IsoTables, std::marker::PhantomData<&'o ()>);
+    impl<'o> RowPass for Fill<'_, 'o> {
+        type Acc = &'o mut [f32];
+        fn init() -> Self::Acc {
+            &mut []
+        }
+        #[inline(always)]
+        fn row(&self, out: &mut Self::Acc, r: usize, p: usize) {
+            let out = (&mut out[p * PADDED..(p + 1) * PADDED]).try_into().unwrap();
+            row_ideal(self.0, merl_geometry(), r, out);
+        }
+        fn merge(_: &mut Self::Acc, _: Self::Acc) {}
+    }
+    let mut out = out;
+    run_rows(&Fill(tables, std::marker::PhantomData), &mut out, rows, 0);
 }
 
 /// Σ x_ideal per θd bin.
 struct IdealSums<'a> {
     set: &'a IsoSamples,
     tables: &'a IsoTables,
+    cached: Option<&'a RowIdeals>,
 }
 
 impl RowPass for IdealSums<'_> {
@@ -342,13 +418,12 @@ impl RowPass for IdealSums<'_> {
     }
 
     #[inline(always)]
-    fn row(&self, acc: &mut Vec<f64>, r: usize) {
+    fn row(&self, acc: &mut Vec<f64>, r: usize, p: usize) {
         let d = self.tables.d32[r / THETA_D_RES];
         if !(d > 0.0) {
             return;
         }
-        let mut ideal = [0.0f32; PADDED];
-        row_ideal(self.tables, merl_geometry(), r, &mut ideal);
+        let mut ideal = ideal_of(self.cached, self.tables, r, p);
         let valid = &self.set.data.valid[r * ROW..(r + 1) * ROW];
         for (x, &v) in ideal.iter_mut().zip(valid) {
             *x = if v { *x } else { 0.0 };
@@ -362,52 +437,16 @@ impl RowPass for IdealSums<'_> {
     }
 }
 
-/// Σ x_ideal per θd bin, and each row's G2 / (4 cos θo) kept (`PADDED` per row, in row order).
-struct IdealRows<'a> {
-    set: &'a IsoSamples,
-    tables: &'a IsoTables,
-}
-
-impl RowPass for IdealRows<'_> {
-    type Acc = (Vec<f64>, Vec<f32>);
-
-    fn init() -> Self::Acc {
-        (vec![0.0; THETA_D_RES], Vec::new())
-    }
-
-    #[inline(always)]
-    fn row(&self, acc: &mut Self::Acc, r: usize) {
-        let mut ideal = [0.0f32; PADDED];
-        row_ideal(self.tables, merl_geometry(), r, &mut ideal);
-        acc.1.extend_from_slice(&ideal);
-        let d = self.tables.d32[r / THETA_D_RES];
-        if !(d > 0.0) {
-            return;
-        }
-        let valid = &self.set.data.valid[r * ROW..(r + 1) * ROW];
-        for (x, &v) in ideal.iter_mut().zip(valid) {
-            *x = if v { *x } else { 0.0 };
-        }
-        ideal[ROW..].fill(0.0);
-        acc.0[r % THETA_D_RES] += d as f64 * lanes_sum(&ideal);
-    }
-
-    fn merge(a: &mut Self::Acc, b: Self::Acc) {
-        a.0.iter_mut().zip(b.0).for_each(|(a, b)| *a += b);
-        a.1.extend_from_slice(&b.1);
-    }
-}
-
-/// The weighted sums of the F / ρd solve, and each row's G2 / (4 cos θo) kept (`PADDED` per
-/// row, in row order) unless given. Per bin w = 1 / (1 + x)², m = D G2 / (4 cos θo) (0 where
-/// D ≤ 0), μ = cos θi. With `l1`, a step of iteratively reweighted least squares for the
-/// metric's L1 norm: w is also divided by the current model's |ln(1 + x_model) − ln(1 + x)|
-/// (at least `IRLS_FLOOR`; F and ρd/π from `tables`), whose sum the pass gathers.
+/// The weighted sums of the F / ρd solve (each row's G2 / (4 cos θo) given). Per bin
+/// w = 1 / (1 + x)², m = D G2 / (4 cos θo) (0 where D ≤ 0), μ = cos θi. With `l1`, a step of
+/// iteratively reweighted least squares for the metric's L1 norm: w is also divided by the
+/// current model's |ln(1 + x_model) − ln(1 + x)| (at least `IRLS_FLOOR`; F and ρd/π from
+/// `tables`), whose sum the pass gathers.
 struct WeightedRows<'a> {
     set: &'a IsoSamples,
     tables: &'a IsoTables,
     l1: bool,
-    cached: Option<(&'a [f32], &'a [u32])>,
+    ideals: &'a RowIdeals,
 }
 
 /// The smallest residual an IRLS weight divides by: 10⁻³ in ln(1 + x), about the f32 error
@@ -415,26 +454,16 @@ struct WeightedRows<'a> {
 const IRLS_FLOOR: f32 = 1e-3;
 
 impl RowPass for WeightedRows<'_> {
-    type Acc = (LinearSums, Vec<f32>);
+    type Acc = LinearSums;
 
     fn init() -> Self::Acc {
-        (LinearSums::zero(), Vec::new())
+        LinearSums::zero()
     }
 
     #[inline(always)]
-    fn row(&self, acc: &mut Self::Acc, r: usize) {
+    fn row(&self, acc: &mut Self::Acc, r: usize, p: usize) {
         let (t, data) = (self.tables, &self.set.data);
-        let mut ideal = [0.0f32; PADDED];
-        match self.cached {
-            Some((rows, at)) => {
-                let p = at[r] as usize * PADDED;
-                ideal.copy_from_slice(&rows[p..p + PADDED]);
-            }
-            None => {
-                row_ideal(t, merl_geometry(), r, &mut ideal);
-                acc.1.extend_from_slice(&ideal);
-            }
-        }
+        let ideal = self.ideals.row(p);
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let d = t.d32[i];
         let d = if d > 0.0 { d } else { 0.0 };
@@ -447,10 +476,9 @@ impl RowPass for WeightedRows<'_> {
         }
         for c in 0..3 {
             let range = (3 * r + c) * ROW..(3 * r + c + 1) * ROW;
-            let x: &[f32; ROW] = data.x[range.clone()].try_into().unwrap();
             let mut inv_r = [1.0f32; ROW];
             if self.l1 {
-                let log_x: &[f32; ROW] = data.log_x[range].try_into().unwrap();
+                let log_x: &[f32; ROW] = data.log_x[range.clone()].try_into().unwrap();
                 let (f, kd) = (t.fresnel[j][c] as f32, t.diffuse[c] as f32);
                 let mut e = [0.0f32; PADDED];
                 for k in 0..ROW {
@@ -459,8 +487,9 @@ impl RowPass for WeightedRows<'_> {
                     e[k] = if valid[k] { res } else { 0.0 };
                     inv_r[k] = 1.0 / res.max(IRLS_FLOOR);
                 }
-                acc.0.error += lanes_sum(&e);
+                acc.error += lanes_sum(&e);
             }
+            let x: &[f32; ROW] = data.x[range].try_into().unwrap();
             let mut s = [[0.0f32; PADDED]; 5];
             for k in 0..ROW {
                 // w = 1 / (1 + x)²: d ln(1 + x) = dx / (1 + x)
@@ -472,17 +501,16 @@ impl RowPass for WeightedRows<'_> {
                 s[3][k] = wu * mu_i[k];
                 s[4][k] = wu * x[k];
             }
-            let b = &mut acc.0.bins[j][c];
+            let b = &mut acc.bins[j][c];
             (0..3).for_each(|n| b[n] += lanes_sum(&s[n]));
-            let e = &mut acc.0.diffuse[c];
+            let e = &mut acc.diffuse[c];
             e[0] += lanes_sum(&s[3]);
             e[1] += lanes_sum(&s[4]);
         }
     }
 
     fn merge(a: &mut Self::Acc, b: Self::Acc) {
-        a.0.add(&b.0);
-        a.1.extend_from_slice(&b.1);
+        a.add(&b);
     }
 }
 
@@ -490,6 +518,7 @@ impl RowPass for WeightedRows<'_> {
 struct BinScan<'a> {
     set: &'a IsoSamples,
     tables: &'a IsoTables,
+    ideals: &'a RowIdeals,
     scales: &'a [[f32; SCAN]; THETA_H_RES],
 }
 
@@ -501,15 +530,14 @@ impl RowPass for BinScan<'_> {
     }
 
     #[inline(always)]
-    fn row(&self, acc: &mut Self::Acc, r: usize) {
+    fn row(&self, acc: &mut Self::Acc, r: usize, p: usize) {
         let t = self.tables;
-        let mut ideal = [0.0f32; PADDED];
-        row_ideal(t, merl_geometry(), r, &mut ideal);
+        let ideal = self.ideals.row(p);
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let kd = t.diffuse.map(|k| k as f32);
         for (m, &s) in self.scales[i].iter().enumerate() {
             let f = t.fresnel[j].map(|f| f as f32 * t.d32[i] * s);
-            acc[i][m] += row_error(&self.set.data, r, f, kd, &ideal);
+            acc[i][m] += row_error(&self.set.data, r, f, kd, ideal);
         }
     }
 
@@ -524,8 +552,8 @@ impl RowPass for BinScan<'_> {
 struct ErrorSum<'a> {
     set: &'a IsoSamples,
     tables: &'a IsoTables,
-    /// G2 / (4 cos θo) of every row already formed, and each row's place in it.
-    cached: Option<(&'a [f32], &'a [u32])>,
+    /// G2 / (4 cos θo) of the set's rows already formed.
+    cached: Option<&'a RowIdeals>,
 }
 
 impl RowPass for ErrorSum<'_> {
@@ -536,18 +564,10 @@ impl RowPass for ErrorSum<'_> {
     }
 
     #[inline(always)]
-    fn row(&self, acc: &mut f64, r: usize) {
+    fn row(&self, acc: &mut f64, r: usize, p: usize) {
         let (t, data) = (self.tables, &self.set.data);
-        let geo = merl_geometry();
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
-        let mut ideal = [0.0f32; PADDED];
-        match self.cached {
-            Some((rows, at)) => {
-                let p = at[r] as usize * PADDED;
-                ideal.copy_from_slice(&rows[p..p + PADDED]);
-            }
-            None => row_ideal(t, geo, r, &mut ideal),
-        }
+        let ideal = ideal_of(self.cached, t, r, p);
         let f = t.fresnel[j].map(|f| f as f32 * t.d32[i]);
         *acc += row_error(data, r, f, t.diffuse.map(|k| k as f32), &ideal);
     }
@@ -572,7 +592,7 @@ impl RowPass for ErrorSums<'_> {
     }
 
     #[inline(always)]
-    fn row(&self, acc: &mut Vec<f64>, r: usize) {
+    fn row(&self, acc: &mut Vec<f64>, r: usize, _: usize) {
         let t = self.tables;
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let mut ideal = [0.0f32; PADDED];
@@ -599,38 +619,38 @@ impl RowPass for ErrorSums<'_> {
 /// floating-point operation is fused or reordered (Rust contracts nothing into FMA) and the
 /// sums run in eight lanes in both.
 #[inline(always)]
-fn run_rows<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
+fn run_rows<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16], first: usize) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU has AVX-512F, checked just above.
-            return unsafe { run_rows_avx512(pass, acc, rows) };
+            return unsafe { run_rows_avx512(pass, acc, rows, first) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { run_rows_avx2(pass, acc, rows) };
+            return unsafe { run_rows_avx2(pass, acc, rows, first) };
         }
     }
-    run_rows_baseline(pass, acc, rows)
+    run_rows_baseline(pass, acc, rows, first)
 }
 
 #[inline(always)]
-fn run_rows_baseline<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
-    for &r in rows {
-        pass.row(acc, r as usize);
+fn run_rows_baseline<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16], first: usize) {
+    for (n, &r) in rows.iter().enumerate() {
+        pass.row(acc, r as usize, first + n);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn run_rows_avx2<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
-    run_rows_baseline(pass, acc, rows)
+fn run_rows_avx2<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16], first: usize) {
+    run_rows_baseline(pass, acc, rows, first)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-fn run_rows_avx512<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16]) {
-    run_rows_baseline(pass, acc, rows)
+fn run_rows_avx512<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16], first: usize) {
+    run_rows_baseline(pass, acc, rows, first)
 }
 
 /// The outputs of consecutive rows of an [`IsoData`] being built.

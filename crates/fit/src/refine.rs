@@ -69,8 +69,10 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
     let scan_rows = sub.diagonal(SCAN_STRIDE);
     let mut tables = IsoTables::new(&model_of(ndf))?;
     let d0 = tables.d32;
+    // G is held through the rounds (only D changes): its G2 / (4 cos θo) is formed once.
+    let (ideals, scan_ideals) = (sub.ideals(&tables), scan_rows.ideals(&tables));
     let solve = |tables: &mut IsoTables| {
-        let (f, q, e) = sub.fresnel_diffuse_and_error_sum(tables, ROUND_IRLS);
+        let (f, q, e) = sub.fresnel_diffuse_and_error_sum_with(tables, ROUND_IRLS, &ideals);
         tables.set_fresnel(&f);
         tables.diffuse = q;
         e
@@ -86,7 +88,7 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
         let scales = std::array::from_fn(|_| {
             std::array::from_fn(|m| (step * (m as f64 - centre as f64)).exp() as f32)
         });
-        let scan = scan_rows.bin_scan(&tables, &scales);
+        let scan = scan_rows.bin_scan(&tables, &scan_ideals, &scales);
         for (i, errors) in scan.iter().enumerate() {
             // The lowest scale, the centre on ties (a bin without samples stays).
             let m = (0..SCAN).fold(centre, |b, m| if errors[m] < errors[b] { m } else { b });
