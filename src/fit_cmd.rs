@@ -73,6 +73,28 @@ fn open_gpu(arg: BackendArg) -> Result<Option<Gpu>> {
     }
 }
 
+/// [`open_gpu`] on a thread while `work` runs on this one: the adapter probe (driver loading,
+/// 30–50 ms with lavapipe) overlaps the first input's loading.
+fn open_gpu_during<T>(arg: BackendArg, work: impl FnOnce() -> T) -> (Result<Option<Gpu>>, T) {
+    std::thread::scope(|s| {
+        let probe = s.spawn(|| open_gpu(arg));
+        let done = work();
+        let gpu = probe
+            .join()
+            .unwrap_or_else(|_| Err(anyhow::anyhow!("the adapter probe panicked")));
+        (gpu, done)
+    })
+}
+
+/// A source opened, and the milliseconds it took.
+type Opened = (Result<Box<dyn facet_fit::Brdf>, facet_fit::FitError>, f64);
+
+fn open_timed(input: &str, nbrdf: Option<&Path>, library: &mut Option<NbrdfLibrary>) -> Opened {
+    let t = Instant::now();
+    let src = open_source(input, nbrdf, library);
+    (src, t.elapsed().as_secs_f64() * 1e3)
+}
+
 /// Pipelines on the GPU, or the CPU when `--backend auto` cannot build them.
 fn fitter<'g>(gpu: &'g Option<Gpu>, arg: BackendArg) -> Result<Option<GpuFitter<'g>>> {
     let Some(g) = gpu else { return Ok(None) };
@@ -224,11 +246,16 @@ impl FitArgs {
 
 pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let cfg = args.config()?;
-    let gpu = open_gpu(args.backend)?;
+    let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
+    let mut library = None;
+    let (gpu, mut first) = open_gpu_during(args.backend, || {
+        let first = args.inputs.first()?;
+        Some(open_timed(first, nbrdf.as_deref(), &mut library))
+    });
+    let gpu = gpu?;
     let fitter = fitter(&gpu, args.backend)?;
     let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
     crate::output::folder(&args.out, "--out")?;
-    let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
     let mut outputs = Outputs {
         dir: &args.out,
         read: args
@@ -240,7 +267,6 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
             .collect(),
         names: HashSet::new(),
     };
-    let mut library = None;
     let bar = (args.inputs.len() > 1).then(|| {
         let bar = ProgressBar::new(args.inputs.len() as u64);
         bar.set_style(
@@ -256,14 +282,10 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
         if let Some(bar) = &bar {
             bar.set_message(input.clone());
         }
-        match fit_one(
-            input,
-            &cfg,
-            backend,
-            nbrdf.as_deref(),
-            &mut library,
-            &mut outputs,
-        ) {
+        let opened = first
+            .take()
+            .unwrap_or_else(|| open_timed(input, nbrdf.as_deref(), &mut library));
+        match fit_one(input, opened, &cfg, backend, &mut outputs) {
             Ok(fit) => rows.push(fit),
             Err(e) => {
                 failures += 1;
@@ -335,15 +357,12 @@ impl Outputs<'_> {
 
 fn fit_one(
     input: &str,
+    (src, load_ms): Opened,
     cfg: &FitConfig,
     backend: Backend,
-    nbrdf: Option<&Path>,
-    library: &mut Option<NbrdfLibrary>,
     outputs: &mut Outputs,
 ) -> Result<FittedMaterial> {
-    let t = Instant::now();
-    let src = open_source(input, nbrdf, library)?;
-    let load_ms = t.elapsed().as_secs_f64() * 1e3;
+    let src = src?;
     let mut fit = fit_material_on(src.as_ref(), input, cfg, backend)?;
     if fit.record.backend.starts_with("cpu (fallback") {
         eprintln!("notice: {input}: {}", fit.record.backend);
@@ -473,12 +492,15 @@ pub fn fit_default(out: &Path) -> Result<(FittedMaterial, std::path::PathBuf)> {
     println!(
         "        (sampled into a MERL table, then extracted and fitted; see `facet fit --help`)"
     );
-    let t = Instant::now();
-    let model = facet_fit::analytic::parse_analytic(DEFAULT_MATERIAL)?;
-    let src = MerlBrdf::from_table("default-gold-ggx", MerlTable::sample(&model))
-        .map_err(anyhow::Error::msg)?;
-    let load_ms = t.elapsed().as_secs_f64() * 1e3;
-    let gpu = open_gpu(BackendArg::Auto)?;
+    let (gpu, sampled) = open_gpu_during(BackendArg::Auto, || -> Result<_> {
+        let t = Instant::now();
+        let model = facet_fit::analytic::parse_analytic(DEFAULT_MATERIAL)?;
+        let src = MerlBrdf::from_table("default-gold-ggx", MerlTable::sample(&model))
+            .map_err(anyhow::Error::msg)?;
+        Ok((src, t.elapsed().as_secs_f64() * 1e3))
+    });
+    let (src, load_ms) = sampled?;
+    let gpu = gpu?;
     let fitter = fitter(&gpu, BackendArg::Auto)?;
     let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
     let mut fit = fit_material_on(
