@@ -663,14 +663,30 @@ struct RowsOut<'a> {
     count: &'a mut [u16],
 }
 
-/// Fills rows from the MERL channels (AVX2 where the CPU has it, as the passes); returns the
-/// first sample out of range.
+/// Fills rows from the MERL channels (AVX-512 or AVX2 where the CPU has it, as the passes);
+/// returns the first sample out of range.
 fn build_rows(out: RowsOut, raw: [&[f64]; 3], geo: &MerlGeometry) -> Option<(usize, [f32; 3])> {
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2, checked just above.
-        return unsafe { build_rows_avx2(out, raw, geo) };
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F, checked just above.
+            return unsafe { build_rows_avx512(out, raw, geo) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above.
+            return unsafe { build_rows_avx2(out, raw, geo) };
+        }
     }
+    build_rows_baseline(out, raw, geo)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn build_rows_avx512(
+    out: RowsOut,
+    raw: [&[f64]; 3],
+    geo: &MerlGeometry,
+) -> Option<(usize, [f32; 3])> {
     build_rows_baseline(out, raw, geo)
 }
 
