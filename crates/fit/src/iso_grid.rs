@@ -241,23 +241,28 @@ impl IsoSamples {
         tables: &IsoTables,
         irls: usize,
     ) -> (Vec<Rgb>, Rgb, f64) {
-        self.fresnel_diffuse_and_error_sum_with(tables, irls, &self.ideals(tables))
+        self.fresnel_diffuse_and_error_sum_with(tables, irls, &self.ideals(tables), None)
     }
 
     /// [`Self::fresnel_diffuse_and_error_sum`] with the rows' G2 / (4 cos θo) formed already
-    /// ([`Self::ideals`] for the G of `tables`).
+    /// ([`Self::ideals`] for the G of `tables`), and with `plain` their plain weighted sums
+    /// ([`Self::row_sums`] of `ideals`), which spare the first pass.
     pub fn fresnel_diffuse_and_error_sum_with(
         &self,
         tables: &IsoTables,
         irls: usize,
         ideals: &RowIdeals,
+        plain: Option<&RowSums>,
     ) -> (Vec<Rgb>, Rgb, f64) {
-        let sums = self.run(&WeightedRows {
-            set: self,
-            tables,
-            l1: false,
-            ideals,
-        });
+        let sums = match plain {
+            Some(plain) => self.plain_sums(tables, plain),
+            None => self.run(&WeightedRows {
+                set: self,
+                tables,
+                l1: false,
+                ideals,
+            }),
+        };
         let mut tables = tables.clone();
         let (mut fresnel, mut kd) = sums.solve();
         let mut best: Option<(Vec<Rgb>, Rgb, f64)> = None;
@@ -308,19 +313,71 @@ impl IsoSamples {
     /// G2 / (4 cos θo) of every row of this set for the G of `tables` (D, F and ρd play no
     /// part): formed once in an exactly sized buffer and read by the passes that hold G.
     pub fn ideals(&self, tables: &IsoTables) -> RowIdeals {
-        let mut values = vec![0.0f32; self.rows.len() * PADDED];
+        let mut values = vec![[0.0f32; PADDED]; self.rows.len()];
+        self.fill_rows(&mut values, |r, out| {
+            row_ideal(tables, merl_geometry(), r, out)
+        });
+        RowIdeals(values)
+    }
+
+    /// The plain (unreweighted) weighted sums of every row of this set for the G of `ideals`,
+    /// D factored out: with G held, the plain F / ρd solve of any D then costs O(rows)
+    /// ([`Self::fresnel_diffuse_and_error_sum_with`]) instead of a pass.
+    pub fn row_sums(&self, ideals: &RowIdeals) -> RowSums {
+        let mut values = vec![[[0.0f64; 5]; 3]; self.rows.len()];
+        self.fill_rows_at(&mut values, |r, p, out| {
+            *out = weighted_row(&self.data, r, ideals.row(p), None).0;
+        });
+        RowSums(values)
+    }
+
+    /// The plain normal equations of the D of `tables` from the rows' sums (O(rows)); as the
+    /// pass would give them, summed in another order.
+    fn plain_sums(&self, tables: &IsoTables, plain: &RowSums) -> LinearSums {
+        debug_assert_eq!(plain.0.len(), self.rows.len());
+        let mut acc = LinearSums::zero();
+        for (&r, sums) in self.rows.iter().zip(&plain.0) {
+            let (i, j) = (r as usize / THETA_D_RES, r as usize % THETA_D_RES);
+            let d = tables.d32[i];
+            add_row(&mut acc, j, if d > 0.0 { d as f64 } else { 0.0 }, sums);
+        }
+        acc
+    }
+
+    /// `out[p]` = `value(r)` for the `p`-th row `r` of this set: rayon over θh bins, each bin's
+    /// rows vectorised as the passes are ([`run_rows`]).
+    fn fill_rows<T: Send>(&self, out: &mut [T], value: impl Fn(usize, &mut T) + Sync) {
+        self.fill_rows_at(out, |r, _, out| value(r, out));
+    }
+
+    /// [`Self::fill_rows`] with the row's position `p` in the set given as well.
+    fn fill_rows_at<T: Send>(&self, out: &mut [T], value: impl Fn(usize, usize, &mut T) + Sync) {
+        // A pass whose accumulator is the output (run over given rows, never folded).
+        struct Fill<'o, T, F>(F, usize, std::marker::PhantomData<fn(&'o mut T)>);
+        impl<'o, T: Send, F: Fn(usize, usize, &mut T) + Sync> RowPass for Fill<'o, T, F> {
+            type Acc = &'o mut [T];
+            fn init() -> Self::Acc {
+                &mut []
+            }
+            #[inline(always)]
+            fn row(&self, out: &mut Self::Acc, r: usize, p: usize) {
+                (self.0)(r, self.1 + p, &mut out[p]);
+            }
+            fn merge(_: &mut Self::Acc, _: Self::Acc) {}
+        }
         let bounds = self.bin_bounds();
         let mut parts = Vec::with_capacity(THETA_H_RES);
-        let mut rest = values.as_mut_slice();
+        let mut rest = out;
         for i in 0..THETA_H_RES {
-            let (part, tail) = rest.split_at_mut((bounds[i + 1] - bounds[i]) * PADDED);
-            parts.push((&self.rows[bounds[i]..bounds[i + 1]], part));
+            let (part, tail) = rest.split_at_mut(bounds[i + 1] - bounds[i]);
+            parts.push((i, part));
             rest = tail;
         }
-        parts
-            .into_par_iter()
-            .for_each(|(rows, out)| fill_ideals(tables, rows, out));
-        RowIdeals(values)
+        parts.into_par_iter().for_each(|(i, mut out)| {
+            let rows = &self.rows[bounds[i]..bounds[i + 1]];
+            let fill = Fill(&value, bounds[i], std::marker::PhantomData);
+            run_rows(&fill, &mut out, rows, 0);
+        });
     }
 
     /// Where each θh bin's rows start in `rows` (which are increasing), and the end.
@@ -359,15 +416,20 @@ trait RowPass: Sync {
 
 /// G2 / (4 cos θo) of a set's rows for one model's G, `PADDED` values per row in the set's row
 /// order ([`IsoSamples::ideals`]).
-pub(crate) struct RowIdeals(Vec<f32>);
+pub(crate) struct RowIdeals(Vec<[f32; PADDED]>);
 
 impl RowIdeals {
     /// The `p`-th row's values.
     #[inline(always)]
     fn row(&self, p: usize) -> &[f32; PADDED] {
-        self.0[p * PADDED..(p + 1) * PADDED].try_into().unwrap()
+        &self.0[p]
     }
 }
+
+/// The plain weighted sums of a set's rows for one model's G with D factored out, per row and
+/// channel [Σ w ι², Σ w ι μ, Σ w ι x, Σ w μ², Σ w μ x] ([`weighted_row`]; ι = G2 / (4 cos θo))
+/// in the set's row order ([`IsoSamples::row_sums`]).
+pub(crate) struct RowSums(Vec<[[f64; 5]; 3]>);
 
 /// A row's G2 / (4 cos θo) from `cached` (the `p`-th row of its set), or formed.
 #[inline(always)]
@@ -380,27 +442,6 @@ fn ideal_of(cached: Option<&RowIdeals>, t: &IsoTables, r: usize, p: usize) -> [f
             ideal
         }
     }
-}
-
-/// Fills `out` (`PADDED` values per row) with G2 / (4 cos θo) of `rows` (vectorised as the
-/// passes are, [`run_rows`]).
-fn fill_ideals(tables: &IsoTables, rows: &[u16], out: &mut [f32]) {
-    // A pass whose accumulator is the output (run over given rows, never folded).
-    struct Fill<'t, 'o>(&'t IsoTables, std::marker::PhantomData<&'o ()>);
-    impl<'o> RowPass for Fill<'_, 'o> {
-        type Acc = &'o mut [f32];
-        fn init() -> Self::Acc {
-            &mut []
-        }
-        #[inline(always)]
-        fn row(&self, out: &mut Self::Acc, r: usize, p: usize) {
-            let out = (&mut out[p * PADDED..(p + 1) * PADDED]).try_into().unwrap();
-            row_ideal(self.0, merl_geometry(), r, out);
-        }
-        fn merge(_: &mut Self::Acc, _: Self::Acc) {}
-    }
-    let mut out = out;
-    run_rows(&Fill(tables, std::marker::PhantomData), &mut out, rows, 0);
 }
 
 /// Σ x_ideal per θd bin.
@@ -462,56 +503,89 @@ impl RowPass for WeightedRows<'_> {
 
     #[inline(always)]
     fn row(&self, acc: &mut Self::Acc, r: usize, p: usize) {
-        let (t, data) = (self.tables, &self.set.data);
-        let ideal = self.ideals.row(p);
+        let t = self.tables;
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let d = t.d32[i];
         let d = if d > 0.0 { d } else { 0.0 };
-        let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
-        let valid = &data.valid[r * ROW..(r + 1) * ROW];
-        let (mut m, mut mu_i) = ([0.0f32; PADDED], [0.0f32; PADDED]);
-        for k in 0..ROW {
-            m[k] = if valid[k] { d * ideal[k] } else { 0.0 };
-            mu_i[k] = if valid[k] { mu[ROW - k] } else { 0.0 };
-        }
-        for c in 0..3 {
-            let range = (3 * r + c) * ROW..(3 * r + c + 1) * ROW;
-            let mut inv_r = [1.0f32; ROW];
-            if self.l1 {
-                let log_x: &[f32; ROW] = data.log_x[range.clone()].try_into().unwrap();
-                let (f, kd) = (t.fresnel[j][c] as f32, t.diffuse[c] as f32);
-                let mut e = [0.0f32; PADDED];
-                for k in 0..ROW {
-                    // x_model = F D (G2 / (4 cos θo)) + ρd/π cos θi, masked bins 0
-                    let res = (ln_1p(f * m[k] + kd * mu_i[k]) - log_x[k]).abs();
-                    e[k] = if valid[k] { res } else { 0.0 };
-                    inv_r[k] = 1.0 / res.max(IRLS_FLOOR);
-                }
-                acc.error += lanes_sum(&e);
-            }
-            let x: &[f32; ROW] = data.x[range].try_into().unwrap();
-            let mut s = [[0.0f32; PADDED]; 5];
-            for k in 0..ROW {
-                // w = 1 / (1 + x)²: d ln(1 + x) = dx / (1 + x)
-                let w = inv_r[k] / ((1.0 + x[k]) * (1.0 + x[k]));
-                let (wm, wu) = (w * m[k], w * mu_i[k]);
-                s[0][k] = wm * m[k];
-                s[1][k] = wm * mu_i[k];
-                s[2][k] = wm * x[k];
-                s[3][k] = wu * mu_i[k];
-                s[4][k] = wu * x[k];
-            }
-            let b = &mut acc.bins[j][c];
-            (0..3).for_each(|n| b[n] += lanes_sum(&s[n]));
-            let e = &mut acc.diffuse[c];
-            e[0] += lanes_sum(&s[3]);
-            e[1] += lanes_sum(&s[4]);
-        }
+        let l1 = self.l1.then(|| {
+            let fd = t.fresnel[j].map(|f| f as f32 * d);
+            (fd, t.diffuse.map(|k| k as f32))
+        });
+        let (sums, error) = weighted_row(&self.set.data, r, self.ideals.row(p), l1);
+        acc.error += error;
+        add_row(acc, j, d as f64, &sums);
     }
 
     fn merge(a: &mut Self::Acc, b: Self::Acc) {
         a.add(&b);
     }
+}
+
+/// Adds a row of θd bin `j` and D = `d` to the normal equations, given its sums with D
+/// factored out ([`weighted_row`]): m = D ι, so Σ w m² = D² Σ w ι² and Σ w m · = D Σ w ι ·.
+#[inline(always)]
+fn add_row(acc: &mut LinearSums, j: usize, d: f64, sums: &[[f64; 5]; 3]) {
+    for (c, s) in sums.iter().enumerate() {
+        let b = &mut acc.bins[j][c];
+        b[0] += d * d * s[0];
+        b[1] += d * s[1];
+        b[2] += d * s[2];
+        acc.diffuse[c][0] += s[3];
+        acc.diffuse[c][1] += s[4];
+    }
+}
+
+/// One row's weighted sums with D factored out: per channel [Σ w ι², Σ w ι μ, Σ w ι x,
+/// Σ w μ², Σ w μ x] over the valid bins, ι = G2 / (4 cos θo) (`ideal`), μ = cos θi,
+/// w = 1 / (1 + x)². With `l1` = (F D, ρd/π) per channel, a step of iteratively reweighted
+/// least squares for the metric's L1 norm: w is also divided by that model's
+/// |ln(1 + x_model) − ln(1 + x)| (at least `IRLS_FLOOR`), whose sum (the row's error, as
+/// [`row_error`] gives it) is returned too.
+#[inline(always)]
+fn weighted_row(
+    data: &IsoData,
+    r: usize,
+    ideal: &[f32; PADDED],
+    l1: Option<([f32; 3], [f32; 3])>,
+) -> ([[f64; 5]; 3], f64) {
+    let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
+    let valid = &data.valid[r * ROW..(r + 1) * ROW];
+    let (mut m, mut mu_i) = ([0.0f32; PADDED], [0.0f32; PADDED]);
+    for k in 0..ROW {
+        m[k] = if valid[k] { ideal[k] } else { 0.0 };
+        mu_i[k] = if valid[k] { mu[ROW - k] } else { 0.0 };
+    }
+    let (mut sums, mut error) = ([[0.0f64; 5]; 3], 0.0);
+    for (c, out) in sums.iter_mut().enumerate() {
+        let range = (3 * r + c) * ROW..(3 * r + c + 1) * ROW;
+        let mut inv_r = [1.0f32; ROW];
+        if let Some((fd, kd)) = l1 {
+            let log_x: &[f32; ROW] = data.log_x[range.clone()].try_into().unwrap();
+            let (f, kd) = (fd[c], kd[c]);
+            let mut e = [0.0f32; PADDED];
+            for k in 0..ROW {
+                // x_model = F D (G2 / (4 cos θo)) + ρd/π cos θi, masked bins 0
+                let res = (ln_1p(f * m[k] + kd * mu_i[k]) - log_x[k]).abs();
+                e[k] = if valid[k] { res } else { 0.0 };
+                inv_r[k] = 1.0 / res.max(IRLS_FLOOR);
+            }
+            error += lanes_sum(&e);
+        }
+        let x: &[f32; ROW] = data.x[range].try_into().unwrap();
+        let mut s = [[0.0f32; PADDED]; 5];
+        for k in 0..ROW {
+            // w = 1 / (1 + x)²: d ln(1 + x) = dx / (1 + x)
+            let w = inv_r[k] / ((1.0 + x[k]) * (1.0 + x[k]));
+            let (wm, wu) = (w * m[k], w * mu_i[k]);
+            s[0][k] = wm * m[k];
+            s[1][k] = wm * mu_i[k];
+            s[2][k] = wm * x[k];
+            s[3][k] = wu * mu_i[k];
+            s[4][k] = wu * x[k];
+        }
+        *out = s.map(|s| lanes_sum(&s));
+    }
+    (sums, error)
 }
 
 /// The error sum per θh bin with that bin's D scaled by each of its `SCAN` scales.
@@ -831,6 +905,47 @@ fn row_ideal(t: &IsoTables, geo: &MerlGeometry, r: usize, out: &mut [f32; PADDED
 mod tests {
     use super::*;
     use crate::analytic::parse_analytic;
+
+    /// The plain normal equations from the rows' cached sums are the pass's: the same per-row
+    /// sums ([`weighted_row`]) added in another order, so equal to f64 rounding (1e-12).
+    #[test]
+    fn cached_row_sums_give_the_pass_sums() {
+        let src = parse_analytic("ggx?alpha=0.3&f0=0.04&kd=0.3,0.1,0.05").unwrap();
+        let set = IsoSamples::new(&src).diagonal(4);
+        let model = crate::microfacet::MicrofacetBrdf::ideal(
+            "m",
+            crate::microfacet::Ndf::Analytic(crate::microfacet::AnalyticNdf::isotropic(
+                crate::microfacet::NdfKind::Beckmann,
+                0.2,
+            )),
+        );
+        let tables = IsoTables::new(&model).unwrap();
+        let ideals = set.ideals(&tables);
+        let pass = set.run(&WeightedRows {
+            set: &set,
+            tables: &tables,
+            l1: false,
+            ideals: &ideals,
+        });
+        let cached = set.plain_sums(&tables, &set.row_sums(&ideals));
+        let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300);
+        for (j, (a, b)) in pass.bins.iter().zip(&cached.bins).enumerate() {
+            for c in 0..3 {
+                for n in 0..3 {
+                    assert!(
+                        close(a[c][n], b[c][n]),
+                        "θd bin {j} c {c} n {n}: {a:?} {b:?}"
+                    );
+                }
+            }
+        }
+        for c in 0..3 {
+            for n in 0..2 {
+                let (a, b) = (pass.diffuse[c][n], cached.diffuse[c][n]);
+                assert!(a > 0.0 && close(a, b), "diffuse c {c} n {n}: {a} {b}");
+            }
+        }
+    }
 
     /// The diagonal subsample keeps about 1/stride of every θh bin's and every θd bin's rows:
     /// no per-bin unknown is left without samples (every `stride`-th row in order would drop

@@ -14,7 +14,7 @@
 
 use crate::brdf::Rgb;
 use crate::extract::azimuthal_integral;
-use crate::grid::{GridSamples, IsoTables, fresnel_diffuse_and_error};
+use crate::grid::{GridSamples, IsoTables};
 use crate::iso_grid::SCAN;
 use crate::merl::{THETA_H_RES, bin_angles};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf};
@@ -69,10 +69,13 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
     let scan_rows = sub.diagonal(SCAN_STRIDE);
     let mut tables = IsoTables::new(&model_of(ndf))?;
     let d0 = tables.d32;
-    // G is held through the rounds (only D changes): its G2 / (4 cos θo) is formed once.
+    // G is held through the rounds (only D changes): its G2 / (4 cos θo) and the rows' plain
+    // weighted sums are formed once.
     let (ideals, scan_ideals) = (sub.ideals(&tables), scan_rows.ideals(&tables));
+    let plain = sub.row_sums(&ideals);
     let solve = |tables: &mut IsoTables| {
-        let (f, q, e) = sub.fresnel_diffuse_and_error_sum_with(tables, ROUND_IRLS, &ideals);
+        let (f, q, e) =
+            sub.fresnel_diffuse_and_error_sum_with(tables, ROUND_IRLS, &ideals, Some(&plain));
         tables.set_fresnel(&f);
         tables.diffuse = q;
         e
@@ -114,6 +117,17 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
             break;
         }
     }
+    // F, ρd and the error per sample and channel of a final candidate
+    // ([`crate::grid::fresnel_diffuse_and_error`]); one whose G is the rounds' (G1 held) reuses their sums.
+    let solve_final = |ndf: &TabulatedNdf| {
+        let t = IsoTables::new(&model_of(ndf))?;
+        let (f, q, e) = if t.lambda_cos == tables.lambda_cos {
+            sub.fresnel_diffuse_and_error_sum_with(&t, IRLS, &ideals, Some(&plain))
+        } else {
+            sub.fresnel_diffuse_and_error_sum(&t, IRLS)
+        };
+        Some((f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64))
+    };
     let d = rescaled_d(ndf, &best.0);
     let held = ndf.tables().g1.clone();
     let smith = smith_g1(&d, ndf.tables().ng)?;
@@ -127,7 +141,7 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
                 ..t.clone()
             };
             let ndf = TabulatedNdf::new(tables, Stretch::IDENTITY).ok()?;
-            let (fresnel, albedo, error) = fresnel_diffuse_and_error(&model_of(&ndf), set, IRLS)?;
+            let (fresnel, albedo, error) = solve_final(&ndf)?;
             Some(Refined {
                 ndf,
                 fresnel,
