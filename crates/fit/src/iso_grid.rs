@@ -314,9 +314,7 @@ impl IsoSamples {
     /// part): formed once in an exactly sized buffer and read by the passes that hold G.
     pub fn ideals(&self, tables: &IsoTables) -> RowIdeals {
         let mut values = vec![[0.0f32; PADDED]; self.rows.len()];
-        self.fill_rows(&mut values, |r, out| {
-            row_ideal(tables, merl_geometry(), r, out)
-        });
+        self.fill_rows(&mut values, &IdealFill(tables));
         RowIdeals(values)
     }
 
@@ -325,9 +323,11 @@ impl IsoSamples {
     /// ([`Self::fresnel_diffuse_and_error_sum_with`]) instead of a pass.
     pub fn row_sums(&self, ideals: &RowIdeals) -> RowSums {
         let mut values = vec![[[0.0f64; 5]; 3]; self.rows.len()];
-        self.fill_rows_at(&mut values, |r, p, out| {
-            *out = weighted_row(&self.data, r, ideals.row(p), None).0;
-        });
+        let fill = SumsFill {
+            data: &self.data,
+            ideals,
+        };
+        self.fill_rows(&mut values, &fill);
         RowSums(values)
     }
 
@@ -344,24 +344,19 @@ impl IsoSamples {
         acc
     }
 
-    /// `out[p]` = `value(r)` for the `p`-th row `r` of this set: rayon over θh bins, each bin's
-    /// rows vectorised as the passes are ([`run_rows`]).
-    fn fill_rows<T: Send>(&self, out: &mut [T], value: impl Fn(usize, &mut T) + Sync) {
-        self.fill_rows_at(out, |r, _, out| value(r, out));
-    }
-
-    /// [`Self::fill_rows`] with the row's position `p` in the set given as well.
-    fn fill_rows_at<T: Send>(&self, out: &mut [T], value: impl Fn(usize, usize, &mut T) + Sync) {
+    /// `out[p]` = the value of the `p`-th row of this set: rayon over θh bins, each bin's rows
+    /// vectorised as the passes are ([`run_rows`]).
+    fn fill_rows<F: RowFill>(&self, out: &mut [F::Out], fill: &F) {
         // A pass whose accumulator is the output (run over given rows, never folded).
-        struct Fill<'o, T, F>(F, usize, std::marker::PhantomData<fn(&'o mut T)>);
-        impl<'o, T: Send, F: Fn(usize, usize, &mut T) + Sync> RowPass for Fill<'o, T, F> {
-            type Acc = &'o mut [T];
+        struct Fill<'f, 'o, F: RowFill>(&'f F, usize, std::marker::PhantomData<fn(&'o mut F)>);
+        impl<'o, F: RowFill> RowPass for Fill<'_, 'o, F> {
+            type Acc = &'o mut [F::Out];
             fn init() -> Self::Acc {
                 &mut []
             }
             #[inline(always)]
             fn row(&self, out: &mut Self::Acc, r: usize, p: usize) {
-                (self.0)(r, self.1 + p, &mut out[p]);
+                self.0.fill(r, self.1 + p, &mut out[p]);
             }
             fn merge(_: &mut Self::Acc, _: Self::Acc) {}
         }
@@ -375,8 +370,12 @@ impl IsoSamples {
         }
         parts.into_par_iter().for_each(|(i, mut out)| {
             let rows = &self.rows[bounds[i]..bounds[i + 1]];
-            let fill = Fill(&value, bounds[i], std::marker::PhantomData);
-            run_rows(&fill, &mut out, rows, 0);
+            run_rows(
+                &Fill(fill, bounds[i], std::marker::PhantomData),
+                &mut out,
+                rows,
+                0,
+            );
         });
     }
 
@@ -412,6 +411,42 @@ trait RowPass: Sync {
     /// Adds row `r`, the `p`-th row of the set.
     fn row(&self, acc: &mut Self::Acc, r: usize, p: usize);
     fn merge(a: &mut Self::Acc, b: Self::Acc);
+}
+
+/// A value per row that [`IsoSamples::fill_rows`] writes. `fill` is inlined into the
+/// vectorised row loop ([`run_rows`]); a closure there would be called out of line, compiled
+/// for the baseline target.
+trait RowFill: Sync {
+    type Out: Send;
+    /// The value of row `r`, the `p`-th of the set.
+    fn fill(&self, r: usize, p: usize, out: &mut Self::Out);
+}
+
+/// G2 / (4 cos θo) of a row for the G of the tables.
+struct IdealFill<'a>(&'a IsoTables);
+
+impl RowFill for IdealFill<'_> {
+    type Out = [f32; PADDED];
+
+    #[inline(always)]
+    fn fill(&self, r: usize, _: usize, out: &mut Self::Out) {
+        row_ideal(self.0, merl_geometry(), r, out);
+    }
+}
+
+/// A row's plain weighted sums with D factored out, for the G of `ideals`.
+struct SumsFill<'a> {
+    data: &'a IsoData,
+    ideals: &'a RowIdeals,
+}
+
+impl RowFill for SumsFill<'_> {
+    type Out = [[f64; 5]; 3];
+
+    #[inline(always)]
+    fn fill(&self, r: usize, p: usize, out: &mut Self::Out) {
+        *out = weighted_row(self.data, r, self.ideals.row(p), None).0;
+    }
 }
 
 /// G2 / (4 cos θo) of a set's rows for one model's G, `PADDED` values per row in the set's row
@@ -583,7 +618,10 @@ fn weighted_row(
             s[3][k] = wu * mu_i[k];
             s[4][k] = wu * x[k];
         }
-        *out = s.map(|s| lanes_sum(&s));
+        // A loop, not `map`: an array's map is called out of line, outside the vector code.
+        for (o, s) in out.iter_mut().zip(&s) {
+            *o = lanes_sum(s);
+        }
     }
     (sums, error)
 }
