@@ -117,8 +117,9 @@ pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Optio
             break;
         }
     }
-    // F, ρd and the error per sample and channel of a final candidate
-    // ([`crate::grid::fresnel_diffuse_and_error`]); one whose G is the rounds' (G1 held) reuses their sums.
+    // F, ρd and the error per sample and channel of a final candidate, as
+    // `crate::grid::fresnel_diffuse_and_error` gives them; one whose G is the rounds' (G1
+    // held) reuses their G2 / (4 cos θo) and plain sums.
     let solve_final = |ndf: &TabulatedNdf| {
         let t = IsoTables::new(&model_of(ndf))?;
         let (f, q, e) = if t.lambda_cos == tables.lambda_cos {
