@@ -10,7 +10,12 @@
 //! (γ/w) rings and (2π sin ψ / w) nodes per ring (small rings need fewer). The
 //! [`ConeRule::direct`] rule is the previous, fixed one (12 + 0.75·γ° rings of 24 + 1.5·γ°
 //! nodes, sized for α ≈ 0.05 at every γ): the reference the fast rule is measured against.
+//!
+//! A cone much wider than the lobe is better integrated about the lobe than about the cone's
+//! axis: [`ConeRule::fast`] switches a level to [`LobeRule`] where that needs fewer nodes
+//! ([`ConeRule::level`]).
 
+use crate::lobe_rule::LobeRule;
 use bytemuck::{Pod, Zeroable};
 use facet_fit::microfacet::Ndf;
 use facet_fit::quadrature::gauss_legendre;
@@ -37,6 +42,38 @@ pub struct ConeRule {
     pub chi_per_width: f64,
     /// The narrowest lobe resolved (radians): below it the rule stops growing.
     pub min_width: f64,
+    /// The rule about the lobe, taken at a level where it needs fewer nodes than the rings.
+    pub lobe: Option<LobeRule>,
+}
+
+/// What one node of the rule about the lobe costs in ring nodes: its arcs, its walk over the
+/// intervals and neighbouring cells that take different intervals. Measured on lavapipe with the
+/// nine-level builds (`facet bench --only dpf`): the lobe rule's most evaluations cost about
+/// 1.2× as many ring nodes.
+pub const LOBE_NODE_COST: f64 = 1.25;
+
+/// How one level is integrated: rings about ωo, or the rule about the lobe.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LevelRule {
+    /// The rings of the cone rule.
+    Rings(Vec<Ring>),
+    /// The rule about the lobe, for a lobe of width `width`.
+    Lobe {
+        /// Its node counts.
+        rule: LobeRule,
+        /// The lobe width it is sized to (floored as the rings are).
+        width: f64,
+    },
+}
+
+impl LevelRule {
+    /// The D evaluations per cell (the rule about the lobe: at most).
+    pub fn evaluations(&self) -> usize {
+        match self {
+            LevelRule::Rings(rings) => rings.iter().map(|r| r.n_chi as usize).sum(),
+            LevelRule::Lobe { rule, width } => rule.max_evaluations(*width),
+        }
+    }
 }
 
 impl ConeRule {
@@ -52,12 +89,14 @@ impl ConeRule {
             chi_per_deg: 1.5,
             chi_per_width: 0.0,
             min_width: 0.0,
+            lobe: None,
         }
     }
 
     /// Nodes in proportion to the lobe: 3 + 2.5·γ/w rings, 4 + 2·(2π sin ψ)/w nodes on a ring
     /// (a node every ~w/2 across the lobe at both sizes), growing down to α = 0.05 (w = 0.1) as
-    /// the direct rule did. Measured against [`ConeRule::direct`] in `tests/glint.rs`.
+    /// the direct rule did; [`LobeRule::standard`] on the wide cones where it is cheaper.
+    /// Measured against [`ConeRule::direct`] in `tests/glint.rs`.
     pub const fn fast() -> Self {
         ConeRule {
             psi_base: 3,
@@ -67,6 +106,7 @@ impl ConeRule {
             chi_per_deg: 0.0,
             chi_per_width: 2.0,
             min_width: 0.1,
+            lobe: Some(LobeRule::standard()),
         }
     }
 
@@ -94,12 +134,29 @@ impl ConeRule {
             .collect()
     }
 
-    /// The D evaluations per cell of a cone (the sum of the rings' nodes).
+    /// How the level of half-angle `gamma` is integrated for a lobe of width `width`: the rings,
+    /// or the rule about the lobe where its most evaluations, at [`LOBE_NODE_COST`], cost less.
+    pub fn level(&self, gamma: f64, width: f64) -> LevelRule {
+        let rings = LevelRule::Rings(self.rings(gamma, width));
+        match self.lobe {
+            Some(rule) => {
+                let lobe = LevelRule::Lobe {
+                    rule,
+                    width: width.max(self.min_width),
+                };
+                if (lobe.evaluations() as f64 * LOBE_NODE_COST) < rings.evaluations() as f64 {
+                    lobe
+                } else {
+                    rings
+                }
+            }
+            None => rings,
+        }
+    }
+
+    /// The D evaluations per cell of a cone (at most, where the rule about the lobe is taken).
     pub fn evaluations(&self, gamma: f64, width: f64) -> usize {
-        self.rings(gamma, width)
-            .iter()
-            .map(|r| r.n_chi as usize)
-            .sum()
+        self.level(gamma, width).evaluations()
     }
 }
 

@@ -6,9 +6,11 @@
 //! 7–24 %): with h(ω) = normalize(ωi + ω) and dω_h = dω / (4 ωi·h),
 //!   P = ∫_{ω ∈ cone(ωo, γ)} D(h) cos θh / (4 ωi·h) dω,
 //! Gauss–Legendre in the cone's polar angle ψ (weight sin ψ) × midpoint in its azimuth χ, with
-//! node counts sized to the NDF's lobe ([`crate::cone_rule`]).
+//! node counts sized to the NDF's lobe ([`crate::cone_rule`]), or on wide cones polar
+//! coordinates about the lobe clipped to the cone ([`crate::lobe_rule`]).
 
-use crate::cone_rule::{ConeRule, Ring, lobe_width};
+use crate::cone_rule::{ConeRule, LevelRule, Ring, lobe_width};
+use crate::lobe_rule::LobeRule;
 use facet_fit::microfacet::Ndf;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -36,7 +38,31 @@ pub fn dpf_reference(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64) -> f64 {
 
 /// P by the cone rule `rule`.
 pub fn dpf_with(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64, rule: &ConeRule) -> f64 {
-    dpf_on_rings(ndf, wi, wo, &rule.rings(gamma, lobe_width(ndf)))
+    dpf_on_level(ndf, wi, wo, gamma, &rule.level(gamma, lobe_width(ndf)))
+}
+
+/// P by the rule a level takes.
+pub fn dpf_on_level(ndf: &Ndf, wi: DVec3, wo: DVec3, gamma: f64, level: &LevelRule) -> f64 {
+    match level {
+        LevelRule::Rings(rings) => dpf_on_rings(ndf, wi, wo, rings),
+        LevelRule::Lobe { rule, width } => dpf_on_lobe(ndf, wi, wo, gamma, *width, rule),
+    }
+}
+
+/// P by the rule about the lobe of width `width`: Σ weight · p(h)/(4 ωi·h) over its nodes.
+pub fn dpf_on_lobe(
+    ndf: &Ndf,
+    wi: DVec3,
+    wo: DVec3,
+    gamma: f64,
+    width: f64,
+    rule: &LobeRule,
+) -> f64 {
+    let mut sum = 0.0;
+    rule.for_each_node(wi, wo, gamma, width, |w, weight| {
+        sum += weight * flake_density(ndf, wi, w)
+    });
+    sum
 }
 
 /// P by the rings of a cone rule: Σ_rings weight · Σ_χ p(h)/(4 ωi·h) (what the shader sums).
@@ -138,14 +164,14 @@ impl DpfTable {
     /// The CPU build with the cone rule `rule`.
     pub fn build_with(ndf: &Ndf, gamma: f64, config: DpfConfig, rule: &ConeRule) -> Self {
         let (nt, np) = (config.n_theta, config.n_dphi);
-        let rings = rule.rings(gamma, lobe_width(ndf));
+        let level = rule.level(gamma, lobe_width(ndf));
         let values = (0..nt * nt * np)
             .into_par_iter()
             .map(|c| {
                 let (o, i, p) = (c / (nt * np), c / np % nt, c % np);
                 let (theta_o, theta_i, dphi) = Self::cell_centre(config, o, i, p);
                 let (wi, wo) = query_directions(theta_o, theta_i, dphi);
-                dpf_on_rings(ndf, wi, wo, &rings) as f32
+                dpf_on_level(ndf, wi, wo, gamma, &level) as f32
             })
             .collect();
         DpfTable {

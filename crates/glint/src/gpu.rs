@@ -1,8 +1,9 @@
 //! Host driver of `shaders/glint/dpf_build.wgsl`: the DPF levels built on the GPU and stored as
 //! one 3D texture per level (R32Float, x = Δφ, y = θi, z = θo, values at cell centres).
 
-use crate::cone_rule::{ConeRule, lobe_width};
+use crate::cone_rule::{ConeRule, LevelRule, Ring, lobe_width};
 use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG};
+use crate::lobe_rule::{LOBE_EPS, TOUCH_MERGE};
 use bytemuck::{Pod, Zeroable};
 use facet_fit::geometry::spherical;
 use facet_fit::microfacet::Ndf;
@@ -23,9 +24,14 @@ pub struct DpfParams {
     pub rotation: f32,
     pub table_nu: u32,
     pub table_nphi: u32,
+    /// 0 the rings, 1 the rule about the lobe.
+    pub rule: u32,
+    pub n_radial: u32,
+    pub n_angular: u32,
+    pub gamma: f32,
+    pub lobe_width: f32,
     pub pad0: u32,
     pub pad1: u32,
-    pub pad2: u32,
 }
 
 /// Resolution of the NDF table for tabulated (or stretched) NDFs on the GPU.
@@ -106,7 +112,12 @@ pub fn build_levels_with(
     rule: &ConeRule,
 ) -> Result<GpuDpf, GpuError> {
     let d = &gpu.device;
-    let pipeline = shader::compute_pipeline(d, "glint/dpf_build.wgsl", "dpf_build", &[])?;
+    let pipeline = shader::compute_pipeline(
+        d,
+        "glint/dpf_build.wgsl",
+        "dpf_build",
+        &[("LOBE_EPS", LOBE_EPS), ("TOUCH_MERGE", TOUCH_MERGE)],
+    )?;
     let wg = shader::workgroup_size("glint/dpf_build.wgsl", "dpf_build")?;
     let (base, table) = ndf_upload(ndf);
     let width = lobe_width(ndf);
@@ -120,17 +131,31 @@ pub fn build_levels_with(
         .filter(|(k, _)| which.contains(k))
     {
         let gamma = deg.to_radians();
-        let rings = rule.rings(gamma, width);
-        let params = DpfParams {
+        let mut params = DpfParams {
             n_theta: config.n_theta as u32,
             n_dphi: config.n_dphi as u32,
-            n_rings: rings.len() as u32,
+            gamma: gamma as f32,
             ..base
         };
-        let (pb, gb, ob) = gpu.scoped(|| {
+        // The buffers of the rule not taken hold one unused element.
+        let (rings, nodes) = match rule.level(gamma, width) {
+            LevelRule::Rings(rings) => {
+                params.n_rings = rings.len() as u32;
+                (rings, vec![[0.0f32; 2]])
+            }
+            LevelRule::Lobe { rule, width } => {
+                params.rule = 1;
+                params.n_radial = rule.radial as u32;
+                params.n_angular = rule.angular as u32;
+                params.lobe_width = width as f32;
+                (vec![Ring::default()], rule.nodes())
+            }
+        };
+        let (pb, gb, nb, ob) = gpu.scoped(|| {
             (
                 buffer::uniform(d, "dpf params", &params),
                 buffer::storage(d, "cone rings", &rings),
+                buffer::storage(d, "lobe rule nodes", &nodes),
                 buffer::storage_zeroed(d, "dpf level", (cells * 4) as u64),
             )
         })?;
@@ -139,6 +164,7 @@ pub fn build_levels_with(
             gb.as_entire_binding(),
             table_buf.as_entire_binding(),
             ob.as_entire_binding(),
+            nb.as_entire_binding(),
         ];
         dispatch::run(
             d,

@@ -1,7 +1,8 @@
 //! # facet-glint: discrete stochastic microfacets with the filterable DPF
 //!
 //! [`tea`]: the per-flake hash (Rust and WGSL). [`cone_rule`]: the quadrature over a cone,
-//! sized to the NDF's lobe, shared by the CPU and the GPU. [`dpf`]: the Directional Probability Function
+//! sized to the NDF's lobe, shared by the CPU and the GPU, and [`lobe_rule`] about the lobe for
+//! wide cones. [`dpf`]: the Directional Probability Function
 //! by cone integration, its tables (documented cell centres) and the nine-level pyramid, with
 //! the paper's Gaussian-blurred levels for comparison. [`flakes`]: the procedural flake field,
 //! its consistent quadtree and counting over footprints. [`lit`]: lit counts per node, so a
@@ -27,4 +28,5 @@ pub mod flakes;
 pub mod glint_brdf;
 pub mod gpu;
 pub mod lit;
+pub mod lobe_rule;
 pub mod tea;
