@@ -362,10 +362,7 @@ fn lobe_rule_converges_to_the_cone_integral() {
         lobe: None,
         ..ConeRule::fast()
     };
-    let high = LobeRule {
-        radial: 16,
-        angular: 48,
-    };
+    let high = LobeRule::uniform(16, 48);
     let cfg = DpfConfig::preview();
     for (kind, alpha) in [
         (NdfKind::Beckmann, 0.1),

@@ -9,9 +9,10 @@
 
 const WG: u32 = 64u;
 const PI: f32 = 3.14159265358979;
-// Rust: facet_glint::lobe_rule::LOBE_EPS and TOUCH_MERGE.
+// Rust: facet_glint::lobe_rule::LOBE_EPS, TOUCH_MERGE and TAIL_START.
 override LOBE_EPS: f32;
 override TOUCH_MERGE: f32;
+override TAIL_START: f32;
 
 // Rust: facet_glint::gpu::DpfParams.
 struct Params {
@@ -27,14 +28,14 @@ struct Params {
     table_nphi: u32,
     // 0: the rings; 1: the rule about the lobe.
     rule: u32,
-    // The rule about the lobe: Gauss–Legendre nodes per radial interval and per ring, the cone's
-    // half-angle γ and the lobe width w its intervals are scaled to.
+    // The rule about the lobe: Gauss–Legendre nodes per radial interval and per ring (core,
+    // tail), the cone's half-angle γ and the lobe width w its intervals are scaled to.
     n_radial: u32,
     n_angular: u32,
+    n_tail_angular: u32,
     gamma: f32,
     lobe_width: f32,
     pad0: u32,
-    pad1: u32,
 }
 
 // Rust: facet_glint::cone_rule::Ring. Nodes cos ψ ωo + sin ψ (cos χ t + sin χ b),
@@ -52,7 +53,8 @@ struct Ring {
 // The NDF table when ndf_kind = 2 (index k · nphi + l).
 @group(0) @binding(2) var<storage, read> ndf_table: array<f32>;
 @group(0) @binding(3) var<storage, read_write> out: array<f32>;
-// The rule about the lobe's Gauss–Legendre nodes on [0, 1], (x, weight): n_radial, then n_angular.
+// The rule about the lobe's Gauss–Legendre nodes on [0, 1], (x, weight): n_radial, n_angular,
+// then n_tail_angular.
 @group(0) @binding(4) var<storage, read> lobe_nodes: array<vec2<f32>>;
 
 fn ndf(h: vec3<f32>) -> f32 {
@@ -222,7 +224,6 @@ fn lobe_sum(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     let whole_below = gamma - beta;
     let cos_gamma = cos(gamma);
     let n_r = params.n_radial;
-    let n_a = params.n_angular;
     var sum = 0.0;
     var a = lo;
     var scale = params.lobe_width;
@@ -245,6 +246,13 @@ fn lobe_sum(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
         let end = touches(b, lo, hi, whole_below);
         let code = select(0u, 1u, start) + select(0u, 2u, end);
         let len = b - a;
+        // The core's or the tail's angular nodes.
+        var first = n_r;
+        var n_a = params.n_angular;
+        if (a >= TAIL_START * params.lobe_width) {
+            first = n_r + params.n_angular;
+            n_a = params.n_tail_angular;
+        }
         for (var j = 0u; j < n_r; j++) {
             let node = lobe_nodes[j];
             let g = radial_map(code, node.x);
@@ -258,7 +266,7 @@ fn lobe_sum(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
             // The arc's nodes φ = half (2t − 1) come in pairs ±φ (the rule is symmetric).
             var ring = 0.0;
             for (var m = 0u; 2u * m < n_a; m++) {
-                let ang = lobe_nodes[n_r + m];
+                let ang = lobe_nodes[first + m];
                 let phi = half * (2.0 * ang.x - 1.0);
                 let sp = sin(phi);
                 let cp = cos(phi);

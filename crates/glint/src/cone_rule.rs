@@ -46,10 +46,14 @@ pub struct ConeRule {
     pub lobe: Option<LobeRule>,
 }
 
-/// What one node of the rule about the lobe costs in ring nodes: its arcs, its walk over the
-/// intervals and neighbouring cells that take different intervals. Measured on lavapipe with the
-/// nine-level builds (`facet bench --only dpf`): the lobe rule's most evaluations cost about
-/// 1.2× as many ring nodes.
+/// What one node of the rule about the lobe's bound ([`LobeRule::max_evaluations`]) costs in
+/// ring nodes: its arcs, its walk over the intervals and neighbouring cells that take different
+/// intervals, against the cells that need fewer intervals than the bound. Chosen from single
+/// levels of the standard tables on lavapipe (ms about the lobe / on rings): GGX α = 0.05 at
+/// 30° 133 / 252, 90° 228 / 1262; Beckmann α = 0.1 at 60° 188 / 234; GGX α = 0.15 at 60°
+/// 182 / 124 (rings), at 90° a tie (210 / 212). Two levels sit near the switch and take the
+/// slower rule by a little: GGX α = 0.05 at 20° (rings, 137 / 107) and Beckmann α = 0.1 at 45°
+/// (the lobe, 164 / 157).
 pub const LOBE_NODE_COST: f64 = 1.25;
 
 /// How one level is integrated: rings about ωo, or the rule about the lobe.

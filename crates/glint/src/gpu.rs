@@ -3,7 +3,7 @@
 
 use crate::cone_rule::{ConeRule, LevelRule, Ring, lobe_width};
 use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG};
-use crate::lobe_rule::{LOBE_EPS, TOUCH_MERGE};
+use crate::lobe_rule::{LOBE_EPS, TAIL_START, TOUCH_MERGE};
 use bytemuck::{Pod, Zeroable};
 use facet_fit::geometry::spherical;
 use facet_fit::microfacet::Ndf;
@@ -28,10 +28,10 @@ pub struct DpfParams {
     pub rule: u32,
     pub n_radial: u32,
     pub n_angular: u32,
+    pub n_tail_angular: u32,
     pub gamma: f32,
     pub lobe_width: f32,
     pub pad0: u32,
-    pub pad1: u32,
 }
 
 /// Resolution of the NDF table for tabulated (or stretched) NDFs on the GPU.
@@ -116,7 +116,11 @@ pub fn build_levels_with(
         d,
         "glint/dpf_build.wgsl",
         "dpf_build",
-        &[("LOBE_EPS", LOBE_EPS), ("TOUCH_MERGE", TOUCH_MERGE)],
+        &[
+            ("LOBE_EPS", LOBE_EPS),
+            ("TOUCH_MERGE", TOUCH_MERGE),
+            ("TAIL_START", TAIL_START),
+        ],
     )?;
     let wg = shader::workgroup_size("glint/dpf_build.wgsl", "dpf_build")?;
     let (base, table) = ndf_upload(ndf);
@@ -147,6 +151,7 @@ pub fn build_levels_with(
                 params.rule = 1;
                 params.n_radial = rule.radial as u32;
                 params.n_angular = rule.angular as u32;
+                params.n_tail_angular = rule.tail_angular as u32;
                 params.lobe_width = width as f32;
                 (vec![Ring::default()], rule.nodes())
             }
