@@ -217,18 +217,29 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
         }
         let h = node_hash(nd.level, nd.ix, nd.iy);
         if (nd.n <= LEAF_FLAKES || nd.level == MAX_DEPTH) {
+            // Flakes past the chains' last lit ones are not looked at, and only a flake some
+            // chain takes has its position hashed.
             var needed = nd.lit;
             for (var k = 0u; k < nd.n; k++) {
+                if (!any_lit(needed)) {
+                    break;
+                }
                 let id = leaf_flake_id(h, k);
-                let uv = lo + size * vec2<f32>(tea_unit(id.x, 1u), tea_unit(id.x, 2u));
-                let st = inv * (uv - center);
-                let inside = dot(st, st) <= 1.0;
+                var taken = 0u;
                 for (var c = 0u; c < nc; c++) {
                     if (needed[c] > 0u && leaf_lit(id, needed[c], nd.n - k, keys[c])) {
                         needed[c] -= 1u;
-                        if (inside) {
-                            acc[c] += 1u;
-                        }
+                        taken |= 1u << c;
+                    }
+                }
+                if (taken == 0u) {
+                    continue;
+                }
+                let uv = lo + size * vec2<f32>(tea_unit(id.x, 1u), tea_unit(id.x, 2u));
+                let st = inv * (uv - center);
+                if (dot(st, st) <= 1.0) {
+                    for (var c = 0u; c < nc; c++) {
+                        acc[c] += (taken >> c) & 1u;
                     }
                 }
             }

@@ -152,7 +152,17 @@ impl FlakeField {
 
     /// Flake `k` of the leaf (level, ix, iy) whose cell starts at `min` with side `size`.
     pub(crate) fn leaf_flake(&self, h: u64, k: u32, min: DVec2, size: f64) -> Flake {
-        let id = tea(h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32 ^ k);
+        Self::flake_at(Self::leaf_flake_id(h, k), min, size)
+    }
+
+    /// The id of flake `k` of the leaf whose node hash is `h` (one TEA; its position takes two
+    /// more, [`FlakeField::flake_at`]).
+    pub(crate) fn leaf_flake_id(h: u64, k: u32) -> u64 {
+        tea(h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32 ^ k)
+    }
+
+    /// The flake of id `id` in the leaf cell starting at `min` with side `size`.
+    pub(crate) fn flake_at(id: u64, min: DVec2, size: f64) -> Flake {
         let uv =
             min + size * DVec2::new(tea_unit(id as u32, 1) as f64, tea_unit(id as u32, 2) as f64);
         Flake { id, uv }

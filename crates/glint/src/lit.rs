@@ -171,14 +171,10 @@ impl FlakeField {
         [l00, l10, lit_left - l00, lit - lit_left - l10]
     }
 
-    /// Which of a leaf's `n` flakes are lit, `lit` of them (Algorithm S: flake k is taken with
-    /// probability needed / remaining, at a uniform keyed on the flake).
-    pub(crate) fn leaf_lit(&self, flake: &Flake, needed: u64, remaining: u64, key: LitKey) -> bool {
-        let u = pcg3d([
-            flake.id as u32 ^ key.0,
-            (flake.id >> 32) as u32 ^ key.1,
-            0x27d4_eb2f,
-        ]);
+    /// Whether a leaf's flake `id` is lit, `needed` of its `remaining` flakes still to pick
+    /// (Algorithm S: taken with probability needed / remaining, at a uniform keyed on the flake).
+    pub(crate) fn leaf_lit(&self, id: u64, needed: u64, remaining: u64, key: LitKey) -> bool {
+        let u = pcg3d([id as u32 ^ key.0, (id >> 32) as u32 ^ key.1, 0x27d4_eb2f]);
         unit(u[0]) * (remaining as f64) < needed as f64
     }
 
@@ -237,11 +233,17 @@ impl FlakeField {
         }
         let h = self.node_hash(level, ix, iy);
         if n <= LEAF_FLAKES || level == MAX_DEPTH {
+            // Flakes past the last lit one are not looked at, and only a lit flake's position
+            // is hashed.
             let (mut needed, mut found) = (lit, 0);
             for k in 0..n {
-                let flake = self.leaf_flake(h, k as u32, min, size);
-                if needed > 0 && self.leaf_lit(&flake, needed, n - k, key) {
+                if needed == 0 {
+                    break;
+                }
+                let id = FlakeField::leaf_flake_id(h, k as u32);
+                if self.leaf_lit(id, needed, n - k, key) {
                     needed -= 1;
+                    let flake = FlakeField::flake_at(id, min, size);
                     if fp.contains(inv, flake.uv) {
                         found += 1;
                         if let Some(o) = out.as_deref_mut() {
