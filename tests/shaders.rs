@@ -191,8 +191,8 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         }),
         layout_check!(DpfParams, "glint/dpf_build.wgsl", "Params", {
             n_theta, n_dphi, n_rings, ndf_kind, alpha_x, alpha_y, rotation,
-            table_nu, table_nphi, rule, n_radial, n_angular, n_tail_angular, gamma, lobe_width,
-            pad0,
+            table_nu, table_nphi, n_radial, n_angular, n_tail_angular, gamma, lobe_width, pad0,
+            pad1,
         }),
         layout_check!(Ring, "glint/dpf_build.wgsl", "Ring", {
             cos_psi, sin_psi, weight, n_chi,

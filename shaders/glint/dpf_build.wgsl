@@ -13,6 +13,9 @@ const PI: f32 = 3.14159265358979;
 override LOBE_EPS: f32;
 override TOUCH_MERGE: f32;
 override TAIL_START: f32;
+// 0: the rings; 1: the rule about the lobe. A constant per pipeline, so a build compiles only the
+// rule its levels take (facet_glint::gpu builds a pipeline per rule used).
+override RULE: u32;
 
 // Rust: facet_glint::gpu::DpfParams.
 struct Params {
@@ -26,8 +29,6 @@ struct Params {
     rotation: f32,
     table_nu: u32,
     table_nphi: u32,
-    // 0: the rings; 1: the rule about the lobe.
-    rule: u32,
     // The rule about the lobe: Gauss–Legendre nodes per radial interval and per ring (core,
     // tail), the cone's half-angle γ and the lobe width w its intervals are scaled to.
     n_radial: u32,
@@ -36,6 +37,7 @@ struct Params {
     gamma: f32,
     lobe_width: f32,
     pad0: u32,
+    pad1: u32,
 }
 
 // Rust: facet_glint::cone_rule::Ring. Nodes cos ψ ωo + sin ψ (cos χ t + sin χ b),
@@ -113,7 +115,7 @@ fn dpf_build(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgro
     let dphi = (f32(p) + 0.5) * PI / f32(np);
     let wi = vec3<f32>(sin(theta_i), 0.0, cos(theta_i));
     let wo = vec3<f32>(sin(theta_o) * cos(dphi), sin(theta_o) * sin(dphi), cos(theta_o));
-    if (params.rule == 1u) {
+    if (RULE == 1u) {
         out[cell] = lobe_sum(wi, wo);
     } else {
         out[cell] = rings_sum(wi, wo);

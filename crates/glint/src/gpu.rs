@@ -24,14 +24,13 @@ pub struct DpfParams {
     pub rotation: f32,
     pub table_nu: u32,
     pub table_nphi: u32,
-    /// 0 the rings, 1 the rule about the lobe.
-    pub rule: u32,
     pub n_radial: u32,
     pub n_angular: u32,
     pub n_tail_angular: u32,
     pub gamma: f32,
     pub lobe_width: f32,
     pub pad0: u32,
+    pub pad1: u32,
 }
 
 /// Resolution of the NDF table for tabulated (or stretched) NDFs on the GPU.
@@ -112,16 +111,8 @@ pub fn build_levels_with(
     rule: &ConeRule,
 ) -> Result<GpuDpf, GpuError> {
     let d = &gpu.device;
-    let pipeline = shader::compute_pipeline(
-        d,
-        "glint/dpf_build.wgsl",
-        "dpf_build",
-        &[
-            ("LOBE_EPS", LOBE_EPS),
-            ("TOUCH_MERGE", TOUCH_MERGE),
-            ("TAIL_START", TAIL_START),
-        ],
-    )?;
+    // One pipeline per rule a level takes (the WGSL's RULE), built when first needed.
+    let mut pipelines: [Option<wgpu::ComputePipeline>; 2] = [None, None];
     let wg = shader::workgroup_size("glint/dpf_build.wgsl", "dpf_build")?;
     let (base, table) = ndf_upload(ndf);
     let width = lobe_width(ndf);
@@ -142,13 +133,28 @@ pub fn build_levels_with(
             ..base
         };
         // The buffers of the rule not taken hold one unused element.
-        let (rings, nodes) = match rule.level(gamma, width) {
+        let level = rule.level(gamma, width);
+        let rule_code = matches!(level, LevelRule::Lobe { .. }) as usize;
+        let pipeline = match &mut pipelines[rule_code] {
+            Some(p) => &*p,
+            slot => slot.insert(shader::compute_pipeline(
+                d,
+                "glint/dpf_build.wgsl",
+                "dpf_build",
+                &[
+                    ("LOBE_EPS", LOBE_EPS),
+                    ("TOUCH_MERGE", TOUCH_MERGE),
+                    ("TAIL_START", TAIL_START),
+                    ("RULE", rule_code as f64),
+                ],
+            )?),
+        };
+        let (rings, nodes) = match level {
             LevelRule::Rings(rings) => {
                 params.n_rings = rings.len() as u32;
                 (rings, vec![[0.0f32; 2]])
             }
             LevelRule::Lobe { rule, width } => {
-                params.rule = 1;
                 params.n_radial = rule.radial as u32;
                 params.n_angular = rule.angular as u32;
                 params.n_tail_angular = rule.tail_angular as u32;
@@ -174,7 +180,7 @@ pub fn build_levels_with(
         dispatch::run(
             d,
             &gpu.queue,
-            &pipeline,
+            pipeline,
             "dpf build",
             &resources,
             cells as u32,
