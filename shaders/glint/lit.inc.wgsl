@@ -260,8 +260,13 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
             child[2][c] = l.z;
             child[3][c] = l.w;
         }
+        // Children outside the footprint's box are not pushed (the test their pop would make:
+        // the child's edges at the node's midlines are exact in f32).
+        let mid = lo + 0.5 * size;
         for (var k = 0u; k < 4u; k++) {
-            if (cn[k] > 0u && any_lit(child[k]) && top < STACK) {
+            let inx = select(mid.x >= center.x - ext.x, mid.x <= center.x + ext.x, (k & 1u) == 1u);
+            let iny = select(mid.y >= center.y - ext.y, mid.y <= center.y + ext.y, (k >> 1u) == 1u);
+            if (cn[k] > 0u && inx && iny && any_lit(child[k]) && top < STACK) {
                 lit_stack[top] = LitNode(nd.level + 1u, 2u * nd.ix + (k & 1u), 2u * nd.iy + (k >> 1u), cn[k], child[k]);
                 top += 1u;
             }
