@@ -747,7 +747,11 @@ fn bench_smoke_reports_every_section() {
         positive(&row["mrays_per_s"], "Mrays/s");
     }
     let integrator = r["integrator"].as_array().unwrap();
-    assert_eq!(integrator.len(), 2);
+    assert_eq!(
+        integrator.len(),
+        3,
+        "without glints, with glints, glints unfiltered"
+    );
     for row in integrator {
         positive(&row["msamples_per_s"], "Msamples/s");
     }
@@ -767,11 +771,12 @@ fn bench_smoke_reports_every_section() {
     ] {
         assert!(stages.contains(&s), "{s} missing from {stages:?}");
     }
-    assert!(
-        r["glint"]["overhead_percent"]
-            .as_f64()
-            .is_some_and(f64::is_finite)
-    );
+    for key in ["overhead_percent", "unfiltered_overhead_percent"] {
+        assert!(
+            r["glint"][key].as_f64().is_some_and(f64::is_finite),
+            "{key}"
+        );
+    }
     positive(&r["glint"]["dpf_build_ms"], "DPF build");
     positive(&r["viewer"]["frames_per_s"], "viewer frames/s");
     positive(&r["viewer"]["msamples_per_s"], "viewer Msamples/s");
