@@ -145,27 +145,31 @@ pub fn probe(src: &MerlBrdf) {
     let set = GridSamples::new(src);
     let t_set = t.elapsed().as_secs_f64() * 1e3;
     let model = parse_analytic("ggx?alpha=0.2&f0=0.5").unwrap();
-    let t = Instant::now();
-    for _ in 0..10 {
+    // Medians of 31 runs each: single runs on a shared machine scatter by ±30 %.
+    let time = |f: &dyn Fn()| {
+        median(
+            (0..31)
+                .map(|_| {
+                    let t = Instant::now();
+                    f();
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect(),
+        )
+    };
+    let t_f = time(&|| {
         std::hint::black_box(fresnel_average(&model, &set));
-    }
-    let t_f = t.elapsed().as_secs_f64() * 1e2;
-    let t = Instant::now();
-    for _ in 0..10 {
+    });
+    let t_e = time(&|| {
         std::hint::black_box(microfacet_error(&model, &set));
-    }
-    let t_e = t.elapsed().as_secs_f64() * 1e2;
+    });
     for irls in [0, 1, 2] {
-        let t = Instant::now();
-        for _ in 0..10 {
+        let t = time(&|| {
             std::hint::black_box(facet_fit::grid::fresnel_diffuse_and_error(
                 &model, &set, irls,
             ));
-        }
-        println!(
-            "probe: solve irls {irls}: {:.2} ms",
-            t.elapsed().as_secs_f64() * 1e2
-        );
+        });
+        println!("probe: solve irls {irls}: {t:.2} ms");
     }
     println!(
         "probe: first set (with the grid geometry) {t_first:.2} ms, set {t_set:.2} ms, fresnel pass {t_f:.2} ms, error pass {t_e:.2} ms"
