@@ -17,7 +17,9 @@ use crate::grid::{
 };
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
-use crate::params::{fit_least_squares, fit_moments, refine_on_full_grid};
+use crate::params::{
+    fit_least_squares, fit_moments, least_squares_candidates, refine_on_full_grid,
+};
 use crate::refine::{model_of, refine, tabulate};
 use std::sync::Arc;
 use std::time::Instant;
@@ -319,16 +321,21 @@ fn fit_with(
     let search = set.subsample(cfg.search_stride);
     let fit_kind = |kind: NdfKind| -> Result<ParamRecord, FitError> {
         let moments = fit_moments(kind, &ex.ndf);
-        let lsq = fit_least_squares(moments, cfg.anisotropic, diffuse, &search);
         let model = |ndf: AnalyticNdf| MicrofacetBrdf::ideal("lsq", Ndf::Analytic(ndf));
         // Isotropic: the final steps on the final-step rows (coarse to fine), the error on the
         // full grid.
         let (lsq, (lsq_fresnel, lsq_diffuse, error)) = if cfg.anisotropic {
+            let lsq = fit_least_squares(moments, true, diffuse, &search);
             (lsq, solve(&model(lsq))?)
         } else {
+            // The search's candidates compete on the final-step rows.
+            let starts: Vec<f64> = least_squares_candidates(moments, diffuse, &search)
+                .iter()
+                .map(|n| n.alpha_x.ln())
+                .collect();
             // With a diffuse lobe the bracket's F and ρd are plain weighted least squares, and
             // the α found gets the reweighted solve.
-            let (t, e, (f, kd)) = refine_on_full_grid(lsq.alpha_x.ln(), |t| {
+            let (t, e, (f, kd)) = refine_on_full_grid(&starts, |t| {
                 let m = model(AnalyticNdf::isotropic(kind, t.exp()));
                 let bracket = diffuse
                     .then(|| fresnel_diffuse_and_error(&m, &final_steps, BRACKET_IRLS))

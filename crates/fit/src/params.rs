@@ -14,6 +14,9 @@ use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 pub const ALPHA_MIN: f64 = 1e-3;
 /// The upper bound (`ALPHA_MIN` is the lower).
 pub const ALPHA_MAX: f64 = 4.0;
+/// Points of the isotropic least-squares search's coarse scan over [ln `ALPHA_MIN`,
+/// ln `ALPHA_MAX`]: 0.76 apart in ln α, about half the width of the error's basin.
+const COARSE_SCAN: usize = 12;
 
 /// E|x~ cos ψ + y~ sin ψ| of the tabulated slope distribution for ψ = 0, 45°, 90°, 135°.
 fn abs_slope_moments(ndf: &TabulatedNdf) -> [f64; 4] {
@@ -98,9 +101,40 @@ fn error_of(name: &str, ndf: AnalyticNdf, diffuse: bool, set: &GridSamples) -> f
     }
 }
 
+/// The minima of the error metric over isotropic α on `set` found by Brent's method on ln α
+/// from two brackets: around `start` (ln α − 3 to ln α + 1.5), and around the best point of a
+/// coarse scan of the whole range of ln α. The start (the slope moments) can lie far from the
+/// metric's minimum: haze or a diffuse term in the extraction's tails put the moments' α a
+/// hundred times above a sharp lobe's (specular-violet-phenolic: 0.84 against 0.006), outside
+/// a bracket around it; on a flat, bumpy error (rough materials) the two may settle in
+/// neighbouring dips. One candidate when both agree; the caller picks on a finer set.
+pub fn least_squares_candidates(
+    start: AnalyticNdf,
+    diffuse: bool,
+    set: &GridSamples,
+) -> Vec<AnalyticNdf> {
+    let kind = start.kind;
+    let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), diffuse, set);
+    let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
+    let x0 = start.alpha_x.clamp(ALPHA_MIN, ALPHA_MAX).ln();
+    let local = brent(f, (x0 - 3.0).max(lo), x0, (x0 + 1.5).min(hi), 2e-4);
+    let step = (hi - lo) / (COARSE_SCAN - 1) as f64;
+    let (_, x) = (0..COARSE_SCAN)
+        .map(|k| lo + step * k as f64)
+        .map(|t| (f(t), t))
+        .fold((f64::INFINITY, x0), |b, p| if p.0 < b.0 { p } else { b });
+    let global = brent(f, (x - step).max(lo), x, (x + step).min(hi), 2e-4);
+    let mut out = vec![AnalyticNdf::isotropic(kind, local.exp())];
+    if (global - local).abs() > 1e-3 {
+        out.push(AnalyticNdf::isotropic(kind, global.exp()));
+    }
+    out
+}
+
 /// α (and rotation when anisotropic) minimising the error metric on `set`, from `start`.
-/// Isotropic: Brent's method on ln α. Anisotropic: Nelder–Mead on (ln αx, ln αy, ρ). With
-/// `diffuse`, each candidate's F and ρd are solved for it ([`crate::diffuse`]).
+/// Isotropic: the better on `set` of [`least_squares_candidates`]. Anisotropic: Nelder–Mead
+/// on (ln αx, ln αy, ρ). With `diffuse`, each candidate's F and ρd are solved for it
+/// ([`crate::diffuse`]).
 pub fn fit_least_squares(
     start: AnalyticNdf,
     anisotropic: bool,
@@ -109,11 +143,12 @@ pub fn fit_least_squares(
 ) -> AnalyticNdf {
     let kind = start.kind;
     if !anisotropic {
-        let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), diffuse, set);
-        let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
-        let x0 = start.alpha_x.clamp(ALPHA_MIN, ALPHA_MAX).ln();
-        let t = brent(f, (x0 - 3.0).max(lo), x0, (x0 + 1.5).min(hi), 2e-4);
-        return AnalyticNdf::isotropic(kind, t.exp());
+        let candidates = least_squares_candidates(start, diffuse, set);
+        let error = |n: &AnalyticNdf| error_of("lsq", *n, diffuse, set);
+        return match candidates[..] {
+            [a, b] if error(&b) < error(&a) => b,
+            _ => candidates[0],
+        };
     }
     let make = |p: &[f64; 3]| AnalyticNdf {
         kind,
@@ -133,15 +168,16 @@ pub fn fit_least_squares(
 }
 
 /// The final steps of an isotropic least-squares fit on the reporting (full) grid, from the
-/// search's ln α = `t0`: `error(t)` is the full-grid error at ln α = t with its own Fresnel
-/// table. ln α is evaluated at t0 and t0 ± h, the bracket moved by h towards the lower side
+/// search's candidates ln α ∈ `starts` ([`least_squares_candidates`]): `error(t)` is the
+/// full-grid error at ln α = t with its own Fresnel table. Each start is evaluated and the
+/// lowest, t0, kept; ln α is evaluated at t0 ± h, the bracket moved by h towards the lower side
 /// (at most `MOVES` times) until its centre is lowest, then the parabola's vertex through the
 /// three points; the lowest point evaluated wins. Returns (t, error, Fresnel) of that point.
 /// The error near its minimum is close to a parabola in ln α, and the search's subsampled grid
 /// puts its minimum within a few percent of the full grid's (`examples/fit_timing.rs` sweeps
 /// it), so one bracket of h = 0.05 (5 % in α) and one vertex usually suffice: four passes.
 pub fn refine_on_full_grid<F, E>(
-    t0: f64,
+    starts: &[f64],
     mut error: impl FnMut(f64) -> Result<(f64, F), E>,
 ) -> Result<(f64, f64, F), E> {
     const H: f64 = 0.05;
@@ -155,8 +191,15 @@ pub fn refine_on_full_grid<F, E>(
         }
         Ok(e)
     };
-    let mut c = t0.clamp(lo + H, hi - H);
-    let mut ec = eval(c, &mut best)?;
+    debug_assert!(!starts.is_empty(), "a start to refine");
+    let (mut c, mut ec) = (f64::NAN, f64::INFINITY);
+    for &t in starts {
+        let t = t.clamp(lo + H, hi - H);
+        let e = eval(t, &mut best)?;
+        if c.is_nan() || e < ec {
+            (c, ec) = (t, e);
+        }
+    }
     let (mut em, mut ep) = (eval(c - H, &mut best)?, eval(c + H, &mut best)?);
     for _ in 0..MOVES {
         if ec <= em && ec <= ep {
