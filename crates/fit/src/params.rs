@@ -181,7 +181,7 @@ pub fn refine_on_full_grid<F, E>(
     mut error: impl FnMut(f64) -> Result<(f64, F), E>,
 ) -> Result<(f64, f64, F), E> {
     const H: f64 = 0.05;
-    const MOVES: usize = 4;
+    const MOVES: usize = 8;
     let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
     let mut best: Option<(f64, f64, F)> = None;
     let mut eval = |t: f64, best: &mut Option<(f64, f64, F)>| -> Result<f64, E> {
