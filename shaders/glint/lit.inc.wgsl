@@ -75,73 +75,68 @@ fn binomial_p(n: u32, p: f32, u: f32) -> u32 {
     return binomial_low(n, p, u);
 }
 
-// Hypergeometric(n, m, l) at u for m, l ≤ n/2 (support from 0).
-fn hypergeometric_small(n: u32, m: u32, l: u32, u: f32) -> u32 {
-    if (l == 0u || m == 0u) {
-        return 0u;
-    }
-    let top = min(l, m);
-    if (l > SPLIT_EXACT_MAX) {
-        let q = f32(m) / f32(n);
-        let v = f32(l) * q * (1.0 - q) * f32(n - l) / f32(n - 1u);
-        let x = f32(l) * q + sqrt(v) * normal_quantile(u) + 0.5;
-        return min(u32(max(x, 0.0)), top);
-    }
-    // P(0) = Π_{j<l} (n − m − j)/(n − j), then the CDF search: both written out to
-    // SPLIT_EXACT_MAX = 8 steps, not loops (llvmpipe caps an invocation's loop iterations).
-    var pmf = 1.0;
-    pmf *= pmf0_factor(n, m, l, 0u);
-    pmf *= pmf0_factor(n, m, l, 1u);
-    pmf *= pmf0_factor(n, m, l, 2u);
-    pmf *= pmf0_factor(n, m, l, 3u);
-    pmf *= pmf0_factor(n, m, l, 4u);
-    pmf *= pmf0_factor(n, m, l, 5u);
-    pmf *= pmf0_factor(n, m, l, 6u);
-    pmf *= pmf0_factor(n, m, l, 7u);
-    var st = HyperStep(0u, pmf, pmf);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    st = hyper_step(st, n, m, l, top, u);
-    return st.k;
+// The next state of a split's uniforms (facet_glint::lit::next_state).
+fn next_state(s: u32) -> u32 {
+    return s * 747796405u + 2891336453u;
 }
 
-// Factor j of P(0), 1 past l.
-fn pmf0_factor(n: u32, m: u32, l: u32, j: u32) -> f32 {
-    if (j >= l) {
-        return 1.0;
+// A state's 24-bit uniform, PCG's output permutation (facet_glint::lit::state_unit).
+fn state_unit(s: u32) -> f32 {
+    let w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return unit24((w >> 22u) ^ w);
+}
+
+// One draw of the exact split: while draws remain (j < few), the j-th lands in the part with
+// probability (the part's flakes left) / (flakes left).
+fn split_draw(s: ptr<function, u32>, k: ptr<function, u32>, j: u32, few: u32, n: u32, m: u32) {
+    if (j < few) {
+        *s = next_state(*s);
+        if (state_unit(*s) * f32(n - j) < f32(m - *k)) {
+            *k += 1u;
+        }
     }
-    return f32(n - m - j) / f32(n - j);
 }
 
-struct HyperStep {
-    k: u32,
-    pmf: f32,
-    cdf: f32,
-}
-
-// One step of the search: P(k+1) = P(k) (m − k)(l − k) / ((k + 1)(n − m − l + k + 1)).
-fn hyper_step(s: HyperStep, n: u32, m: u32, l: u32, top: u32, u: f32) -> HyperStep {
-    if (s.cdf > u || s.k >= top) {
-        return s;
-    }
-    let pmf = s.pmf * (f32(m - s.k) * f32(l - s.k)) / (f32(s.k + 1u) * f32(n - m - l + s.k + 1u));
-    return HyperStep(s.k + 1u, pmf, s.cdf + pmf);
-}
-
-// Lit flakes among the m of n in one part when l of the n are lit (facet_glint::lit::hypergeometric).
-fn hypergeometric(n: u32, m: u32, l: u32, u: f32) -> u32 {
+// Hypergeometric(n, m, l) at u by the normal approximation, on the smaller part and the fewer
+// of lit and unlit (support from 0).
+fn hypergeometric_normal(n: u32, m: u32, l: u32, u: f32) -> u32 {
     let flip_l = 2u * l > n;
     let l1 = select(l, n - l, flip_l);
     let flip_m = 2u * m > n;
     let m1 = select(m, n - m, flip_m);
-    var k = hypergeometric_small(n, m1, l1, u);
+    var k = 0u;
+    if (l1 > 0u && m1 > 0u) {
+        let q = f32(m1) / f32(n);
+        let v = f32(l1) * q * (1.0 - q) * f32(n - l1) / f32(n - 1u);
+        let x = f32(l1) * q + sqrt(v) * normal_quantile(u) + 0.5;
+        k = min(u32(max(x, 0.0)), min(l1, m1));
+    }
     k = select(k, l1 - k, flip_m);
     return select(k, m - k, flip_l);
+}
+
+// Lit flakes among the m of n in one part when l of the n are lit (facet_glint::lit::hypergeometric):
+// the fewer of lit and unlit drawn one by one up to SPLIT_EXACT_MAX = 8 of them (written out,
+// not a loop: llvmpipe caps an invocation's loop iterations), the rest by the normal
+// approximation from the flakes left.
+fn hypergeometric(n: u32, m: u32, l: u32, seed: u32) -> u32 {
+    let flip = l > n - l;
+    let few = min(l, n - l);
+    var s = seed;
+    var k = 0u;
+    split_draw(&s, &k, 0u, few, n, m);
+    split_draw(&s, &k, 1u, few, n, m);
+    split_draw(&s, &k, 2u, few, n, m);
+    split_draw(&s, &k, 3u, few, n, m);
+    split_draw(&s, &k, 4u, few, n, m);
+    split_draw(&s, &k, 5u, few, n, m);
+    split_draw(&s, &k, 6u, few, n, m);
+    split_draw(&s, &k, 7u, few, n, m);
+    if (few > SPLIT_EXACT_MAX) {
+        let e = SPLIT_EXACT_MAX;
+        k += hypergeometric_normal(n - e, m - k, few - e, unit24(seed));
+    }
+    return select(k, m - k, flip);
 }
 
 // A chain's lit counts of the four children (c: their flake counts), node hash h.
@@ -152,9 +147,9 @@ fn split_lit(h: vec2<u32>, c: vec4<u32>, lit: u32, key: vec2<u32>) -> vec4<u32> 
     let r = pcg3d(vec3<u32>(h.x ^ key.x, h.y ^ key.y, 0x2545f491u));
     let left = c.x + c.z;
     let n = left + c.y + c.w;
-    let lit_left = hypergeometric(n, left, lit, unit24(r.x));
-    let l00 = hypergeometric(left, c.x, lit_left, unit24(r.y));
-    let l10 = hypergeometric(n - left, c.y, lit - lit_left, unit24(r.z));
+    let lit_left = hypergeometric(n, left, lit, r.x);
+    let l00 = hypergeometric(left, c.x, lit_left, r.y);
+    let l10 = hypergeometric(n - left, c.y, lit - lit_left, r.z);
     return vec4<u32>(l00, l10, lit_left - l00, lit - lit_left - l10);
 }
 
