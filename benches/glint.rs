@@ -148,9 +148,56 @@ fn queries(c: &mut Criterion) {
     }
 }
 
+/// The lit-count walk alone on the GPU (`shaders/glint/glint_count.wgsl`), on pairs of queries
+/// like a shading point's (a light sample and a BSDF sample): 20 000 pairs over footprints of
+/// about 90 flakes (the demo's primary hits), expected lit counts 0.05–5 a query, direction
+/// coordinates spread over many cells (so lanes read one, two or four blended cells), filter
+/// on and off. One sample is one dispatch with its upload and read-back.
+fn gpu_counts(c: &mut Criterion) {
+    let Ok(gpu) = facet_gpu::Gpu::new() else {
+        eprintln!("no GPU adapter: glint_gpu_count skipped");
+        return;
+    };
+    let counter = facet_glint::gpu::GlintCounter::new(&gpu.device).unwrap();
+    let field = FlakeField {
+        density: 2.0e6,
+        seed: 3,
+    };
+    let r = (90.0 / (std::f64::consts::PI * field.density)).sqrt();
+    let unit = |k: u32, s: u32| facet_glint::tea::tea_unit(k, s) as f64;
+    let pairs: Vec<_> = (0..20_000u32)
+        .map(|k| {
+            let fp = Footprint {
+                center: DVec2::new(unit(k, 1), unit(k, 2)),
+                a: DVec2::new(r * (0.7 + 0.6 * unit(k, 3)), 0.0),
+                b: DVec2::new(0.3 * r * unit(k, 4), r * (0.7 + 0.6 * unit(k, 5))),
+            };
+            // Expected lit counts N a P from 0.05 to 5, log-uniform, per query.
+            let p = [6, 7].map(|s| 0.05 * 100f64.powf(unit(k, s)) / (field.density * fp.area()));
+            let coords = [8, 10].map(|s| DVec2::new(64.0 * unit(k, s), 64.0 * unit(k, s + 1)));
+            facet_glint::gpu::GlintQuery::pair(&fp, p, coords)
+        })
+        .collect();
+    let mut g = c.benchmark_group("glint_gpu_count");
+    g.sample_size(10);
+    for filtered in [true, false] {
+        let cfg = GlintConfig {
+            gamma: 1f64.to_radians(),
+            threshold: 16.0,
+            filtered,
+            blend: true,
+        };
+        let label = if filtered { "filtered" } else { "unfiltered" };
+        g.bench_function(format!("{label}/20000_pairs_90_flakes"), |b| {
+            b.iter(|| counter.count(&gpu, &field, &cfg, &pairs).unwrap())
+        });
+    }
+    g.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().warm_up_time(Duration::from_millis(300)).measurement_time(Duration::from_secs(2));
-    targets = pyramid, queries
+    targets = pyramid, queries, gpu_counts
 }
 criterion_main!(benches);
