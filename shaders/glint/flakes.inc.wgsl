@@ -8,6 +8,8 @@ const PI_F: f32 = 3.14159265358979;
 override LEAF_FLAKES: u32;
 override MAX_DEPTH: u32;
 override BINOMIAL_EXACT_MAX: u32;
+override SPLIT_SALT: u32;
+override POSITION_SALT: u32;
 
 // Rust: facet_glint::gpu::GlintField.
 struct Field {
@@ -76,7 +78,7 @@ fn binomial(n: u32, u: f32) -> u32 {
 }
 
 fn node_hash(level: u32, ix: u32, iy: u32) -> vec2<u32> {
-    return tea(ix | (level << 21u), iy ^ (field.seed * 0x9e3779b9u));
+    return pcg3d(vec3<u32>(ix | (level << 21u), iy, field.seed * 0x9e3779b9u)).xy;
 }
 
 // Footprint area π |det [a b]|.
@@ -86,5 +88,12 @@ fn footprint_area(a: vec2<f32>, b: vec2<f32>) -> f32 {
 
 // Flake k of a leaf whose hash is h: its id (facet_glint::flakes::FlakeField::leaf_flake).
 fn leaf_flake_id(h: vec2<u32>, k: u32) -> vec2<u32> {
-    return tea(h.x ^ (k * 0x85ebca6bu), h.y ^ k);
+    return pcg3d(vec3<u32>(h.x ^ (k * 0x85ebca6bu), h.y, k)).xy;
+}
+
+// The position of flake id in the leaf cell from lo with side size
+// (facet_glint::flakes::FlakeField::flake_at).
+fn flake_uv(id: vec2<u32>, lo: vec2<f32>, size: f32) -> vec2<f32> {
+    let u = pcg3d(vec3<u32>(id.x, id.y, POSITION_SALT));
+    return lo + size * vec2<f32>(unit24(u.x), unit24(u.y));
 }

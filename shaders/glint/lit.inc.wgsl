@@ -17,24 +17,6 @@ const CHAINS: u32 = 8u;
 // holds at most 3 · MAX_DEPTH + 1 nodes (facet_glint::lit::STACK_DEPTH, checked by a test).
 const STACK: u32 = 61u;
 
-// pcg3d (Jarzynski & Olano 2020): facet_glint::lit::pcg3d.
-fn pcg3d(x: vec3<u32>) -> vec3<u32> {
-    var v = x * 1664525u + 1013904223u;
-    v.x += v.y * v.z;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v ^= v >> vec3<u32>(16u);
-    v.x += v.y * v.z;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    return v;
-}
-
-// 24 bits to [0, 1).
-fn unit24(x: u32) -> f32 {
-    return f32(x >> 8u) / 16777216.0;
-}
-
 // ln(1 − p), accurate for small p.
 fn ln_1m(p: f32) -> f32 {
     if (p < 0.01) {
@@ -230,7 +212,7 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
                 if (taken == 0u) {
                     continue;
                 }
-                let uv = lo + size * vec2<f32>(tea_unit(id.x, 1u), tea_unit(id.x, 2u));
+                let uv = flake_uv(id, lo, size);
                 let st = inv * (uv - center);
                 if (dot(st, st) <= 1.0) {
                     for (var c = 0u; c < nc; c++) {
@@ -240,12 +222,10 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
             }
             continue;
         }
-        let u0 = tea_unit(h.x, 0u ^ h.y);
-        let u1 = tea_unit(h.x, 1u ^ h.y);
-        let u2 = tea_unit(h.x, 2u ^ h.y);
-        let left = binomial(nd.n, u0);
-        let l0 = binomial(left, u1);
-        let r0 = binomial(nd.n - left, u2);
+        let u = pcg3d(vec3<u32>(h.x, h.y, SPLIT_SALT));
+        let left = binomial(nd.n, unit24(u.x));
+        let l0 = binomial(left, unit24(u.y));
+        let r0 = binomial(nd.n - left, unit24(u.z));
         let cn = vec4<u32>(l0, r0, left - l0, nd.n - left - r0);
         var child: array<array<u32, CHAINS>, 4>;
         for (var c = 0u; c < nc; c++) {

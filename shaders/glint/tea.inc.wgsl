@@ -1,4 +1,4 @@
-// Include-only. TEA, 8 rounds (Rust twin: facet_glint::tea). The key and δ are override
+// Include-only. TEA, 8 rounds, and pcg3d (Rust twins: facet_glint::tea). The key and δ are override
 // constants that every pipeline gets from Rust (facet_glint::tea::pipeline_constants), so they
 // are written once. Returns (v0, v1) after TEA_ROUNDS rounds: the 64-bit hash is (v1 << 32) + v0.
 override TEA_K0: u32;
@@ -44,4 +44,22 @@ fn tea(a: u32, b: u32) -> vec2<u32> {
 // Uniform in [0, 1): the low word's top 23 bits as a mantissa in [1, 2), minus 1.
 fn tea_unit(a: u32, b: u32) -> f32 {
     return bitcast<f32>(0x3f800000u | (tea(a, b).x >> 9u)) - 1.0;
+}
+
+// pcg3d (Jarzynski & Olano 2020): facet_glint::tea::pcg3d.
+fn pcg3d(x: vec3<u32>) -> vec3<u32> {
+    var v = x * 1664525u + 1013904223u;
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    v ^= v >> vec3<u32>(16u);
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    return v;
+}
+
+// 24 bits to [0, 1).
+fn unit24(x: u32) -> f32 {
+    return f32(x >> 8u) / 16777216.0;
 }

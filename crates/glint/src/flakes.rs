@@ -9,7 +9,7 @@
 //! a query (each with probability P(ωi, ωo, γ), keyed on the direction cell of the query — the
 //! half vector quantised to cells of size γ — never on the traversal) is [`crate::lit`]'s.
 
-use crate::tea::{tea, tea_unit};
+use crate::tea::{pcg3d, tea_unit, unit};
 use glam::{DMat2, DVec2, DVec3};
 
 /// Leaves hold at most this many flakes. 32 rather than 8: a lit walk then stops two levels
@@ -18,6 +18,11 @@ use glam::{DMat2, DVec2, DVec3};
 /// ~1.6× faster; with it on, unchanged). Every split is then of more than
 /// [`BINOMIAL_EXACT_MAX`] flakes and takes the normal approximation (of Binomial(≥ 33, ½)).
 pub const LEAF_FLAKES: u64 = 32;
+/// The third word of the pcg3d hash of a node's position split (its three uniforms; WGSL:
+/// `SPLIT_SALT` in `shaders/glint/flakes.inc.wgsl`).
+pub const SPLIT_SALT: u32 = 0x5851_f42d;
+/// The third word of the pcg3d hash of a flake's position (WGSL: `POSITION_SALT`).
+pub const POSITION_SALT: u32 = 0x68e3_1da4;
 /// Deepest level of the quadtree (2²⁰ cells per side).
 pub const MAX_DEPTH: u32 = 20;
 /// Binomial splits of up to this many flakes are exact inverse CDFs; larger ones use the
@@ -126,7 +131,8 @@ pub struct Flake {
 
 impl FlakeField {
     pub(crate) fn node_hash(&self, level: u32, ix: u32, iy: u32) -> u64 {
-        tea(ix | (level << 21), iy ^ self.seed.wrapping_mul(0x9e37_79b9))
+        let v = pcg3d([ix | (level << 21), iy, self.seed.wrapping_mul(0x9e37_79b9)]);
+        ((v[1] as u64) << 32) | v[0] as u64
     }
 
     /// Flakes in the root (the whole torus).
@@ -137,9 +143,9 @@ impl FlakeField {
     /// Counts of the four children (x-major: (0,0), (1,0), (0,1), (1,1)) of a node with n flakes.
     pub(crate) fn split(&self, level: u32, ix: u32, iy: u32, n: u64) -> [u64; 4] {
         let h = self.node_hash(level, ix, iy);
-        let u = |k: u32| tea_unit(h as u32, k ^ (h >> 32) as u32) as f64;
-        let left = binomial(n, u(0));
-        let (l0, r0) = (binomial(left, u(1)), binomial(n - left, u(2)));
+        let u = pcg3d([h as u32, (h >> 32) as u32, SPLIT_SALT]).map(unit);
+        let left = binomial(n, u[0]);
+        let (l0, r0) = (binomial(left, u[1]), binomial(n - left, u[2]));
         [l0, r0, left - l0, n - left - r0]
     }
 
@@ -159,17 +165,20 @@ impl FlakeField {
         Self::flake_at(Self::leaf_flake_id(h, k), min, size)
     }
 
-    /// The id of flake `k` of the leaf whose node hash is `h` (one TEA; its position takes two
-    /// more, [`FlakeField::flake_at`]).
+    /// The id of flake `k` of the leaf whose node hash is `h` (one pcg3d; its position takes
+    /// one more, [`FlakeField::flake_at`]).
     pub(crate) fn leaf_flake_id(h: u64, k: u32) -> u64 {
-        tea(h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32 ^ k)
+        let v = pcg3d([h as u32 ^ k.wrapping_mul(0x85eb_ca6b), (h >> 32) as u32, k]);
+        ((v[1] as u64) << 32) | v[0] as u64
     }
 
     /// The flake of id `id` in the leaf cell starting at `min` with side `size`.
     pub(crate) fn flake_at(id: u64, min: DVec2, size: f64) -> Flake {
-        let uv =
-            min + size * DVec2::new(tea_unit(id as u32, 1) as f64, tea_unit(id as u32, 2) as f64);
-        Flake { id, uv }
+        let u = pcg3d([id as u32, (id >> 32) as u32, POSITION_SALT]).map(unit);
+        Flake {
+            id,
+            uv: min + size * DVec2::new(u[0], u[1]),
+        }
     }
 
     #[allow(clippy::too_many_arguments)]

@@ -276,15 +276,17 @@ impl GlintQuery {
     }
 }
 
-/// The override constants of the flake shaders (TEA and the quadtree), from Rust.
+/// The override constants of the flake shaders (the hashes and the quadtree), from Rust.
 pub fn flake_constants() -> Vec<(&'static str, f64)> {
-    use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH};
+    use crate::flakes::{BINOMIAL_EXACT_MAX, LEAF_FLAKES, MAX_DEPTH, POSITION_SALT, SPLIT_SALT};
     use crate::lit::{BLEND_BAND, LIT_EXACT_MEAN, SPLIT_EXACT_MAX};
     let mut constants: Vec<(&str, f64)> = crate::tea::pipeline_constants().to_vec();
     constants.extend([
         ("LEAF_FLAKES", LEAF_FLAKES as f64),
         ("MAX_DEPTH", MAX_DEPTH as f64),
         ("BINOMIAL_EXACT_MAX", BINOMIAL_EXACT_MAX as f64),
+        ("SPLIT_SALT", SPLIT_SALT as f64),
+        ("POSITION_SALT", POSITION_SALT as f64),
         ("LIT_EXACT_MEAN", LIT_EXACT_MEAN),
         ("SPLIT_EXACT_MAX", SPLIT_EXACT_MAX as f64),
         ("BLEND_BAND", BLEND_BAND),

@@ -16,7 +16,7 @@
 //! (mean above [`LIT_EXACT_MEAN`], splits of more than [`SPLIT_EXACT_MAX`]).
 
 use crate::flakes::{Flake, FlakeField, Footprint, LEAF_FLAKES, MAX_DEPTH, normal_quantile};
-use crate::tea::tea;
+use crate::tea::{pcg3d, tea, unit};
 use glam::{DMat2, DVec2};
 
 /// Binomial(n, P) draws of up to this mean are exact inverse CDFs (a loop of at most ~60
@@ -45,25 +45,6 @@ impl LitKey {
         let c = tea(cell.0, cell.1);
         LitKey(c as u32, (c >> 32) as u32)
     }
-}
-
-/// pcg3d (Jarzynski & Olano 2020): three well-mixed words from three, cheap on a GPU.
-pub fn pcg3d(v: [u32; 3]) -> [u32; 3] {
-    let mut v = v.map(|x| x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223));
-    let mix = |v: &mut [u32; 3]| {
-        v[0] = v[0].wrapping_add(v[1].wrapping_mul(v[2]));
-        v[1] = v[1].wrapping_add(v[2].wrapping_mul(v[0]));
-        v[2] = v[2].wrapping_add(v[0].wrapping_mul(v[1]));
-    };
-    mix(&mut v);
-    v = v.map(|x| x ^ (x >> 16));
-    mix(&mut v);
-    v
-}
-
-/// A word to a uniform in [0, 1) with 24 bits (exact in f32).
-pub fn unit(x: u32) -> f64 {
-    (x >> 8) as f64 / 16_777_216.0
 }
 
 /// Inverse CDF of Binomial(n, p) at u (p may be any probability).
