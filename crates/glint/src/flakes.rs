@@ -12,12 +12,13 @@
 use crate::tea::{pcg3d, tea_unit, unit};
 use glam::{DMat2, DVec2, DVec3};
 
-/// Leaves hold at most this many flakes. 32 rather than 8: a lit walk then stops two levels
+/// Leaves hold at most this many flakes. 64 rather than 8: a lit walk then stops three levels
 /// higher, and a leaf's selection sampling stops at its last lit flake, so a boundary leaf costs
-/// little when few of its flakes are lit (the demo with the glint filter off: the glint stage
-/// ~1.6× faster; with it on, unchanged). Every split is then of more than
-/// [`BINOMIAL_EXACT_MAX`] flakes and takes the normal approximation (of Binomial(≥ 33, ½)).
-pub const LEAF_FLAKES: u64 = 32;
+/// little when few of its flakes are lit. On lavapipe, 8 → 32 made the demo's glint stage with
+/// the filter off ~1.6× faster; 32 → 64 (with the cheaper splits and hashes) the unfiltered
+/// render 0.81× as long and `glint_gpu_count` 0.85×; 128 was 1.3× slower. Every split is of
+/// more than [`BINOMIAL_EXACT_MAX`] flakes and takes the normal approximation.
+pub const LEAF_FLAKES: u64 = 64;
 /// The third word of the pcg3d hash of a node's position split (its three uniforms; WGSL:
 /// `SPLIT_SALT` in `shaders/glint/flakes.inc.wgsl`).
 pub const SPLIT_SALT: u32 = 0x5851_f42d;
