@@ -367,6 +367,14 @@ fn fit_one(
     if fit.record.backend.starts_with("cpu (fallback") {
         eprintln!("notice: {input}: {}", fit.record.backend);
     }
+    // The diffuse lobe is solved on the isotropic grid: a source that is not isotropic (an
+    // anisotropic analytic or RGL material fitted without --aniso) gets the single lobe.
+    if cfg.diffuse && !cfg.anisotropic && !fit.record.diffuse_lobe {
+        eprintln!(
+            "notice: {input}: not isotropic, so fitted with a single specular lobe (no diffuse \
+             term, F not clipped to [0, 1]); --aniso fits its αx, αy and rotation"
+        );
+    }
     fit.record.timings_ms.load = load_ms;
     fit.record.timings_ms.total += load_ms;
     let (json, csv) = outputs

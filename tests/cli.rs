@@ -45,6 +45,7 @@ fn fit_writes_json_with_the_documented_fields() {
         stdout.contains("gold-metallic-paint") && stdout.contains("median error over 2 fits"),
         "{stdout}"
     );
+    assert!(!stderr.contains("not isotropic"), "{stderr}");
     let json: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(dir.join("gold-metallic-paint.json")).unwrap(),
     )
@@ -89,6 +90,33 @@ fn fit_writes_json_with_the_documented_fields() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(name).unwrap()).unwrap();
     assert!((json["beckmann"]["alpha_x"].as_f64().unwrap() / 0.3 - 1.0).abs() < 0.01);
+}
+
+/// An anisotropic source fitted without --aniso cannot take the diffuse lobe (solved on the
+/// isotropic grid): the fit says so rather than dropping it silently, and the JSON records it.
+#[test]
+fn anisotropic_source_without_aniso_says_it_fits_one_lobe() {
+    let dir = common::scratch("cli_fit_aniso_source");
+    let (ok, stdout, stderr) = facet(&[
+        "fit",
+        "--model",
+        "ggx",
+        "--backend",
+        "cpu",
+        "analytic:ggx?alpha_x=0.1&alpha_y=0.2&f0=0.04",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stderr.contains("not isotropic"), "{stderr}");
+    let json = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    assert_eq!(json["diffuse_lobe"], serde_json::Value::Bool(false));
 }
 
 #[test]
