@@ -1,6 +1,6 @@
 // Include-only. Lit counts per node (Rust twin: facet_glint::lit): the root's lit count from
 // Binomial(n, P) at a keyed uniform, split down the quadtree by keyed hypergeometric draws as
-// the positions split, leaves picking their lit flakes by selection sampling; a node inside the
+// the positions split, a leaf's lit flakes a run of its flakes from a keyed start; a node inside the
 // footprint adds its lit count, only boundary nodes descend. One walk serves the two queries of
 // a shading point (light sample and BSDF sample), each blended over four direction cells: eight
 // chains of lit counts share the positions' splits.
@@ -135,10 +135,9 @@ fn split_lit(h: vec2<u32>, c: vec4<u32>, lit: u32, key: vec2<u32>) -> vec4<u32> 
     return vec4<u32>(l00, l10, lit_left - l00, lit - lit_left - l10);
 }
 
-// Algorithm S: a leaf's flake (id) is lit with probability needed / remaining.
-fn leaf_lit(id: vec2<u32>, needed: u32, remaining: u32, key: vec2<u32>) -> bool {
-    let r = pcg3d(vec3<u32>(id.x ^ key.x, id.y ^ key.y, 0x27d4eb2fu));
-    return unit24(r.x) * f32(remaining) < f32(needed);
+// The first of a leaf's run of lit flakes (facet_glint::FlakeField::leaf_run_start).
+fn leaf_run_start(h: vec2<u32>, n: u32, key: vec2<u32>) -> u32 {
+    return pcg3d(vec3<u32>(h.x ^ key.x, h.y ^ key.y, 0x27d4eb2fu)).x % n;
 }
 
 struct LitNode {
@@ -194,30 +193,18 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
         }
         let h = node_hash(nd.level, nd.ix, nd.iy);
         if (nd.n <= LEAF_FLAKES || nd.level == MAX_DEPTH) {
-            // Flakes past the chains' last lit ones are not looked at, and only a flake some
-            // chain takes has its position hashed.
-            var needed = nd.lit;
-            for (var k = 0u; k < nd.n; k++) {
-                if (!any_lit(needed)) {
-                    break;
-                }
-                let id = leaf_flake_id(h, k);
-                var taken = 0u;
-                for (var c = 0u; c < nc; c++) {
-                    if (needed[c] > 0u && leaf_lit(id, needed[c], nd.n - k, keys[c])) {
-                        needed[c] -= 1u;
-                        taken |= 1u << c;
-                    }
-                }
-                if (taken == 0u) {
+            // Each chain's lit flakes: a keyed run of the leaf's (leaf_run_start), only their
+            // positions hashed.
+            for (var c = 0u; c < nc; c++) {
+                if (nd.lit[c] == 0u) {
                     continue;
                 }
-                let uv = flake_uv(id, lo, size);
-                let st = inv * (uv - center);
-                if (dot(st, st) <= 1.0) {
-                    for (var c = 0u; c < nc; c++) {
-                        acc[c] += (taken >> c) & 1u;
-                    }
+                let start = leaf_run_start(h, nd.n, keys[c]);
+                for (var j = 0u; j < nd.lit[c]; j++) {
+                    var k = start + j;
+                    k = select(k, k - nd.n, k >= nd.n);
+                    let st = inv * (flake_uv(leaf_flake_id(h, k), lo, size) - center);
+                    acc[c] += select(0u, 1u, dot(st, st) <= 1.0);
                 }
             }
             continue;

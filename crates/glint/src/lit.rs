@@ -7,11 +7,14 @@
 //! is the inverse CDF of Binomial(n, P) at a keyed uniform; a node's L is split among its
 //! children (whose flake counts the positions' split fixed) by hypergeometric draws — first the
 //! left and right halves, then each half's lower and upper quarter, as the positions split —
-//! and a leaf picks its lit flakes by selection sampling (Knuth's Algorithm S). Every draw is
-//! keyed on the node (or flake) and on the query's direction cell — an inverse CDF at a keyed
-//! uniform, or for a split of few lit flakes one keyed draw a flake — so: a node's L is one
-//! number whatever the footprint (nested footprints give nested counts); for fixed keys every L
-//! is non-decreasing in P (a slowly moving light changes counts gradually);
+//! and a leaf's L lit flakes are a run of its flakes from a keyed start
+//! ([`FlakeField::leaf_run_start`]): a flake's position hashes its id, so any L distinct flakes
+//! of a leaf lie at L independent uniform positions in it, and only the lit ones are looked at.
+//! Every draw is keyed on the node (or leaf) and on the query's direction cell — an inverse CDF
+//! at a keyed uniform, or for a split of few lit flakes one keyed draw a flake — so: a node's L
+//! is one number whatever the footprint (nested footprints give nested counts); for fixed keys
+//! every L is non-decreasing in P, and a leaf's larger L lights a superset (a slowly moving
+//! light changes counts gradually);
 //! and the distribution is that of independent flakes. Large draws use normal approximations
 //! (mean above [`LIT_EXACT_MEAN`], splits of more than [`SPLIT_EXACT_MAX`]).
 
@@ -172,11 +175,13 @@ impl FlakeField {
         [l00, l10, lit_left - l00, lit - lit_left - l10]
     }
 
-    /// Whether a leaf's flake `id` is lit, `needed` of its `remaining` flakes still to pick
-    /// (Algorithm S: taken with probability needed / remaining, at a uniform keyed on the flake).
-    pub(crate) fn leaf_lit(&self, id: u64, needed: u64, remaining: u64, key: LitKey) -> bool {
-        let u = pcg3d([id as u32 ^ key.0, (id >> 32) as u32 ^ key.1, 0x27d4_eb2f]);
-        unit(u[0]) * (remaining as f64) < needed as f64
+    /// Where the run of a leaf's lit flakes starts: flakes start, start + 1, … (mod n) of the
+    /// leaf of hash `h` and n flakes are its lit ones under `key`. Any L distinct flakes of a
+    /// leaf are L independent uniform positions in it (a flake's position hashes its id), so
+    /// the run gives the law of independent flakes, and a larger L lights a superset.
+    pub fn leaf_run_start(&self, h: u64, n: u64, key: LitKey) -> u64 {
+        let r = pcg3d([h as u32 ^ key.0, (h >> 32) as u32 ^ key.1, 0x27d4_eb2f]);
+        (r[0] % n as u32) as u64
     }
 
     /// Lit flakes in the footprint for P = `p` under `key`: interior nodes add their lit count,
@@ -234,22 +239,16 @@ impl FlakeField {
         }
         let h = self.node_hash(level, ix, iy);
         if n <= LEAF_FLAKES || level == MAX_DEPTH {
-            // Flakes past the last lit one are not looked at, and only a lit flake's position
-            // is hashed.
-            let (mut needed, mut found) = (lit, 0);
-            for k in 0..n {
-                if needed == 0 {
-                    break;
-                }
-                let id = FlakeField::leaf_flake_id(h, k as u32);
-                if self.leaf_lit(id, needed, n - k, key) {
-                    needed -= 1;
-                    let flake = FlakeField::flake_at(id, min, size);
-                    if fp.contains(inv, flake.uv) {
-                        found += 1;
-                        if let Some(o) = out.as_deref_mut() {
-                            o.push(flake);
-                        }
+            // The lit flakes: a keyed run of the leaf's, only their positions hashed.
+            let start = self.leaf_run_start(h, n, key);
+            let mut found = 0;
+            for j in 0..lit {
+                let k = ((start + j) % n) as u32;
+                let flake = FlakeField::flake_at(FlakeField::leaf_flake_id(h, k), min, size);
+                if fp.contains(inv, flake.uv) {
+                    found += 1;
+                    if let Some(o) = out.as_deref_mut() {
+                        o.push(flake);
                     }
                 }
             }
