@@ -198,7 +198,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
             cos_psi, sin_psi, weight, n_chi,
         }),
         layout_check!(GlintField, "glint/glint_count.wgsl", "Field", {
-            density, seed, root_count, filtered, threshold, blend, pad => [pad1, pad2],
+            density, seed, root_count, filtered, threshold, blend, table_levels, pad,
         }),
         layout_check!(GlintQuery, "glint/glint_count.wgsl", "Query", {
             center, a, b, p, coords0, coords1,

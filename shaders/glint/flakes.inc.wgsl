@@ -1,6 +1,7 @@
 // Include-only. The flake field (Rust twin: facet_glint::flakes): the quadtree's keyed binomial
 // splits, leaf flakes from TEA. Counting lit flakes is glint/lit.inc.wgsl's.
-// Needs `field: Field` declared by the includer, and glint/tea.inc.wgsl.
+// Needs `field: Field` and `split_table: array<u32>` (facet_glint::flakes::SplitTable) declared
+// by the includer, and glint/tea.inc.wgsl.
 
 const PI_F: f32 = 3.14159265358979;
 
@@ -20,8 +21,9 @@ struct Field {
     threshold: f32,
     // Whether counts blend the four direction cells around the half vector.
     blend: u32,
-    pad1: u32,
-    pad2: u32,
+    // The deepest level whose nodes' flake counts `split_table` holds.
+    table_levels: u32,
+    pad: u32,
 }
 
 // Rust: facet_glint::gpu::GlintQuery. Two queries sharing one footprint (a shading point's
@@ -75,6 +77,23 @@ fn binomial(n: u32, u: f32) -> u32 {
         cdf += p;
     }
     return k;
+}
+
+// The flake counts of the four children of node (level, ix, iy) holding n flakes
+// (facet_glint::FlakeField::split): read from the table down to its deepest level, drawn below.
+fn split_counts(level: u32, ix: u32, iy: u32, n: u32, h: vec2<u32>) -> vec4<u32> {
+    if (level < field.table_levels) {
+        // Level d starts at (4^d − 1) / 3, row-major.
+        let d = level + 1u;
+        let w = 1u << d;
+        let i = ((1u << (2u * d)) - 1u) / 3u + 2u * iy * w + 2u * ix;
+        return vec4<u32>(split_table[i], split_table[i + 1u], split_table[i + w], split_table[i + w + 1u]);
+    }
+    let u = pcg3d(vec3<u32>(h.x, h.y, SPLIT_SALT));
+    let left = binomial(n, unit24(u.x));
+    let l0 = binomial(left, unit24(u.y));
+    let r0 = binomial(n - left, unit24(u.z));
+    return vec4<u32>(l0, r0, left - l0, n - left - r0);
 }
 
 fn node_hash(level: u32, ix: u32, iy: u32) -> vec2<u32> {

@@ -9,6 +9,7 @@ const WG: u32 = 64u;
 @group(0) @binding(0) var<uniform> field: Field;
 @group(0) @binding(1) var<storage, read> queries: array<Query>;
 @group(0) @binding(2) var<storage, read_write> counts: array<vec2<f32>>;
+@group(0) @binding(3) var<storage, read> split_table: array<u32>;
 
 #include "glint/flakes.inc.wgsl"
 #include "glint/lit.inc.wgsl"

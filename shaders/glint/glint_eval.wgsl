@@ -24,6 +24,7 @@ struct EvalQuery {
 @group(0) @binding(4) var<storage, read> fresnel: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> queries: array<EvalQuery>;
 @group(0) @binding(6) var<storage, read_write> out: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> split_table: array<u32>;
 
 #include "glint/flakes.inc.wgsl"
 #include "glint/lit.inc.wgsl"

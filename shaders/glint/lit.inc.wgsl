@@ -209,11 +209,7 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
             }
             continue;
         }
-        let u = pcg3d(vec3<u32>(h.x, h.y, SPLIT_SALT));
-        let left = binomial(nd.n, unit24(u.x));
-        let l0 = binomial(left, unit24(u.y));
-        let r0 = binomial(nd.n - left, unit24(u.z));
-        let cn = vec4<u32>(l0, r0, left - l0, nd.n - left - r0);
+        let cn = split_counts(nd.level, nd.ix, nd.iy, nd.n, h);
         var child: array<array<u32, CHAINS>, 4>;
         for (var c = 0u; c < nc; c++) {
             let l = split_lit(h, cn, nd.lit[c], keys[c]);

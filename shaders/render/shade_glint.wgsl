@@ -21,6 +21,7 @@ override Q_SHADE: u32;
 @group(2) @binding(1) var<uniform> params: EvalParams;
 @group(2) @binding(2) var level0: texture_3d<f32>;
 @group(2) @binding(3) var level1: texture_3d<f32>;
+@group(2) @binding(4) var<storage, read> split_table: array<u32>;
 
 // EvalParams.ndf_kind of a tabulated NDF (facet_glint::gpu::GlintEvalParams).
 const NDF_TABULATED: u32 = 2u;

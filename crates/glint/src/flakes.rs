@@ -26,6 +26,8 @@ pub const SPLIT_SALT: u32 = 0x5851_f42d;
 pub const POSITION_SALT: u32 = 0x68e3_1da4;
 /// Deepest level of the quadtree (2²⁰ cells per side).
 pub const MAX_DEPTH: u32 = 20;
+/// Deepest level whose nodes' flake counts a [`SplitTable`] holds (4⁸ nodes, 256 KiB there).
+pub const SPLIT_TABLE_LEVELS: u32 = 8;
 /// Binomial splits of up to this many flakes are exact inverse CDFs; larger ones use the
 /// continuity-corrected normal approximation. Kept small because the exact search is a loop, and
 /// llvmpipe (lavapipe) caps a loop's iterations per invocation at 65 535: at 100 a GPU walk over
@@ -150,6 +152,35 @@ impl FlakeField {
         [l0, r0, left - l0, n - left - r0]
     }
 
+    /// The flake counts of the top of the quadtree, drawn once ([`SplitTable`]).
+    pub fn split_table(&self) -> SplitTable {
+        let mut counts = vec![self.root_count() as u32];
+        let (mut levels, mut first) = (0, 0);
+        while levels < SPLIT_TABLE_LEVELS.min(MAX_DEPTH) {
+            let side = 1u32 << levels;
+            let parents = &counts[first..];
+            if parents.iter().all(|&n| n as u64 <= LEAF_FLAKES) {
+                break;
+            }
+            // Level + 1, row-major: the children of (ix, iy) at (2 ix + dx, 2 iy + dy).
+            let mut next = vec![0u32; 4 * parents.len()];
+            for (i, &n) in parents.iter().enumerate() {
+                if n as u64 <= LEAF_FLAKES {
+                    continue; // a leaf: its children are never read
+                }
+                let (ix, iy) = (i as u32 % side, i as u32 / side);
+                for (k, c) in self.split(levels, ix, iy, n as u64).into_iter().enumerate() {
+                    let (x, y) = (2 * ix + (k as u32 & 1), 2 * iy + (k as u32 >> 1));
+                    next[(y * 2 * side + x) as usize] = c as u32;
+                }
+            }
+            first = counts.len();
+            counts.extend(next);
+            levels += 1;
+        }
+        SplitTable { levels, counts }
+    }
+
     /// Every flake inside the footprint (UVs wrap), found through the quadtree.
     pub fn flakes_in(&self, fp: &Footprint) -> Vec<Flake> {
         let mut out = Vec::new();
@@ -223,6 +254,20 @@ impl FlakeField {
             self.visit(fp, inv, ext, level + 1, 2 * ix + dx, 2 * iy + dy, m, out);
         }
     }
+}
+
+/// The flake counts of the quadtree's nodes from the root down to `levels` (at most
+/// [`SPLIT_TABLE_LEVELS`], and no deeper than the deepest inner node's children), level by
+/// level, each level row-major (iy · 2^level + ix; level d starts at (4^d − 1) / 3), as
+/// the position splits draw them (the children of a leaf hold 0). A GPU walk reads a node's
+/// children's counts here instead of drawing them (`split_table` in
+/// `shaders/glint/flakes.inc.wgsl`): the CPU's draws (f64), not three f32 normal quantiles a node.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SplitTable {
+    /// The deepest level held.
+    pub levels: u32,
+    /// The counts.
+    pub counts: Vec<u32>,
 }
 
 /// Inverse CDF of Poisson(mean) at u; a normal approximation above mean 500.
@@ -308,5 +353,56 @@ pub fn normal_quantile(u: f64) -> f64 {
         let r = q * q;
         (((((A[0] * r + A[1]) * r + A[2]) * r + A[3]) * r + A[4]) * r + A[5]) * q
             / (((((B[0] * r + B[1]) * r + B[2]) * r + B[3]) * r + B[4]) * r + 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table holds what the splits draw: each inner node's children as `split` gives
+    /// them, every level's counts summing to the root's until the leaves stop it, and it stops
+    /// at the first level of leaves only (or at `SPLIT_TABLE_LEVELS`).
+    #[test]
+    fn split_table_holds_the_splits() {
+        for density in [3.0e3, 3.0e5, 2.0e6, 5.0e8] {
+            let field = FlakeField { density, seed: 7 };
+            let t = field.split_table();
+            let start = |d: u32| (((1u64 << (2 * d)) - 1) / 3) as usize;
+            assert_eq!(t.counts.len(), start(t.levels + 1), "density {density}");
+            assert_eq!(t.counts[0] as u64, field.root_count());
+            for d in 0..t.levels {
+                let side = 1u32 << d;
+                let mut leaves = 0;
+                for iy in 0..side {
+                    for ix in 0..side {
+                        let n = t.counts[start(d) + (iy * side + ix) as usize] as u64;
+                        let child = |dx: u32, dy: u32| {
+                            let i =
+                                start(d + 1) + ((2 * iy + dy) * 2 * side + 2 * ix + dx) as usize;
+                            t.counts[i] as u64
+                        };
+                        let kids = [child(0, 0), child(1, 0), child(0, 1), child(1, 1)];
+                        if n <= LEAF_FLAKES {
+                            leaves += 1;
+                            assert_eq!(kids, [0; 4]);
+                        } else {
+                            assert_eq!(kids, field.split(d, ix, iy, n), "{d} {ix} {iy}");
+                        }
+                    }
+                }
+                // Not all of level d are leaves, else the table would have stopped above.
+                assert!(
+                    leaves < side * side,
+                    "density {density}: level {d} all leaves"
+                );
+            }
+            let last = &t.counts[start(t.levels)..];
+            assert!(
+                t.levels == SPLIT_TABLE_LEVELS || last.iter().all(|&n| n as u64 <= LEAF_FLAKES),
+                "density {density}: stopped at {} with inner nodes left",
+                t.levels
+            );
+        }
     }
 }

@@ -239,7 +239,8 @@ pub struct GlintField {
     pub filtered: u32,
     pub threshold: f32,
     pub blend: u32,
-    pub pad: [u32; 2],
+    pub table_levels: u32,
+    pub pad: u32,
 }
 
 /// Two glint queries sharing a footprint (WGSL `Query`): the footprint, the P of each (0: no
@@ -295,8 +296,13 @@ pub fn flake_constants() -> Vec<(&'static str, f64)> {
 }
 
 impl GlintField {
-    /// The uniform of `field` counted under `cfg`.
-    pub fn new(field: &crate::flakes::FlakeField, cfg: &crate::glint_brdf::GlintConfig) -> Self {
+    /// The uniform of `field` counted under `cfg`, its top levels' counts in `table`
+    /// ([`crate::flakes::FlakeField::split_table`]).
+    pub fn new(
+        field: &crate::flakes::FlakeField,
+        cfg: &crate::glint_brdf::GlintConfig,
+        table: &crate::flakes::SplitTable,
+    ) -> Self {
         GlintField {
             density: field.density as f32,
             seed: field.seed,
@@ -304,7 +310,8 @@ impl GlintField {
             filtered: cfg.filtered as u32,
             threshold: cfg.threshold as f32,
             blend: cfg.blend as u32,
-            pad: [0; 2],
+            table_levels: table.levels,
+            pad: 0,
         }
     }
 }
@@ -340,18 +347,21 @@ impl GlintCounter {
         queries: &[GlintQuery],
     ) -> Result<Vec<[f64; 2]>, GpuError> {
         let d = &gpu.device;
-        let uniform = GlintField::new(field, cfg);
-        let (ub, qb, cb) = gpu.scoped(|| {
+        let table = field.split_table();
+        let uniform = GlintField::new(field, cfg, &table);
+        let (ub, qb, cb, tb) = gpu.scoped(|| {
             (
                 buffer::uniform(d, "glint field", &uniform),
                 buffer::storage(d, "glint queries", queries),
                 buffer::storage_zeroed(d, "glint counts", (queries.len() * 8) as u64),
+                buffer::storage(d, "glint split table", &table.counts),
             )
         })?;
         let resources = [
             ub.as_entire_binding(),
             qb.as_entire_binding(),
             cb.as_entire_binding(),
+            tb.as_entire_binding(),
         ];
         dispatch::run(
             d,
@@ -452,19 +462,21 @@ impl GlintEvaluator {
     ) -> Result<Vec<[f64; 3]>, GpuError> {
         let d = &gpu.device;
         let (params, t0, t1) = eval_params(cfg, &Ndf::Analytic(*ndf), dpf)?;
-        let uniform = GlintField::new(field, cfg);
+        let table = field.split_table();
+        let uniform = GlintField::new(field, cfg, &table);
         let f: Vec<[f32; 4]> = fresnel
             .rgb
             .iter()
             .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, 0.0])
             .collect();
-        let (fb, pb, frb, qb, ob) = gpu.scoped(|| {
+        let (fb, pb, frb, qb, ob, tb) = gpu.scoped(|| {
             (
                 buffer::uniform(d, "glint field", &uniform),
                 buffer::uniform(d, "glint eval params", &params),
                 buffer::storage(d, "fresnel", &f),
                 buffer::storage(d, "glint eval queries", queries),
                 buffer::storage_zeroed(d, "glint values", (queries.len() * 16) as u64),
+                buffer::storage(d, "glint split table", &table.counts),
             )
         })?;
         let (v0, v1) = (
@@ -479,6 +491,7 @@ impl GlintEvaluator {
             frb.as_entire_binding(),
             qb.as_entire_binding(),
             ob.as_entire_binding(),
+            tb.as_entire_binding(),
         ];
         dispatch::run(
             d,

@@ -80,7 +80,13 @@ impl Layouts {
             ),
             glint: layout(
                 "glint",
-                &[uniform(0), uniform(1), texture_3d(2), texture_3d(3)],
+                &[
+                    uniform(0),
+                    uniform(1),
+                    texture_3d(2),
+                    texture_3d(3),
+                    storage(4, true),
+                ],
             ),
             queue_args: layout(
                 "queue args",

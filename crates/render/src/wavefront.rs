@@ -259,6 +259,7 @@ impl Wavefront {
                         g.params.as_entire_binding(),
                         wgpu::BindingResource::TextureView(&g.level0),
                         wgpu::BindingResource::TextureView(&g.level1),
+                        g.split_table.as_entire_binding(),
                     ],
                 )
             })

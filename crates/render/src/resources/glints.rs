@@ -48,10 +48,12 @@ pub fn build(
         density: spec.density as f64,
         seed: material,
     };
+    let table = field.split_table();
     let d = &gpu.device;
     let res = GlintResources {
         material,
-        field: buffer::uniform(d, "glint field", &GlintField::new(&field, &cfg)),
+        field: buffer::uniform(d, "glint field", &GlintField::new(&field, &cfg, &table)),
+        split_table: buffer::storage(d, "glint split table", &table.counts),
         params: buffer::uniform(d, "glint params", &params),
         level0: t0.create_view(&Default::default()),
         level1: t1.create_view(&Default::default()),

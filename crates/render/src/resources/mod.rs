@@ -63,6 +63,8 @@ pub struct GlintResources {
     pub dpf: GpuDpf,
     /// The flake field uniform.
     pub field: wgpu::Buffer,
+    /// The flake counts of the top of its quadtree (`facet_glint::flakes::SplitTable`).
+    pub split_table: wgpu::Buffer,
     /// The evaluation parameters uniform.
     pub params: wgpu::Buffer,
     /// The finer of the two pyramid levels bound.
