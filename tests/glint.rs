@@ -4,7 +4,8 @@ mod common;
 
 use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
 use facet_glint::dpf::{DpfConfig, DpfPyramid, DpfTable, cone_solid_angle, dpf, query_directions};
-use facet_glint::tea::{pipeline_constants, tea, tea_unit};
+use facet_glint::lit::select_cell;
+use facet_glint::tea::{pcg3d, pipeline_constants, tea, tea_unit};
 use facet_gpu::{buffer, gpu_for_tests, shader};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -146,6 +147,68 @@ fn tea_in_wgsl_matches_rust() {
         ((out[n - 1][1] as u64) << 32) | out[n - 1][0] as u64,
         0x6955_6b69_8924_22ac
     );
+}
+
+/// The renderer's stochastic choice of a direction cell (`select_cell` in lit.inc.wgsl) picks
+/// the cell `facet_glint::lit::select_cell` picks, on 2·10⁴ queries near edges, near corners and
+/// inside cells. f32 coordinates make a weight differ from the CPU's by ~1e-7, so a uniform
+/// within that of a weight may go the other way: stated budget 2 queries.
+#[test]
+fn cell_choice_in_wgsl_matches_rust() {
+    let Some(gpu) = gpu_for_tests("cell_choice_in_wgsl_matches_rust") else {
+        return;
+    };
+    let unit = |i: u32, s: u32| (pcg3d([i, s, 9])[0] >> 8) as f32 / (1u32 << 24) as f32;
+    let queries: Vec<[f32; 4]> = (0..20_000u32)
+        .map(|i| {
+            // Coordinates within 0.2 cells of a lattice point half the time, anywhere the rest.
+            let near = i % 2 == 0;
+            let c = |s: u32| {
+                let cell = (pcg3d([i, s, 5])[0] % 40) as f32 - 20.0;
+                cell + if near {
+                    0.2 * unit(i, s) - 0.1
+                } else {
+                    unit(i, s)
+                }
+            };
+            [c(1), c(2), unit(i, 3), 0.0]
+        })
+        .collect();
+    let pipeline = shader::compute_pipeline(
+        &gpu.device,
+        "glint/select_check.wgsl",
+        "select_check",
+        &facet_glint::gpu::flake_constants(),
+    )
+    .unwrap();
+    let qb = buffer::storage(&gpu.device, "queries", &queries);
+    let cb = buffer::storage_zeroed(&gpu.device, "chosen", (queries.len() * 8) as u64);
+    let wg = facet_gpu::shader::workgroup_size("glint/select_check.wgsl", "select_check").unwrap();
+    facet_gpu::dispatch::run(
+        &gpu.device,
+        &gpu.queue,
+        &pipeline,
+        "select",
+        &[qb.as_entire_binding(), cb.as_entire_binding()],
+        queries.len() as u32,
+        wg,
+    );
+    let out: Vec<[f32; 2]> = buffer::read(&gpu.device, &gpu.queue, &cb, queries.len()).unwrap();
+    let differ: Vec<_> = queries
+        .iter()
+        .zip(&out)
+        .filter(|(q, g)| {
+            let coords = glam::DVec2::new(q[0] as f64, q[1] as f64);
+            let cpu = select_cell(coords, q[2] as f64);
+            cpu != glam::DVec2::new(g[0] as f64, g[1] as f64)
+        })
+        .collect();
+    println!(
+        "{} of {} choices differ: {differ:?}",
+        differ.len(),
+        queries.len()
+    );
+    assert!(differ.len() <= 2, "{differ:?}");
 }
 
 #[test]

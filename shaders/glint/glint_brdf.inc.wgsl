@@ -99,6 +99,11 @@ fn glint_dpf(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return (d0 * (1.0 - params.level_t) + select(0.0, d1 * params.level_t, params.level_t > 0.0)) * params.sigma;
 }
 
+// A uniform that picks one of the blended direction cells per query (select_cell in
+// glint/lit.inc.wgsl), set by an includer that draws it per sample; negative (the default): the
+// cells are blended, as facet_glint::glint_brdf does.
+var<private> glint_cell_u: f32 = -1.0;
+
 // f / F of two light directions wi.x, wi.y (one shading point's light sample and BSDF sample)
 // for one view wo over the footprint ellipse (center, a, b) in UV, the flakes walked once; 0
 // below either horizon.
@@ -108,7 +113,13 @@ fn glint_factor_pair(wi0: vec3<f32>, wi1: vec3<f32>, wo: vec3<f32>, center: vec2
     }
     let ok = vec2<bool>(wi0.z > 0.0, wi1.z > 0.0);
     let p = select(vec2<f32>(0.0), vec2<f32>(glint_dpf(wi0, wo), glint_dpf(wi1, wo)), ok);
-    let q = Query(center, a, b, p, direction_coords(wi0, wo), direction_coords(wi1, wo));
+    var c0 = direction_coords(wi0, wo);
+    var c1 = direction_coords(wi1, wo);
+    if (glint_cell_u >= 0.0 && field.blend != 0u) {
+        c0 = select_cell(c0, glint_cell_u);
+        c1 = select_cell(c1, glint_cell_u);
+    }
+    let q = Query(center, a, b, p, c0, c1);
     let count = count_pair(q);
     let area = footprint_area(a, b);
     return vec2<f32>(glint_scale(wi0, wo, count.x, area), glint_scale(wi1, wo, count.y, area));

@@ -121,8 +121,11 @@ fn hypergeometric(n: u32, m: u32, l: u32, seed: u32) -> u32 {
     return select(k, m - k, flip);
 }
 
-// A chain's lit counts of the four children (c: their flake counts), node hash h.
-fn split_lit(h: vec2<u32>, c: vec4<u32>, lit: u32, key: vec2<u32>) -> vec4<u32> {
+// A chain's lit counts of the four children (c: their flake counts), node hash h, of the left
+// (x) and right (y) halves that `halves` asks for; a half not asked for is not split and reads 0
+// (facet_glint::lit::split_lit splits both: each split has its own keyed seed, so the
+// children asked for come out the same).
+fn split_lit(h: vec2<u32>, c: vec4<u32>, lit: u32, key: vec2<u32>, halves: vec2<bool>) -> vec4<u32> {
     if (lit == 0u) {
         return vec4<u32>(0u);
     }
@@ -130,9 +133,18 @@ fn split_lit(h: vec2<u32>, c: vec4<u32>, lit: u32, key: vec2<u32>) -> vec4<u32> 
     let left = c.x + c.z;
     let n = left + c.y + c.w;
     let lit_left = hypergeometric(n, left, lit, r.x);
-    let l00 = hypergeometric(left, c.x, lit_left, r.y);
-    let l10 = hypergeometric(n - left, c.y, lit - lit_left, r.z);
-    return vec4<u32>(l00, l10, lit_left - l00, lit - lit_left - l10);
+    var l = vec4<u32>(0u);
+    if (halves.x) {
+        let l00 = hypergeometric(left, c.x, lit_left, r.y);
+        l.x = l00;
+        l.z = lit_left - l00;
+    }
+    if (halves.y) {
+        let l10 = hypergeometric(n - left, c.y, lit - lit_left, r.z);
+        l.y = l10;
+        l.w = lit - lit_left - l10;
+    }
+    return l;
 }
 
 // The first of a leaf's run of lit flakes (facet_glint::FlakeField::leaf_run_start).
@@ -210,9 +222,12 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
             continue;
         }
         let cn = split_counts(nd.level, nd.ix, nd.iy, nd.n, h);
+        // The halves the footprint's box reaches (left: x below the node's midline).
+        let mid = lo + 0.5 * size;
+        let halves = vec2<bool>(mid.x >= center.x - ext.x, mid.x <= center.x + ext.x);
         var child: array<array<u32, CHAINS>, 4>;
         for (var c = 0u; c < nc; c++) {
-            let l = split_lit(h, cn, nd.lit[c], keys[c]);
+            let l = split_lit(h, cn, nd.lit[c], keys[c], halves);
             child[0][c] = l.x;
             child[1][c] = l.y;
             child[2][c] = l.z;
@@ -220,7 +235,6 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
         }
         // Children outside the footprint's box are not pushed (the test their pop would make:
         // the child's edges at the node's midlines are exact in f32).
-        let mid = lo + 0.5 * size;
         for (var k = 0u; k < 4u; k++) {
             let inx = select(mid.x >= center.x - ext.x, mid.x <= center.x + ext.x, (k & 1u) == 1u);
             let iny = select(mid.y >= center.y - ext.y, mid.y <= center.y + ext.y, (k >> 1u) == 1u);
@@ -262,6 +276,18 @@ fn cell_keys(coords: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, w
         (*keys)[first + k] = tea(u32(bx + i32(ax[i])), u32(by + i32(ay[j])));
         (*weights)[first + k] = select(select(0.0, 1.0, k == 0u), ax[2u + i] * ay[2u + j], field.blend != 0u);
     }
+}
+
+// One of the cells cell_keys reads, chosen with probability its weight by u: the x axis takes
+// u, the y axis what is left of it rescaled; the result is the cell's centre, which lies
+// outside every blend band and so reads that cell alone (facet_glint::lit::select_cell).
+fn select_cell(coords: vec2<f32>, u: f32) -> vec2<f32> {
+    let ax = blend_axis(coords.x);
+    let ay = blend_axis(coords.y);
+    let first_x = u < ax[2] || ax[3] <= 0.0;
+    let v = select((u - ax[2]) / ax[3], u / ax[2], first_x);
+    let first_y = v < ay[2] || ay[3] <= 0.0;
+    return floor(coords) + vec2<f32>(select(ax[1], ax[0], first_x), select(ay[1], ay[0], first_y)) + 0.5;
 }
 
 // The counts of the two queries over the footprint (all its copies on the torus): blended lit

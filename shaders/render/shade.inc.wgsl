@@ -8,7 +8,8 @@
 //   bsdf_roughness(b) -> α of the lobe (for the cone),
 // all in the local shading frame (z the normal).
 
-// Random numbers of a bounce: 0..2 light choice and point, 3..5 BSDF sample, 7 roulette.
+// Random numbers of a bounce: 0..2 light choice and point, 3..5 BSDF sample, 6 the class's own
+// (glints: the direction cell), 7 roulette.
 fn shade(slot: u32) {
     let hit = path_get(R_HIT, slot);
     let prim = bitcast<u32>(hit.y);

@@ -2,7 +2,8 @@
 // per glint material with its own DPF pyramid levels:
 //   f = F(θd) G2 (h·ωo) count / (N a σ(γ) cos θi cos θh cos θo) + ρd/π   (glint/glint_brdf.inc.wgsl;
 //   ρd the fit's diffuse lobe),
-// the light sample's and the BSDF sample's counts from one walk over the flakes,
+// the light sample's and the BSDF sample's counts from one walk over the flakes, each reading
+// one direction cell chosen per sample with its blend weight (stochastic filtering),
 // the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
 // N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals, mixed with
 // the cosine lobe by albedo where the fit has a diffuse term (as shade_microfacet.wgsl).
@@ -40,6 +41,8 @@ struct Bsdf {
     b: vec2<f32>,
     diffuse: vec3<f32>,
     p_spec: f32,
+    // Picks the direction cell each query reads (glint_cell_u in glint/glint_brdf.inc.wgsl).
+    cell_u: f32,
 }
 
 // A world vector in the tangent plane to UV: least squares through J = [dP/du dP/dv],
@@ -70,6 +73,9 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
         b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
     }
     b.center = s.uv;
+    // One of the blended direction cells per sample, chosen by its weight: the image converges
+    // to the blended counts, and the walk follows one chain per query instead of up to four.
+    b.cell_u = path_rand(slot, 6u);
     b.diffuse = m.diffuse.xyz;
     // Lobe choice by albedo, as for the smooth microfacet class.
     let spec = luminance(fresnel_table(m, 1.0));
@@ -105,6 +111,7 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
 // Both directions from one walk over the footprint's flakes.
 fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
     glint_tab = b.tab;
+    glint_cell_u = b.cell_u;
     let k = glint_factor_pair(wi_light, wi_bsdf, wo, b.center, b.a, b.b);
     let m = materials[b.material];
     var f: array<vec3<f32>, 2>;

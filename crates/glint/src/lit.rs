@@ -316,9 +316,66 @@ pub fn blend_cells(coords: DVec2) -> [((u32, u32), f64); 4] {
     [cell(0, 0), cell(1, 0), cell(0, 1), cell(1, 1)]
 }
 
+/// One of the cells [`blend_cells`] reads, chosen with probability its weight by the uniform
+/// `u` (stochastic filtering, as for textures in Pharr et al. 2024): the returned coordinates
+/// are that cell's centre, which lies outside every blend band, so a count there reads that one
+/// cell. Its expectation over u is the blended count, so a renderer that draws u per sample
+/// converges to the blended image while a query walks one chain instead of up to four. The
+/// x axis takes u, the y axis what is left of it: `u < wx` picks the first x cell, then
+/// u / wx (or (u − wx) / (1 − wx)) is uniform again and picks the y cell. WGSL twin:
+/// `select_cell` in lit.inc.wgsl.
+pub fn select_cell(coords: DVec2, u: f64) -> DVec2 {
+    let (ax, ay) = (blend_axis(coords.x), blend_axis(coords.y));
+    let pick = |a: [(i64, f64); 2], u: f64| -> (i64, f64) {
+        // u < w: the first cell, u rescaled to [0, 1) over its weight; else the second.
+        if u < a[0].1 || a[1].1 <= 0.0 {
+            (a[0].0, u / a[0].1)
+        } else {
+            (a[1].0, (u - a[0].1) / a[1].1)
+        }
+    };
+    let (cx, v) = pick(ax, u);
+    let (cy, _) = pick(ay, v);
+    DVec2::new(cx as f64 + 0.5, cy as f64 + 0.5)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A chosen cell is one [`blend_cells`] reads, its centre reads that cell alone (weight
+    /// 1), and over 4·10⁵ uniforms each cell is chosen with its weight (within 4.5 standard
+    /// errors), at an interior point, near an edge and near a corner.
+    #[test]
+    fn chosen_cells_follow_the_blend_weights() {
+        const DRAWS: u32 = 400_000;
+        for coords in [
+            DVec2::new(3.5, -2.4),
+            DVec2::new(3.03, 7.5),
+            DVec2::new(-0.96, 12.02),
+        ] {
+            let cells = blend_cells(coords);
+            let mut hits = [0u32; 4];
+            for i in 0..DRAWS {
+                let centre = select_cell(coords, (i as f64 + 0.5) / DRAWS as f64);
+                let read = blend_cells(centre);
+                assert_eq!(read[0].1, 1.0, "{centre}");
+                let k = cells
+                    .iter()
+                    .position(|c| c.0 == read[0].0 && c.1 > 0.0)
+                    .unwrap_or_else(|| panic!("{coords}: chose {centre}, not a blended cell"));
+                hits[k] += 1;
+            }
+            for (k, &(_, w)) in cells.iter().enumerate() {
+                let f = hits[k] as f64 / DRAWS as f64;
+                let se = (w * (1.0 - w) / DRAWS as f64).sqrt();
+                assert!(
+                    (f - w).abs() <= 4.5 * se + 1e-5,
+                    "{coords}: cell {k} chosen {f}, weight {w}"
+                );
+            }
+        }
+    }
 
     /// P(k) of Hypergeometric(n, m, l), from binomial coefficients in f64.
     fn pmf(n: u64, m: u64, l: u64, k: u64) -> f64 {
