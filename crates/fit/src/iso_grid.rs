@@ -17,9 +17,6 @@ use crate::merl_geometry::{MU_ROW, MerlGeometry, ROW, ROWS, merl_geometry};
 use rayon::prelude::*;
 use std::sync::Arc;
 
-/// Scales per θh bin that one refinement scan evaluates.
-pub(crate) const SCAN: usize = 7;
-
 /// Bins per row rounded up to the sums' eight lanes.
 const PADDED: usize = ROW.div_ceil(8) * 8;
 
@@ -293,20 +290,20 @@ impl IsoSamples {
         }
     }
 
-    /// The error sum of each θh bin with D of bin i scaled by each of `scales[i]`, everything
-    /// else held (G2 / (4 cos θo) of the rows given as `ideals`): the refinement's scan
-    /// ([`crate::refine`]).
-    pub fn bin_scan(
+    /// Per θh bin, the histogram of the scales of D at which each sample's model meets its
+    /// data, weighted by the slope there ([`BinMedians`]): the refinement's per-bin L1
+    /// minimiser, `span` the histogram's half width in ln s.
+    pub fn bin_medians(
         &self,
         tables: &IsoTables,
         ideals: &RowIdeals,
-        scales: &[[f32; SCAN]; THETA_H_RES],
-    ) -> Vec<[f64; SCAN]> {
-        self.run(&BinScan {
+        span: f32,
+    ) -> Vec<[f64; MEDIAN_BUCKETS + 2]> {
+        self.run(&BinMedians {
             set: self,
             tables,
             ideals,
-            scales,
+            span,
         })
     }
 
@@ -629,36 +626,77 @@ fn weighted_row(
     (sums, error)
 }
 
-/// The error sum per θh bin with that bin's D scaled by each of its `SCAN` scales.
-struct BinScan<'a> {
+/// Buckets of [`BinMedians`]' histograms in ln s over [−span, span]; index 0 gathers what
+/// lies below, the last index what lies above. Odd, so that ln s = 0 is a bucket's centre: a
+/// bin whose samples all meet their data at s = 1 stays where it is.
+pub(crate) const MEDIAN_BUCKETS: usize = 129;
+
+/// The weighted median of the scales at which a θh bin's samples are matched. With D of bin i
+/// scaled by s, a sample's model is x(s) = s a + b (a = F D G2 / (4 cos θo), b = ρd/π cos θi)
+/// and its error |ln(1 + s a + b) − ln(1 + x)|, whose slope in s is ±w, w = a / (1 + s a + b),
+/// changing sign at s* = (x − b) / a. The bin's error is least where the weight of the samples
+/// with s* below s equals that of those above: the weighted median of the s*, with w taken at
+/// the current s = 1. The pass gathers per bin the histogram of ln s* weighted by w.
+struct BinMedians<'a> {
     set: &'a IsoSamples,
     tables: &'a IsoTables,
     ideals: &'a RowIdeals,
-    scales: &'a [[f32; SCAN]; THETA_H_RES],
+    span: f32,
 }
 
-impl RowPass for BinScan<'_> {
-    type Acc = Vec<[f64; SCAN]>;
+impl RowPass for BinMedians<'_> {
+    type Acc = Vec<[f64; MEDIAN_BUCKETS + 2]>;
 
     fn init() -> Self::Acc {
-        vec![[0.0; SCAN]; THETA_H_RES]
+        vec![[0.0; MEDIAN_BUCKETS + 2]; THETA_H_RES]
     }
 
     #[inline(always)]
     fn row(&self, acc: &mut Self::Acc, r: usize, p: usize) {
-        let t = self.tables;
-        let ideal = self.ideals.row(p);
+        let (t, data) = (self.tables, &self.set.data);
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
-        let kd = t.diffuse.map(|k| k as f32);
-        for (m, &s) in self.scales[i].iter().enumerate() {
-            let f = t.fresnel[j].map(|f| f as f32 * t.d32[i] * s);
-            acc[i][m] += row_error(&self.set.data, r, f, kd, ideal);
+        let ideal = self.ideals.row(p);
+        let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
+        let valid = &data.valid[r * ROW..(r + 1) * ROW];
+        let d = t.d32[i];
+        if !(d > 0.0) {
+            return;
+        }
+        let per_bucket = MEDIAN_BUCKETS as f32 / (2.0 * self.span);
+        let mut at = [0u32; ROW];
+        let mut w = [0.0f32; ROW];
+        for c in 0..3 {
+            let x: &[f32; ROW] = data.x[(3 * r + c) * ROW..(3 * r + c + 1) * ROW]
+                .try_into()
+                .unwrap();
+            let (fd, kd) = (t.fresnel[j][c] as f32 * d, t.diffuse[c] as f32);
+            for k in 0..ROW {
+                let (a, b) = (fd * ideal[k], kd * mu[ROW - k]);
+                // s* = (x − b) / a; ln s* = ± ln(max(s*, 1 / s*)), nothing below 2⁻⁶⁴
+                let s = ((x[k] - b) / a).max(5.4e-20);
+                let up = s >= 1.0;
+                let l = ln_1p_abs(if up { s } else { 1.0 / s } - 1.0);
+                let ln_s = if up { l } else { -l };
+                // bucket 1 + ⌊(ln s* + span) · B / (2 span)⌋, clamped to [0, B + 1]
+                let y = ((ln_s + self.span) * per_bucket + 1.0)
+                    .max(0.0)
+                    .min((MEDIAN_BUCKETS + 1) as f32);
+                // SAFETY: y is in [0, B + 1] (a NaN became 0 in `max`).
+                at[k] = unsafe { y.to_int_unchecked::<u32>() };
+                // w = a / (1 + a + b), masked bins and a ≤ 0 weigh nothing
+                let wk = a / (1.0 + a + b);
+                w[k] = if valid[k] && a > 0.0 { wk } else { 0.0 };
+            }
+            let h = &mut acc[i];
+            for k in 0..ROW {
+                h[at[k] as usize] += w[k] as f64;
+            }
         }
     }
 
     fn merge(a: &mut Self::Acc, b: Self::Acc) {
         for (a, b) in a.iter_mut().zip(b) {
-            (0..SCAN).for_each(|m| a[m] += b[m]);
+            a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
         }
     }
 }
