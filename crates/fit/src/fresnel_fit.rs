@@ -11,6 +11,7 @@
 use crate::brdf::Rgb;
 use crate::fresnel::{Fresnel, FresnelTable, conductor, dielectric};
 use crate::params::brent;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The largest θd fitted, degrees.
@@ -197,38 +198,49 @@ fn fit_dielectric(bins: &[(f64, Rgb)]) -> f64 {
 
 /// (η, k) per channel minimising the squared difference, searched in Gulbrandsen's (2014)
 /// coordinates: reflectivity r = F(0) and edge tint g, both in [0, 1], nearly independent where
-/// (η, k) run along a curved valley. A grid over (r, g), then alternating Brent steps.
+/// (η, k) run along a curved valley. An 8 × 8 grid over (r, g) (16 × 16 gave gold's η and k
+/// to the same 1e-6, at 2.5× the time), then alternating Brent steps, each channel a task.
 fn fit_conductor(bins: &[(f64, Rgb)]) -> (Rgb, Rgb) {
-    let mut eta = [0.0; 3];
-    let mut k = [0.0; 3];
-    for c in 0..3 {
-        let cost = |r: f64, g: f64| -> f64 {
-            let (e, kk) = gulbrandsen(r, g);
-            bins.iter()
-                .map(|(cos, f)| (conductor(*cos, e, kk) - f[c]).powi(2))
-                .sum()
-        };
-        const N: usize = 16;
-        const R_MAX: f64 = 0.999;
-        let mut best = (f64::INFINITY, 0.5, 0.5);
-        for a in 0..N {
-            let r = R_MAX * (a as f64 + 0.5) / N as f64;
-            for b in 0..N {
-                let g = (b as f64 + 0.5) / N as f64;
-                let v = cost(r, g);
-                if v < best.0 {
-                    best = (v, r, g);
+    // The channels are independent: one task each.
+    let per_channel: Vec<(f64, f64)> = (0..3)
+        .into_par_iter()
+        .map(|c| {
+            let cost = |r: f64, g: f64| -> f64 {
+                let (e, kk) = gulbrandsen(r, g);
+                bins.iter()
+                    .map(|(cos, f)| (conductor(*cos, e, kk) - f[c]).powi(2))
+                    .sum()
+            };
+            const N: usize = 8;
+            const R_MAX: f64 = 0.999;
+            let mut best = (f64::INFINITY, 0.5, 0.5);
+            for a in 0..N {
+                let r = R_MAX * (a as f64 + 0.5) / N as f64;
+                for b in 0..N {
+                    let g = (b as f64 + 0.5) / N as f64;
+                    let v = cost(r, g);
+                    if v < best.0 {
+                        best = (v, r, g);
+                    }
                 }
             }
-        }
-        let (_, mut r, mut g) = best;
-        for _ in 0..8 {
-            r = brent(|x| cost(x, g), 0.0, r, R_MAX, 1e-7);
-            g = brent(|x| cost(r, x), 0.0, g, 1.0, 1e-7);
-        }
-        (eta[c], k[c]) = gulbrandsen(r, g);
-    }
-    (eta, k)
+            let (_, mut r, mut g) = best;
+            for _ in 0..8 {
+                let (r0, g0) = (r, g);
+                r = brent(|x| cost(x, g), 0.0, r, R_MAX, 1e-7);
+                g = brent(|x| cost(r, x), 0.0, g, 1.0, 1e-7);
+                // Converged: a round that moves neither by more than Brent's own tolerance.
+                if (r - r0).abs() <= 1e-7 * r0.max(1e-3) && (g - g0).abs() <= 1e-7 * g0.max(1e-3) {
+                    break;
+                }
+            }
+            gulbrandsen(r, g)
+        })
+        .collect();
+    (
+        std::array::from_fn(|c| per_channel[c].0),
+        std::array::from_fn(|c| per_channel[c].1),
+    )
 }
 
 /// (η, k) of reflectivity r and edge tint g (Gulbrandsen, "Artist friendly metallic Fresnel",
