@@ -211,6 +211,18 @@ pub fn ln_1p(x: f32) -> f32 {
     if x < 0.0625 { small } else { ln_1p_abs(x) }
 }
 
+/// ln m = t·P(t), t = m − 1 ∈ [√½ − 1, √2 − 1): the coefficients of P, a degree-7 Chebyshev fit.
+const LN_P: [f32; 8] = [
+    0.999_999_94,
+    -0.500_003_64,
+    0.333_351_14,
+    -0.249_700_68,
+    0.198_985_44,
+    -0.172_470_51,
+    0.162_343_81,
+    -0.101_341_79,
+];
+
 /// ln(1 + x) in f32 for x ≥ 0 to ~2e-7 absolute (relative above x = 1): exponent and mantissa
 /// of y = 1 + x split, the mantissa brought into m ∈ [√½, √2) and ln m = t·P(t), t = m − 1, P a
 /// degree-7 Chebyshev fit (max error 6e-8). For tiny x the rounding of 1 + x costs relative,
@@ -219,17 +231,14 @@ pub fn ln_1p(x: f32) -> f32 {
 /// its time here and vectorises it, and libm's log1pf is several times slower.
 #[inline(always)]
 pub fn ln_1p_abs(x: f32) -> f32 {
-    const P: [f32; 8] = [
-        0.999_999_94,
-        -0.500_003_64,
-        0.333_351_14,
-        -0.249_700_68,
-        0.198_985_44,
-        -0.172_470_51,
-        0.162_343_81,
-        -0.101_341_79,
-    ];
-    let y = 1.0 + x.max(0.0);
+    ln_positive(1.0 + x.max(0.0))
+}
+
+/// ln y in f32 for finite y > 0, to ~2e-7 absolute for y near 1 and 1.5e-7 relative
+/// elsewhere: [`ln_1p_abs`]'s method.
+#[inline(always)]
+pub fn ln_positive(y: f32) -> f32 {
+    const P: [f32; 8] = LN_P;
     let bits = y.to_bits();
     let m1 = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
     // Branch-free: mantissas are random, a branch would mispredict half the time.
@@ -246,6 +255,33 @@ pub fn ln_1p_abs(x: f32) -> f32 {
     let p67 = P[6] + P[7] * t;
     let p = (p01 + p23 * t2) + (p45 + p67 * t2) * t4;
     e as f32 * std::f32::consts::LN_2 + t * p
+}
+
+/// [`ln_1p_abs`] with fused multiply-adds (one rounding each: results differ from it in the
+/// last bits). For the passes' kernels, compiled with FMA where the CPU has it; elsewhere
+/// `mul_add` is exact but emulated, several times slower.
+#[inline(always)]
+pub fn ln_1p_fused(x: f32) -> f32 {
+    ln_positive_fused(1.0 + x.max(0.0))
+}
+
+/// [`ln_positive`] with fused multiply-adds (see [`ln_1p_fused`]).
+#[inline(always)]
+pub fn ln_positive_fused(y: f32) -> f32 {
+    let bits = y.to_bits();
+    let m1 = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000);
+    let up = (m1 > std::f32::consts::SQRT_2) as u32;
+    let m = f32::from_bits(m1.to_bits() - (up << 23));
+    let e = ((bits >> 23) & 0xff) as i32 - 127 + up as i32;
+    let t = m - 1.0;
+    let t2 = t * t;
+    let t4 = t2 * t2;
+    let p01 = LN_P[1].mul_add(t, LN_P[0]);
+    let p23 = LN_P[3].mul_add(t, LN_P[2]);
+    let p45 = LN_P[5].mul_add(t, LN_P[4]);
+    let p67 = LN_P[7].mul_add(t, LN_P[6]);
+    let p = p67.mul_add(t2, p45).mul_add(t4, p23.mul_add(t2, p01));
+    (e as f32).mul_add(std::f32::consts::LN_2, t * p)
 }
 
 fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
@@ -570,5 +606,29 @@ mod tests {
             worst = worst.max((a - b).abs() / b.max(1.0));
         }
         assert!(worst < 2e-7, "worst error {worst}");
+    }
+
+    /// The fused variants to the same bound as [`absolute_ln_1p_matches_libm`], and ln y for
+    /// y from 2⁻⁶⁴ to 2⁶⁴ to 1.5e-7 of max(|ln y|, 1): the polynomial's 6e-8, the f32 rounding
+    /// of e ln 2 + t P(t) (6e-8 relative), and one rounding of the exponent's product.
+    #[test]
+    fn fused_logs_match_libm() {
+        let mut worst = 0.0f64;
+        for k in 0..200_000 {
+            let x = 1e-9f32 * 1.0002f32.powi(k);
+            if !x.is_finite() {
+                break;
+            }
+            let (a, b) = (super::ln_1p_fused(x) as f64, (x as f64).ln_1p());
+            worst = worst.max((a - b).abs() / b.max(1.0));
+        }
+        assert!(worst < 2e-7, "ln(1 + x): worst error {worst}");
+        let mut worst = 0.0f64;
+        for k in -64_000..64_000 {
+            let y = 2f64.powf(k as f64 * 1e-3) as f32;
+            let (a, b) = (super::ln_positive_fused(y) as f64, (y as f64).ln());
+            worst = worst.max((a - b).abs() / b.abs().max(1.0));
+        }
+        assert!(worst < 1.5e-7, "ln y: worst error {worst}");
     }
 }
