@@ -20,7 +20,7 @@ use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::params::{
     fit_least_squares, fit_moments, least_squares_candidates, refine_on_full_grid,
 };
-use crate::refine::{model_of, refine, tabulate};
+use crate::refine::{Refinement, model_of, tabulate};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -428,12 +428,21 @@ fn fit_with(
             separation_rounds = sep.rounds;
             let ex = sep.extraction;
             // The candidates compete on the final steps' rows; the one kept is measured on the
-            // full grid.
-            let (f, kd, e) = solve_on(&tabulated_model(&ex), &final_steps)?;
+            // full grid. A refinement solves its start's F and ρd itself, sharing that NDF's
+            // G2 / (4 cos θo) and plain sums with its rounds.
+            let refinement = cfg
+                .refine
+                .then(|| Refinement::new(&ex.ndf, &final_steps))
+                .flatten();
+            let (f, kd, e) = match &refinement {
+                Some(r) => r.start(),
+                None => solve_on(&tabulated_model(&ex), &final_steps)?,
+            };
             let mut best = (ex.ndf.clone(), f, kd, e, "power_iteration");
             let mut best_error = None;
             if cfg.refine {
-                if let Some(r) = refine(&best.0, e, &final_steps) {
+                let start = (best.1.clone(), best.2, best.3);
+                if let Some(r) = refinement.and_then(|r| r.run(&start)) {
                     refine_rounds = r.rounds;
                     best = (r.ndf, r.fresnel, r.albedo, r.error, "power_iteration");
                 }
@@ -444,9 +453,14 @@ fn fit_with(
                     let analytic = AnalyticNdf::isotropic(kind, p.alpha_x);
                     let t = ex.ndf.tables();
                     if let Some(ndf) = tabulate(analytic, t.nu, t.ng) {
-                        let (f, kd, e) = solve_on(&model_of(&ndf), &final_steps)?;
-                        let mut start = (ndf, f, kd, e, kind.name());
-                        if let Some(r) = refine(&start.0, e, &final_steps) {
+                        let refinement = Refinement::new(&ndf, &final_steps);
+                        let (f, kd, e) = match &refinement {
+                            Some(r) => r.start(),
+                            None => solve_on(&model_of(&ndf), &final_steps)?,
+                        };
+                        let refined = refinement.and_then(|r| r.run(&(f.clone(), kd, e)));
+                        let mut start = (ndf.clone(), f, kd, e, kind.name());
+                        if let Some(r) = refined {
                             refine_rounds += r.rounds;
                             start = (r.ndf, r.fresnel, r.albedo, r.error, kind.name());
                         }

@@ -62,17 +62,15 @@ impl IsoData {
 
     /// Whether each bin of row `r` holds a valid sample (false on the padding).
     #[inline(always)]
-    fn valid(&self, r: usize) -> [bool; PADDED] {
-        let mut v = [false; PADDED];
-        v[..ROW].copy_from_slice(&self.valid[r * ROW..(r + 1) * ROW]);
-        v
+    fn valid(&self, r: usize) -> &[bool; PADDED] {
+        self.valid[r * PADDED..(r + 1) * PADDED].try_into().unwrap()
     }
 
     /// cos θi of row `r`'s bins where they hold a valid sample, 0 elsewhere and on the padding.
     #[inline(always)]
     fn mu_i(&self, r: usize) -> [f32; PADDED] {
         let mu: &[f32; MU_ROW] = merl_geometry().mu_row(r).try_into().unwrap();
-        let valid = &self.valid[r * ROW..(r + 1) * ROW];
+        let valid = self.valid(r);
         let mut out = [0.0f32; PADDED];
         for k in 0..ROW {
             // Bin k's cos θi is the row's cosine at 180 − k.
@@ -100,7 +98,7 @@ impl IsoSamples {
         let per_i = THETA_D_RES;
         let mut log_x = vec![0.0f32; 3 * ROWS * PADDED];
         let mut x = vec![0.0f32; 3 * ROWS * PADDED];
-        let mut valid = vec![false; ROWS * ROW];
+        let mut valid = vec![false; ROWS * PADDED];
         crate::huge_pages::advise(&mut log_x);
         crate::huge_pages::advise(&mut x);
         crate::huge_pages::advise(&mut valid);
@@ -110,7 +108,7 @@ impl IsoSamples {
         let out_of_range = log_x
             .par_chunks_mut(3 * per_i * PADDED)
             .zip(x.par_chunks_mut(3 * per_i * PADDED))
-            .zip(valid.par_chunks_mut(per_i * ROW))
+            .zip(valid.par_chunks_mut(per_i * PADDED))
             .zip(sum_x.par_chunks_mut(per_i))
             .zip(count.par_chunks_mut(per_i))
             .enumerate()
@@ -195,7 +193,7 @@ impl IsoSamples {
     pub fn row_samples(&self, r: usize) -> impl Iterator<Item = (usize, [f32; 3])> + '_ {
         let d = &self.data;
         (0..ROW)
-            .filter(move |&k| d.valid[r * ROW + k])
+            .filter(move |&k| d.valid[r * PADDED + k])
             .map(move |k| {
                 let l = std::array::from_fn(|c| d.log_x[(3 * r + c) * PADDED + k]);
                 (r * ROW + k, l)
@@ -205,7 +203,7 @@ impl IsoSamples {
     /// Whether a row's bin is valid.
     #[cfg(feature = "gpu")]
     pub fn valid(&self, s: usize) -> bool {
-        self.data.valid[s]
+        self.data.valid[s / ROW * PADDED + s % ROW]
     }
 
     /// Σ x per channel over the valid samples of each θd bin, counting the rows whose D is
@@ -345,15 +343,19 @@ impl IsoSamples {
         ideals: &RowIdeals,
         span: f32,
     ) -> Vec<[f64; MEDIAN_BUCKETS + 2]> {
-        let h = self.run(&BinMedians {
+        let parts = self.run(&BinMedians {
             set: self,
             tables,
             ideals,
             span,
         });
-        h.iter()
-            .map(|h| std::array::from_fn(|b| (h[0][b] + h[1][b]) + (h[2][b] + h[3][b])))
-            .collect()
+        let mut out = vec![[0.0; MEDIAN_BUCKETS + 2]; THETA_H_RES];
+        for (i, h) in parts {
+            for (b, o) in out[i].iter_mut().enumerate() {
+                *o += (h[0][b] + h[1][b]) + (h[2][b] + h[3][b]);
+            }
+        }
+        out
     }
 
     /// G2 / (4 cos θo) of every row of this set for the G of `tables` (D, F and ρd play no
@@ -512,22 +514,22 @@ impl RowIdeals {
 /// in the set's row order ([`IsoSamples::row_sums`]).
 pub(crate) struct RowSums(Vec<[[f64; 5]; 3]>);
 
-/// A row's G2 / (4 cos θo): the `p`-th row of `cached`, or formed in `buf`.
+/// G2 / (4 cos θo) of row `r` for the G of `t`, formed (the passes without a cached row).
 #[inline(always)]
-fn ideal_row<'a>(
-    cached: Option<&'a RowIdeals>,
-    t: &IsoTables,
-    r: usize,
-    p: usize,
-    buf: &'a mut [f32; PADDED],
-) -> &'a [f32; PADDED] {
-    match cached {
-        Some(c) => c.row(p),
-        None => {
-            row_ideal(t, merl_geometry(), r, buf);
-            buf
-        }
+fn formed_ideal(t: &IsoTables, r: usize) -> [f32; PADDED] {
+    let mut ideal = [0.0f32; PADDED];
+    row_ideal(t, merl_geometry(), r, &mut ideal);
+    ideal
+}
+
+/// Σ of a row's values over its valid bins, in eight lanes.
+#[inline(always)]
+fn valid_sum(valid: &[bool; PADDED], v: &[f32; PADDED]) -> f64 {
+    let mut masked = [0.0f32; PADDED];
+    for k in 0..PADDED {
+        masked[k] = if valid[k] { v[k] } else { 0.0 };
     }
+    lanes_sum(&masked)
 }
 
 /// Σ x_ideal per θd bin.
@@ -551,13 +553,13 @@ impl RowPass for IdealSums<'_> {
             return;
         }
         let valid = self.set.data.valid(r);
-        let mut buf = [0.0f32; PADDED];
-        let ideal = ideal_row(self.cached, self.tables, r, p, &mut buf);
-        let mut masked = [0.0f32; PADDED];
-        for k in 0..PADDED {
-            masked[k] = if valid[k] { ideal[k] } else { 0.0 };
-        }
-        acc[r % THETA_D_RES] += d as f64 * lanes_sum(&masked);
+        // (A function, not a closure: a closure may be called out of line, outside the vector
+        // code.)
+        let sum = match self.cached {
+            Some(c) => valid_sum(valid, c.row(p)),
+            None => valid_sum(valid, &formed_ideal(self.tables, r)),
+        };
+        acc[r % THETA_D_RES] += d as f64 * sum;
     }
 
     fn merge(a: &mut Vec<f64>, b: Vec<f64>) {
@@ -724,6 +726,11 @@ fn l1_channel(
 /// bin whose samples all meet their data at s = 1 stays where it is.
 pub(crate) const MEDIAN_BUCKETS: usize = 129;
 
+/// A θh bin's histograms of [`BinMedians`], four interleaved (bin k of a row in histogram
+/// k mod 4): consecutive bins often share a bucket, and one histogram would chain every
+/// addition on the one before.
+type Histograms = [[f64; MEDIAN_BUCKETS + 2]; 4];
+
 /// The weighted median of the scales at which a θh bin's samples are matched. With D of bin i
 /// scaled by s, a sample's model is x(s) = s a + b (a = F D G2 / (4 cos θo), b = ρd/π cos θi)
 /// and its error |ln(1 + s a + b) − ln(1 + x)|, whose slope in s is ±w, w = a / (1 + s a + b),
@@ -738,10 +745,13 @@ struct BinMedians<'a> {
 }
 
 impl RowPass for BinMedians<'_> {
-    type Acc = Vec<[[f64; MEDIAN_BUCKETS + 2]; 4]>;
+    /// The histograms of the θh bins met, in order: a fold's rows come a bin at a time, and a
+    /// dense accumulator per fold (90 bins of 4 KB) cost more to clear and merge than the
+    /// samples themselves.
+    type Acc = Vec<(usize, Box<Histograms>)>;
 
     fn init() -> Self::Acc {
-        vec![[[0.0; MEDIAN_BUCKETS + 2]; 4]; THETA_H_RES]
+        Vec::new()
     }
 
     #[inline(always)]
@@ -776,9 +786,10 @@ impl RowPass for BinMedians<'_> {
                 let wk = a / (1.0 + a + b);
                 w[k] = if valid[k] && a > 0.0 { wk } else { 0.0 };
             }
-            // Four interleaved histograms: consecutive bins often share a bucket, and one
-            // histogram would chain every addition on the one before.
-            let h = &mut acc[i];
+            if acc.last().is_none_or(|(b, _)| *b != i) {
+                acc.push((i, Box::new([[0.0; MEDIAN_BUCKETS + 2]; 4])));
+            }
+            let h = &mut acc.last_mut().expect("pushed").1;
             for k in 0..PADDED {
                 h[k % 4][at[k] as usize] += w[k] as f64;
             }
@@ -786,11 +797,7 @@ impl RowPass for BinMedians<'_> {
     }
 
     fn merge(a: &mut Self::Acc, b: Self::Acc) {
-        for (a, b) in a.iter_mut().zip(b) {
-            for (a, b) in a.iter_mut().zip(b) {
-                a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
-            }
-        }
+        a.extend(b);
     }
 }
 
@@ -815,9 +822,10 @@ impl RowPass for ErrorSum<'_> {
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let f = t.fresnel[j].map(|f| f as f32 * t.d32[i]);
         let kd = t.diffuse.map(|k| k as f32);
-        let mut buf = [0.0f32; PADDED];
-        let ideal = ideal_row(self.cached, t, r, p, &mut buf);
-        *acc += row_error(data, r, f, kd, ideal);
+        *acc += match self.cached {
+            Some(c) => row_error(data, r, f, kd, c.row(p)),
+            None => row_error(data, r, f, kd, &formed_ideal(t, r)),
+        };
     }
 
     fn merge(a: &mut f64, b: f64) {
@@ -961,7 +969,9 @@ fn build_rows_baseline(
     for (n, (sum, count)) in out.sum_x.iter_mut().zip(out.count.iter_mut()).enumerate() {
         let r = out.first + n;
         let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
-        let valid: &mut [bool; ROW] = (&mut out.valid[n * ROW..(n + 1) * ROW]).try_into().unwrap();
+        let valid: &mut [bool; ROW] = (&mut out.valid[n * PADDED..n * PADDED + ROW])
+            .try_into()
+            .unwrap();
         let v: [&[f64; ROW]; 3] =
             std::array::from_fn(|c| raw[c][r * ROW..(r + 1) * ROW].try_into().unwrap());
         // Valid: both directions above the horizon and no channel missing (negative; a NaN

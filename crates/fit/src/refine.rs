@@ -7,7 +7,9 @@
 //! ([`IsoSamples::bin_medians`], one pass on half of the set's rows, w taken at the current s).
 //! A round moves every bin to its median, bounded to ±`SPAN` in ln s (halving every round), and
 //! solves F and ρd again for the new D. The rounds run on the set given (the fit's
-//! final-step rows, a quarter of the grid) and stop when a round gains less than `MIN_GAIN`. The
+//! final-step rows, a quarter of the grid), from the start's F and ρd ([`Refinement::start`],
+//! whose G2 / (4 cos θo) and plain sums they reuse), and stop when a round gains less than
+//! `MIN_GAIN`. The
 //! bin scales, interpolated in θ, then multiply the D table, which is renormalised
 //! (∫ D cos θh dω = 1); G1 is either recomputed by Smith's relation from the new D or held,
 //! whichever fits better. The result is kept only if its error on the set is lower than the
@@ -16,7 +18,7 @@
 use crate::brdf::Rgb;
 use crate::extract::azimuthal_integral;
 use crate::grid::{GridSamples, IsoTables};
-use crate::iso_grid::MEDIAN_BUCKETS;
+use crate::iso_grid::{IsoSamples, MEDIAN_BUCKETS, RowIdeals, RowSums};
 use crate::merl::{THETA_H_RES, bin_angles};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf};
 use crate::tabulated::{NdfTables, Stretch, TabulatedNdf, theta_node, u_node_theta};
@@ -38,8 +40,9 @@ const SCAN_STRIDE: usize = 8;
 /// The first round moves ln s by at most SPAN (a factor e² ≈ 7.4 in D); the bound halves every
 /// round. With a first bound of 0.5, most bins (50–90 of 90 on delrin) hit it in every round.
 const SPAN: f64 = 2.0;
-/// Reweighted steps of the final F / ρd solves (towards the metric's L1 minimum, which the bin
-/// medians minimise: a plain weighted least-squares solve would undo part of their gain).
+/// Reweighted steps of the start's and the final candidates' F / ρd solves, as the fit's final
+/// steps take (towards the metric's L1 minimum, which the bin medians minimise: a plain
+/// weighted least-squares solve would undo part of their gain).
 const IRLS: usize = 2;
 /// Reweighted steps of the solve after each round's medians. On the 100 proxies with the
 /// earlier scans, tabulated median / p90: one 0.0209 / 0.0636, two 0.0210 / 0.0630 (and
@@ -67,81 +70,132 @@ pub(crate) fn model_of(ndf: &TabulatedNdf) -> MicrofacetBrdf {
     MicrofacetBrdf::ideal("refined", Ndf::Tabulated(Arc::new(ndf.clone())))
 }
 
-/// Refines an isotropic tabulated NDF whose model (F and ρd solved) has error `error` on
-/// `set`; `None` when nothing better was found or the set is not isotropic.
-pub(crate) fn refine(ndf: &TabulatedNdf, error: f64, set: &GridSamples) -> Option<Refined> {
-    let sub = set.iso.as_ref().filter(|_| ndf.is_isotropic())?;
-    let scan_rows = sub.diagonal(SCAN_STRIDE);
-    let mut tables = IsoTables::new(&model_of(ndf))?;
-    let d0 = tables.d32;
-    // G is held through the rounds (only D changes): its G2 / (4 cos θo) and the rows' plain
-    // weighted sums are formed once.
-    let (ideals, scan_ideals) = (sub.ideals(&tables), scan_rows.ideals(&tables));
-    let plain = sub.row_sums(&ideals);
-    let solve = |tables: &mut IsoTables| {
-        let (f, q, e) =
-            sub.fresnel_diffuse_and_error_sum_with(tables, ROUND_IRLS, &ideals, Some(&plain));
-        tables.set_fresnel(&f);
-        tables.diffuse = q;
-        e
-    };
-    let mut e = solve(&mut tables);
-    let (mut ln_s, mut best) = ([0.0f64; THETA_H_RES], ([0.0f64; THETA_H_RES], e));
-    let (mut span, mut rounds) = (SPAN, 0);
-    while rounds < ROUNDS {
-        rounds += 1;
-        let medians = scan_rows.bin_medians(&tables, &scan_ideals, span as f32);
-        for (i, h) in medians.iter().enumerate() {
-            ln_s[i] += weighted_median(h, span);
-            tables.d32[i] = (d0[i] as f64 * ln_s[i].exp()) as f32;
-        }
-        let next = solve(&mut tables);
-        let gain = (e - next) / e;
-        if next < best.1 {
-            best = (ln_s, next);
-        }
-        e = next;
-        span *= 0.5;
-        if !(gain >= MIN_GAIN) {
-            break;
-        }
-    }
-    // F, ρd and the error per sample and channel of a final candidate, as
-    // `crate::grid::fresnel_diffuse_and_error` gives them; one whose G is the rounds' (G1
-    // held) reuses their G2 / (4 cos θo) and plain sums.
-    let solve_final = |ndf: &TabulatedNdf| {
-        let t = IsoTables::new(&model_of(ndf))?;
-        let (f, q, e) = if t.lambda_cos == tables.lambda_cos {
-            sub.fresnel_diffuse_and_error_sum_with(&t, IRLS, &ideals, Some(&plain))
-        } else {
-            sub.fresnel_diffuse_and_error_sum(&t, IRLS)
-        };
-        Some((f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64))
-    };
-    let d = rescaled_d(ndf, &best.0);
-    let held = ndf.tables().g1.clone();
-    let smith = smith_g1(&d, ndf.tables().ng)?;
-    [smith, held]
-        .into_iter()
-        .filter_map(|g1| {
-            let t = ndf.tables();
-            let tables = NdfTables {
-                d: d.clone(),
-                g1,
-                ..t.clone()
-            };
-            let ndf = TabulatedNdf::new(tables, Stretch::IDENTITY).ok()?;
-            let (fresnel, albedo, error) = solve_final(&ndf)?;
-            Some(Refined {
-                ndf,
-                fresnel,
-                albedo,
-                error,
-                rounds,
-            })
+/// F per θd bin, ρd and the mean error per sample and channel of a model on a set, as
+/// [`crate::grid::fresnel_diffuse_and_error`] gives them.
+pub(crate) type Solved = (Vec<Rgb>, Rgb, f64);
+
+/// An isotropic tabulated NDF on the rows of a set, with what its start and its refinement
+/// share: its G2 / (4 cos θo) on those rows and their plain weighted sums (G is held through
+/// the rounds: only D changes).
+pub(crate) struct Refinement<'a> {
+    ndf: &'a TabulatedNdf,
+    sub: &'a IsoSamples,
+    /// Samples in the set (the mean error's divisor, over three channels).
+    samples: usize,
+    tables: IsoTables,
+    ideals: RowIdeals,
+    plain: RowSums,
+}
+
+impl<'a> Refinement<'a> {
+    /// `None` when the NDF or the set is not isotropic.
+    pub fn new(ndf: &'a TabulatedNdf, set: &'a GridSamples) -> Option<Self> {
+        let sub = set.iso.as_ref().filter(|_| ndf.is_isotropic())?;
+        let tables = IsoTables::new(&model_of(ndf))?;
+        let ideals = sub.ideals(&tables);
+        let plain = sub.row_sums(&ideals);
+        Some(Refinement {
+            ndf,
+            sub,
+            samples: set.len().max(1),
+            tables,
+            ideals,
+            plain,
         })
-        .filter(|r| r.error < error)
-        .min_by(|a, b| a.error.total_cmp(&b.error))
+    }
+
+    /// F and ρd solved for the NDF as it is (with `IRLS` reweighted steps), and its error: the
+    /// refinement's start, as `crate::grid::fresnel_diffuse_and_error` gives it (the plain
+    /// sums cached, equal to f64 rounding).
+    pub fn start(&self) -> Solved {
+        let (f, q, e) = self.sub.fresnel_diffuse_and_error_sum_with(
+            &self.tables,
+            IRLS,
+            &self.ideals,
+            Some(&self.plain),
+        );
+        (f, q.map(|q| q * PI), self.mean(e))
+    }
+
+    /// The mean error per sample and channel of an error sum.
+    fn mean(&self, sum: f64) -> f64 {
+        sum / (3 * self.samples) as f64
+    }
+
+    /// The NDF refined from `start` ([`Self::start`]); `None` when nothing better was found.
+    pub fn run(&self, start: &Solved) -> Option<Refined> {
+        let (sub, ideals, plain) = (self.sub, &self.ideals, &self.plain);
+        let scan_rows = sub.diagonal(SCAN_STRIDE);
+        let scan_ideals = scan_rows.ideals(&self.tables);
+        let mut tables = self.tables.clone();
+        let d0 = tables.d32;
+        tables.set_fresnel(&start.0);
+        tables.diffuse = start.1.map(|a| a / PI);
+        let solve = |tables: &mut IsoTables| {
+            let (f, q, e) =
+                sub.fresnel_diffuse_and_error_sum_with(tables, ROUND_IRLS, ideals, Some(plain));
+            tables.set_fresnel(&f);
+            tables.diffuse = q;
+            e
+        };
+        let mut e = start.2 * (3 * self.samples) as f64;
+        let (mut ln_s, mut best) = ([0.0f64; THETA_H_RES], ([0.0f64; THETA_H_RES], e));
+        let (mut span, mut rounds) = (SPAN, 0);
+        while rounds < ROUNDS {
+            rounds += 1;
+            let medians = scan_rows.bin_medians(&tables, &scan_ideals, span as f32);
+            for (i, h) in medians.iter().enumerate() {
+                ln_s[i] += weighted_median(h, span);
+                tables.d32[i] = (d0[i] as f64 * ln_s[i].exp()) as f32;
+            }
+            let next = solve(&mut tables);
+            let gain = (e - next) / e;
+            if next < best.1 {
+                best = (ln_s, next);
+            }
+            e = next;
+            span *= 0.5;
+            if !(gain >= MIN_GAIN) {
+                break;
+            }
+        }
+        // A final candidate's F, ρd and error; one whose G is the rounds' (G1 held) reuses their
+        // G2 / (4 cos θo) and plain sums.
+        let solve_final = |ndf: &TabulatedNdf| {
+            let t = IsoTables::new(&model_of(ndf))?;
+            let (f, q, e) = if t.lambda_cos == self.tables.lambda_cos {
+                sub.fresnel_diffuse_and_error_sum_with(&t, IRLS, ideals, Some(plain))
+            } else {
+                sub.fresnel_diffuse_and_error_sum(&t, IRLS)
+            };
+            Some((f, q.map(|q| q * PI), self.mean(e)))
+        };
+        let ndf = self.ndf;
+        let d = rescaled_d(ndf, &best.0);
+        let held = ndf.tables().g1.clone();
+        let smith = smith_g1(&d, ndf.tables().ng)?;
+        [smith, held]
+            .into_iter()
+            .filter_map(|g1| {
+                let t = ndf.tables();
+                let tables = NdfTables {
+                    d: d.clone(),
+                    g1,
+                    ..t.clone()
+                };
+                let ndf = TabulatedNdf::new(tables, Stretch::IDENTITY).ok()?;
+                let (fresnel, albedo, error) = solve_final(&ndf)?;
+                Some(Refined {
+                    ndf,
+                    fresnel,
+                    albedo,
+                    error,
+                    rounds,
+                })
+            })
+            .filter(|r| r.error < start.2)
+            .min_by(|a, b| a.error.total_cmp(&b.error))
+    }
 }
 
 /// The weighted median of a [`crate::iso_grid::BinMedians`] histogram in ln s over
