@@ -390,12 +390,18 @@ fn fit_with(
             diffuse: lsq_diffuse,
         })
     };
-    let ggx = cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx)).transpose()?;
-    let beckmann = cfg
-        .models
-        .beckmann
-        .then(|| fit_kind(NdfKind::Beckmann))
-        .transpose()?;
+    // The two families side by side: their searches' passes are short (a few hundred rows) and
+    // their steps between passes serial, which one fit alone leaves the second core idle for.
+    let (ggx, beckmann) = rayon::join(
+        || cfg.models.ggx.then(|| fit_kind(NdfKind::Ggx)).transpose(),
+        || {
+            cfg.models
+                .beckmann
+                .then(|| fit_kind(NdfKind::Beckmann))
+                .transpose()
+        },
+    );
+    let (ggx, beckmann) = (ggx?, beckmann?);
     let fit_ms = ms(t);
 
     let t = Instant::now();
