@@ -242,12 +242,32 @@ impl Solver for CpuSolver {
         queries: &[[f64; 3]],
     ) -> Result<Vec<f64>, FitError> {
         let wv: Vec<f64> = v.iter().zip(&p.col).map(|(v, w)| v * w).collect();
+        if p.isotropic {
+            // The nodes' sin θ once, not once per query (768 queries a table).
+            let sin: Vec<f64> = p.dirs.iter().map(|h| h[0].hypot(h[1])).collect();
+            return Ok(queries
+                .par_iter()
+                .map(|q| project_isotropic(p, q, &sin, &wv))
+                .collect());
+        }
         Ok(queries.par_iter().map(|q| project(p, q, &wv)).collect())
     }
 
     fn name(&self) -> String {
         "cpu".into()
     }
+}
+
+/// Σ_h wv_h k(q, h) of an isotropic problem, the nodes' sin θ given: [`azimuthal`] with the
+/// lengths in xy taken once.
+fn project_isotropic(p: &Problem, q: &[f64; 3], sin: &[f64], wv: &[f64]) -> f64 {
+    let sin_q = q[0].hypot(q[1]);
+    p.dirs
+        .iter()
+        .zip(sin)
+        .zip(wv)
+        .map(|((h, s), wv)| azimuthal_ab(q[2] * h[2], sin_q * s) * wv)
+        .sum()
 }
 
 /// Σ_h wv_h k(q, h).
