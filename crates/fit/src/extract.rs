@@ -110,9 +110,10 @@ pub fn azimuthal_integral(theta_o: f64, theta_h: f64) -> f64 {
     azimuthal_ab(theta_o.cos() * theta_h.cos(), theta_o.sin() * theta_h.sin())
 }
 
-/// ∫₀^{2π} max(0, a + b cos φ) dφ for b ≥ 0.
+/// ∫₀^{2π} max(0, a + b cos φ) dφ for b ≥ 0 ([`azimuthal_integral`] is a = cos θo cos θh,
+/// b = sin θo sin θh).
 #[inline]
-fn azimuthal_ab(a: f64, b: f64) -> f64 {
+pub(crate) fn azimuthal_ab(a: f64, b: f64) -> f64 {
     if a >= b {
         2.0 * PI * a
     } else if a <= -b {

@@ -16,7 +16,7 @@
 //! start's.
 
 use crate::brdf::Rgb;
-use crate::extract::azimuthal_integral;
+use crate::extract::azimuthal_ab;
 use crate::grid::{GridSamples, IsoTables};
 use crate::iso_grid::{IsoSamples, MEDIAN_BUCKETS, RowIdeals, RowSums};
 use crate::merl::{THETA_H_RES, bin_angles};
@@ -274,12 +274,14 @@ fn smith_g1(d: &[f64], ng: usize) -> Option<Vec<f64>> {
     };
     let ndf = TabulatedNdf::new(tables, Stretch::IDENTITY).ok()?;
     const CELLS: usize = 512;
-    let nodes: Vec<(f64, f64)> = (0..CELLS)
+    // (cos θ, sin θ, weight) per cell: the 512 × 512 azimuthal integrals take no trigonometry.
+    let nodes: Vec<(f64, f64, f64)> = (0..CELLS)
         .map(|a| {
             let u = (a as f64 + 0.5) / CELLS as f64;
             let th = u * u * FRAC_PI_2;
             // dθ = π u du
-            (th, ndf.base_d(th, 0.0) * th.sin() * PI * u / CELLS as f64)
+            let w = ndf.base_d(th, 0.0) * th.sin() * PI * u / CELLS as f64;
+            (th.cos(), th.sin(), w)
         })
         .collect();
     Some(
@@ -287,9 +289,11 @@ fn smith_g1(d: &[f64], ng: usize) -> Option<Vec<f64>> {
             .into_par_iter()
             .map(|k| {
                 let to = theta_node(k, ng);
+                let (c, s) = (to.cos(), to.sin());
+                // ∫ D(h) ∫ <o, h>+ dφ: azimuthal_integral(θo, θh) with the cosines given
                 let i: f64 = nodes
                     .iter()
-                    .map(|&(th, w)| w * azimuthal_integral(to, th))
+                    .map(|&(ch, sh, w)| w * azimuthal_ab(c * ch, s * sh))
                     .sum();
                 if i > 0.0 {
                     (to.cos().max(0.0) / i).min(1.0)
