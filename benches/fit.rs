@@ -27,6 +27,8 @@ fn merl_file() -> PathBuf {
 fn load(c: &mut Criterion) {
     let path = merl_file();
     c.bench_function("merl_load", |b| b.iter(|| MerlBrdf::open(&path).unwrap()));
+    // As `facet fit` opens it: mapped, not read (the page cache's pages, no buffer to clear).
+    c.bench_function("merl_map", |b| b.iter(|| MerlBrdf::map(&path).unwrap()));
 }
 
 fn full_fit(c: &mut Criterion) {

@@ -6,7 +6,7 @@ use facet_fit::fit::{FitConfig, fit_material};
 use facet_fit::input::same_file;
 use facet_fit::nbrdf::NbrdfLibrary;
 use facet_fit::rgl::{BsdfResolution, RglBsdf, write_rgl};
-use facet_fit::source::open_source;
+use facet_fit::source::open_source_mapped;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -80,7 +80,7 @@ pub fn run(args: &ConvertArgs) -> Result<ExitCode> {
     };
     let t = Instant::now();
     let mut library: Option<NbrdfLibrary> = None;
-    let src = open_source(&args.input, args.nbrdf.as_deref(), &mut library)?;
+    let src = open_source_mapped(&args.input, args.nbrdf.as_deref(), &mut library)?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         crate::output::folder(dir, "OUT's folder")?;

@@ -5,7 +5,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use facet_fit::extract::{ExtractConfig, extract_isotropic};
 use facet_fit::microfacet::{MicrofacetBrdf, Ndf};
-use facet_fit::source::open_source;
+use facet_fit::source::open_source_mapped;
 use facet_glint::dpf::{DpfConfig, DpfPyramid, LEVELS_DEG, dpf, query_directions};
 use facet_gpu::Gpu;
 use std::path::{Path, PathBuf};
@@ -60,7 +60,7 @@ fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
         let fit = facet_fit::material::FittedMaterial::load(Path::new(spec))?;
         return Ok(fit.tabulated.ndf.clone());
     }
-    let src = open_source(spec, path.as_deref(), &mut library)?;
+    let src = open_source_mapped(spec, path.as_deref(), &mut library)?;
     let ex = extract_isotropic(src.as_ref(), &ExtractConfig::isotropic())?;
     let model = MicrofacetBrdf {
         name: spec.into(),

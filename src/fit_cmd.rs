@@ -11,7 +11,7 @@ use facet_fit::material::FittedMaterial;
 use facet_fit::merl::{MerlBrdf, MerlTable};
 use facet_fit::nbrdf::NbrdfLibrary;
 use facet_fit::quadrature::Quadrature;
-use facet_fit::source::open_source;
+use facet_fit::source::open_source_mapped;
 use facet_gpu::Gpu;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
@@ -101,7 +101,7 @@ type Opened = (Result<Box<dyn facet_fit::Brdf>, facet_fit::FitError>, f64);
 
 fn open_timed(input: &str, nbrdf: Option<&Path>, library: &mut Option<NbrdfLibrary>) -> Opened {
     let t = Instant::now();
-    let src = open_source(input, nbrdf, library);
+    let src = open_source_mapped(input, nbrdf, library);
     (src, t.elapsed().as_secs_f64() * 1e3)
 }
 

@@ -557,3 +557,51 @@ fn a_render_never_replaces_a_file_its_scene_reads() {
     );
     assert!(!dir.join("tex.exr").exists());
 }
+
+/// `facet fit` maps MERL files ([`MerlTable::map`]): every bad file gets the error a read gets,
+/// word for word (the mapped path only takes standard files and hands the rest to the reader).
+#[test]
+fn a_mapped_merl_file_is_refused_as_a_read_one() {
+    let dir = scratch("hostile_mapped");
+    let header = |dims: [i32; 3]| {
+        dims.iter()
+            .flat_map(|d| d.to_le_bytes())
+            .collect::<Vec<_>>()
+    };
+    let standard = |value: f64| {
+        let mut b = header([90, 90, 180]);
+        for _ in 0..3 * facet_fit::merl::SAMPLES {
+            b.extend(value.to_le_bytes());
+        }
+        b
+    };
+    let mut nan_at_end = standard(1.0);
+    let n = nan_at_end.len();
+    nan_at_end[n - 8..].copy_from_slice(&f64::NAN.to_le_bytes());
+    let mut cases: Vec<(&str, Vec<u8>)> = vec![
+        ("empty.binary", Vec::new()),
+        ("short-header.binary", vec![90, 0, 0]),
+        ("huge-values.binary", standard(1e308)),
+        ("nan-last.binary", nan_at_end),
+        ("small-dims.binary", header([1, 1, 1])),
+    ];
+    let mut swapped = standard(1.0);
+    swapped[..12].copy_from_slice(&header([180, 90, 90]));
+    cases.push(("swapped-dims.binary", swapped));
+    let mut long = standard(1.0);
+    long.push(0);
+    cases.push(("one-byte-long.binary", long));
+    for (name, bytes) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, &bytes).unwrap();
+        let read = MerlTable::read(&path).unwrap_err().to_string();
+        let mapped = MerlTable::map(&path).unwrap_err().to_string();
+        assert_eq!(mapped, read, "{name}");
+        assert!(read.contains(name), "{read}");
+        assert_eq!(std::fs::read(&path).unwrap(), bytes, "{name} changed");
+    }
+    for special in [dir.clone(), PathBuf::from("/dev/zero")] {
+        let read = MerlTable::read(&special).unwrap_err().to_string();
+        assert_eq!(MerlTable::map(&special).unwrap_err().to_string(), read);
+    }
+}

@@ -113,6 +113,57 @@ fn merl_write_read_round_trip_is_exact() {
     }
 }
 
+/// A mapped table (`facet fit`'s way) holds the values a read one does, bit for bit, missing
+/// samples included; changing it copies it into memory and leaves the file as it was.
+#[test]
+fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
+    let dir = scratch("merl_mapped");
+    let mut table = spec_table("ggx?alpha=0.1&f0=0.04&kd=0.2");
+    table.mark_missing(facet_fit::merl::index(30, 40, 50));
+    let path = dir.join("plastic.binary");
+    table.write(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let read = MerlTable::read(&path).unwrap();
+    let mut mapped = MerlTable::map(&path).unwrap();
+    assert!(mapped == read && mapped == table);
+    #[cfg(target_os = "linux")]
+    assert!(format!("{mapped:?}").ends_with("mapped)"), "{mapped:?}");
+    assert_eq!(mapped.missing_count(), read.missing_count());
+    for s in [0, 1234, facet_fit::merl::index(30, 40, 50), SAMPLES - 1] {
+        assert_eq!(
+            mapped.value_at(s).map(|v| v.map(f64::to_bits)),
+            read.value_at(s).map(|v| v.map(f64::to_bits))
+        );
+    }
+    // Both sources give the fit the same samples: the same fit, to the bit.
+    let cfg = facet_fit::FitConfig {
+        models: facet_fit::fit::Models {
+            tabulated: true,
+            ..facet_fit::fit::Models::NONE
+        },
+        ..facet_fit::FitConfig::isotropic()
+    };
+    let fit = |src: &MerlBrdf| {
+        let m = facet_fit::fit_material(src, "t", &cfg).unwrap();
+        m.record.tabulated.error.map(f64::to_bits)
+    };
+    assert_eq!(
+        fit(&MerlBrdf::map(&path).unwrap()),
+        fit(&MerlBrdf::open(&path).unwrap())
+    );
+    let s = facet_fit::merl::index(10, 20, 30);
+    mapped.scale_sample(s, [2.0; 3]);
+    let v = read.value_at(s).unwrap();
+    assert_eq!(mapped.value_at(s).unwrap(), v.map(|v| v * 2.0));
+    assert!(mapped.value_at(s + 1) == read.value_at(s + 1));
+    assert!(format!("{mapped:?}").ends_with("in memory)"), "{mapped:?}");
+    assert_eq!(
+        std::fs::read(&path).unwrap(),
+        bytes,
+        "the mapped file changed"
+    );
+}
+
 #[test]
 fn interpolated_lookup_beats_nearest_between_bins() {
     let model = parse_analytic("ggx?alpha=0.3&f0=0.04").unwrap();

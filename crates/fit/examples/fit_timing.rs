@@ -78,7 +78,7 @@ fn main() {
     );
     for path in files(&dir, &names) {
         let t = Instant::now();
-        let src = MerlBrdf::open(&path).unwrap();
+        let src = MerlBrdf::map(&path).unwrap();
         let load = t.elapsed().as_secs_f64() * 1e3;
         if std::env::var_os("PROBE").is_some() {
             probe(&src);

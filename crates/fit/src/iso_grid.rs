@@ -940,7 +940,7 @@ struct RowsOut<'a> {
 
 /// Fills rows from the MERL channels (AVX-512 or AVX2 where the CPU has it, as the passes);
 /// returns the first sample out of range.
-fn build_rows(out: RowsOut, raw: [&[f64]; 3], geo: &MerlGeometry) -> Option<(usize, [f32; 3])> {
+fn build_rows(out: RowsOut, raw: [&[[u8; 8]]; 3], geo: &MerlGeometry) -> Option<(usize, [f32; 3])> {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
@@ -959,7 +959,7 @@ fn build_rows(out: RowsOut, raw: [&[f64]; 3], geo: &MerlGeometry) -> Option<(usi
 #[target_feature(enable = "avx512f")]
 fn build_rows_avx512(
     out: RowsOut,
-    raw: [&[f64]; 3],
+    raw: [&[[u8; 8]]; 3],
     geo: &MerlGeometry,
 ) -> Option<(usize, [f32; 3])> {
     build_rows_baseline(out, raw, geo)
@@ -969,7 +969,7 @@ fn build_rows_avx512(
 #[target_feature(enable = "avx2")]
 fn build_rows_avx2(
     out: RowsOut,
-    raw: [&[f64]; 3],
+    raw: [&[[u8; 8]]; 3],
     geo: &MerlGeometry,
 ) -> Option<(usize, [f32; 3])> {
     build_rows_baseline(out, raw, geo)
@@ -978,7 +978,7 @@ fn build_rows_avx2(
 #[inline(always)]
 fn build_rows_baseline(
     out: RowsOut,
-    raw: [&[f64]; 3],
+    raw: [&[[u8; 8]]; 3],
     geo: &MerlGeometry,
 ) -> Option<(usize, [f32; 3])> {
     let mut bad = None;
@@ -988,8 +988,11 @@ fn build_rows_baseline(
         let valid: &mut [bool; ROW] = (&mut out.valid[n * PADDED..n * PADDED + ROW])
             .try_into()
             .unwrap();
-        let v: [&[f64; ROW]; 3] =
-            std::array::from_fn(|c| raw[c][r * ROW..(r + 1) * ROW].try_into().unwrap());
+        // The stored values, little-endian as in the file.
+        let v: [[f64; ROW]; 3] = std::array::from_fn(|c| {
+            let bytes: &[[u8; 8]; ROW] = raw[c][r * ROW..(r + 1) * ROW].try_into().unwrap();
+            bytes.map(f64::from_le_bytes)
+        });
         // Valid: both directions above the horizon and no channel missing (negative; a NaN
         // is a value, refused below as out of range).
         for k in 0..ROW {

@@ -10,6 +10,7 @@
 use crate::brdf::{Brdf, Rgb};
 use crate::error::FitError;
 use crate::geometry::{HalfDiff, from_half_diff, to_half_diff};
+use crate::mapped_file::MappedFile;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -57,62 +58,128 @@ fn bin_coords(c: HalfDiff) -> [f64; 3] {
 }
 
 /// The raw samples of a MERL file, exactly as stored.
-#[derive(Clone, PartialEq)]
 pub struct MerlTable {
-    /// 3 · SAMPLES stored values, channel-major, as in the file.
-    raw: Vec<f64>,
+    raw: Stored,
+}
+
+/// A table's 3 · SAMPLES values, channel-major as in the file, each as its eight little-endian
+/// bytes (the file's own encoding, which a mapped file's unaligned values keep).
+enum Stored {
+    Owned(Vec<[u8; 8]>),
+    /// A standard MERL file mapped whole: the values follow its 12-byte header.
+    Mapped(MappedFile),
+}
+
+impl Stored {
+    fn values(&self) -> &[[u8; 8]] {
+        match self {
+            Stored::Owned(v) => v,
+            Stored::Mapped(m) => bytemuck::cast_slice(&m.bytes()[HEADER_BYTES as usize..]),
+        }
+    }
+}
+
+impl Clone for MerlTable {
+    fn clone(&self) -> Self {
+        MerlTable {
+            raw: Stored::Owned(self.raw.values().to_vec()),
+        }
+    }
+}
+
+impl PartialEq for MerlTable {
+    /// The values compared as numbers (−0 = 0), however each table holds them.
+    fn eq(&self, other: &Self) -> bool {
+        let (a, b) = (self.raw.values(), other.raw.values());
+        a.iter()
+            .zip(b)
+            .all(|(a, b)| f64::from_le_bytes(*a) == f64::from_le_bytes(*b))
+    }
 }
 
 impl std::fmt::Debug for MerlTable {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let held = match self.raw {
+            Stored::Owned(_) => "in memory",
+            Stored::Mapped(_) => "mapped",
+        };
         write!(
             f,
-            "MerlTable({} samples, {} missing)",
+            "MerlTable({} samples, {} missing, {held})",
             SAMPLES,
             self.missing_count()
         )
     }
 }
 
+/// The stored value at flat position `at` (channel-major).
+#[inline(always)]
+fn stored(raw: &[[u8; 8]], at: usize) -> f64 {
+    f64::from_le_bytes(raw[at])
+}
+
 impl MerlTable {
-    /// Reads and validates a MERL `.binary` file.
+    /// Reads and validates a MERL `.binary` file into memory.
     pub fn read(path: &Path) -> Result<Self, FitError> {
-        if let Some(table) = Self::read_standard(path)? {
+        if let Some(table) = Self::read_standard(path, false)? {
             return Ok(table);
         }
         Self::parse(path, &crate::input::read(path, crate::input::Cap::MERL)?)
     }
 
-    /// A file of exactly the standard size with the standard header, read straight into the
-    /// table (one 35 MB buffer, not a byte copy beside it); `None` for any other file, which
-    /// [`MerlTable::parse`] then reads and explains.
-    fn read_standard(path: &Path) -> Result<Option<Self>, FitError> {
-        use std::io::Read;
-        if cfg!(target_endian = "big") {
-            return Ok(None);
+    /// Maps and validates a MERL `.binary` file: the fast way for a short-lived process, as
+    /// [`MerlTable::read`] in all else (the same errors; a file that is not standard, and any
+    /// system without `mmap`, is read). The file must not be truncated or rewritten in place
+    /// while the table lives: a read of the lost part would fault (see `mapped_file.rs`).
+    /// Replacing it by a rename, as [`MerlTable::write`] does, is safe.
+    pub fn map(path: &Path) -> Result<Self, FitError> {
+        if let Some(table) = Self::read_standard(path, true)? {
+            return Ok(table);
         }
+        Self::parse(path, &crate::input::read(path, crate::input::Cap::MERL)?)
+    }
+
+    /// A file of exactly the standard size with the standard header, mapped (`map`) or read
+    /// straight into the table (one 35 MB buffer, not a byte copy beside it); `None` for any
+    /// other file, which [`MerlTable::parse`] then reads and explains.
+    fn read_standard(path: &Path, map: bool) -> Result<Option<Self>, FitError> {
+        use std::io::Read;
         let (mut file, len) = crate::input::open(path, crate::input::Cap::MERL)?;
         if len != HEADER_BYTES + (3 * 8 * SAMPLES) as u64 {
             return Ok(None);
         }
-        let mut header = [0u8; HEADER_BYTES as usize];
-        let mut raw = vec![0.0f64; 3 * SAMPLES];
-        crate::huge_pages::advise(&mut raw);
         let io = |e| FitError::io(path, e);
-        file.read_exact(&mut header).map_err(io)?;
+        let mut header = [0u8; HEADER_BYTES as usize];
+        let raw = match map.then(|| MappedFile::map(&file, len as usize)).flatten() {
+            Some(m) => {
+                header.copy_from_slice(&m.bytes()[..HEADER_BYTES as usize]);
+                Stored::Mapped(m)
+            }
+            None => {
+                let mut raw = vec![[0u8; 8]; 3 * SAMPLES];
+                crate::huge_pages::advise(&mut raw);
+                file.read_exact(&mut header).map_err(io)?;
+                file.read_exact(bytemuck::cast_slice_mut(&mut raw))
+                    .map_err(io)?;
+                // One byte more would be a file that grew while read: the general path
+                // explains it.
+                if file.read(&mut [0u8]).map_err(io)? != 0 {
+                    return Ok(None);
+                }
+                Stored::Owned(raw)
+            }
+        };
         let dims: [i32; 3] = std::array::from_fn(|d| {
             i32::from_le_bytes(header[4 * d..4 * d + 4].try_into().unwrap())
         });
         if dims != [THETA_H_RES as i32, THETA_D_RES as i32, PHI_D_RES as i32] {
             return Ok(None);
         }
-        file.read_exact(bytemuck::cast_slice_mut(&mut raw))
-            .map_err(io)?;
-        // One byte more would be a file that grew while read: the general path explains it.
-        if file.read(&mut [0u8]).map_err(io)? != 0 {
-            return Ok(None);
-        }
-        if raw.iter().any(|v| !(*v <= MAX_STORED)) {
+        if raw
+            .values()
+            .iter()
+            .any(|v| !(f64::from_le_bytes(*v) <= MAX_STORED))
+        {
             return Ok(None); // the general path names the sample
         }
         Ok(Some(MerlTable { raw }))
@@ -166,12 +233,10 @@ impl MerlTable {
                 dims[0], dims[1], dims[2]
             )));
         }
-        let raw: Vec<f64> = bytes[HEADER_BYTES as usize..]
-            .chunks_exact(8)
-            .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
-            .collect();
+        let raw: Vec<[u8; 8]> = bytemuck::cast_slice(&bytes[HEADER_BYTES as usize..]).to_vec();
         // Missing samples are negative, whatever their size; a valid one is at most MAX_STORED.
-        if let Some(at) = raw.iter().position(|v| !(*v <= MAX_STORED)) {
+        if let Some(at) = (0..raw.len()).position(|at| !(stored(&raw, at) <= MAX_STORED)) {
+            let v = stored(&raw, at);
             let (c, s) = (at / SAMPLES, at % SAMPLES);
             let (i, j, k) = (
                 s / (PHI_D_RES * THETA_D_RES),
@@ -181,14 +246,16 @@ impl MerlTable {
             return Err(bad(format!(
                 "sample {s} of channel {} (θh bin {i}, θd bin {j}, φd bin {k}) is {:e}",
                 ["red", "green", "blue"][c],
-                raw[at],
-            ) + &if raw[at].is_finite() {
+                v,
+            ) + &if v.is_finite() {
                 format!(", above the {MAX_STORED:e} a measured value can be")
             } else {
                 String::new()
             }));
         }
-        Ok(MerlTable { raw })
+        Ok(MerlTable {
+            raw: Stored::Owned(raw),
+        })
     }
 
     /// Writes the table as a MERL file. The file is written beside its destination and renamed
@@ -200,13 +267,7 @@ impl MerlTable {
             for d in [THETA_H_RES, THETA_D_RES, PHI_D_RES] {
                 file.write_all(&(d as i32).to_le_bytes())?;
             }
-            if cfg!(target_endian = "big") {
-                for v in &self.raw {
-                    file.write_all(&v.to_le_bytes())?;
-                }
-            } else {
-                file.write_all(bytemuck::cast_slice(&self.raw))?;
-            }
+            file.write_all(bytemuck::cast_slice(self.raw.values()))?;
             file.into_inner().map_err(|e| e.into_error())?.sync_all()?;
             std::fs::rename(&tmp, path)
         })();
@@ -219,7 +280,7 @@ impl MerlTable {
     /// Samples any BRDF at the bin lower edges; below the horizon and where the source has no
     /// value the sample is marked missing (−1).
     pub fn sample<B: Brdf + ?Sized>(brdf: &B) -> Self {
-        let mut raw = vec![-1.0; 3 * SAMPLES];
+        let mut raw = vec![(-1.0f64).to_le_bytes(); 3 * SAMPLES];
         let values: Vec<Option<Rgb>> = (0..SAMPLES)
             .into_par_iter()
             .map(|s| {
@@ -238,17 +299,32 @@ impl MerlTable {
         for (s, v) in values.into_iter().enumerate() {
             if let Some(v) = v {
                 for c in 0..3 {
-                    raw[c * SAMPLES + s] = v[c] / SCALE[c];
+                    raw[c * SAMPLES + s] = (v[c] / SCALE[c]).to_le_bytes();
                 }
             }
         }
-        MerlTable { raw }
+        MerlTable {
+            raw: Stored::Owned(raw),
+        }
     }
 
-    /// The stored values of channel `c` (0 red, 1 green, 2 blue) in flat bin order: f_r is a
-    /// value times `SCALE[c]`, negative where missing.
-    pub(crate) fn channel(&self, c: usize) -> &[f64] {
-        &self.raw[c * SAMPLES..(c + 1) * SAMPLES]
+    /// The stored values of channel `c` (0 red, 1 green, 2 blue) in flat bin order, as
+    /// little-endian bytes: f_r is a value times `SCALE[c]`, negative where missing.
+    pub(crate) fn channel(&self, c: usize) -> &[[u8; 8]] {
+        &self.raw.values()[c * SAMPLES..(c + 1) * SAMPLES]
+    }
+
+    /// The values to change, copied into memory first if the table is a mapped file (which is
+    /// never written).
+    fn values_mut(&mut self) -> &mut [[u8; 8]] {
+        if let Stored::Mapped(m) = &self.raw {
+            let owned = bytemuck::cast_slice(&m.bytes()[HEADER_BYTES as usize..]).to_vec();
+            self.raw = Stored::Owned(owned);
+        }
+        match &mut self.raw {
+            Stored::Owned(v) => v,
+            Stored::Mapped(_) => unreachable!("copied just above"),
+        }
     }
 
     /// f_r of bin (i, j, k), or `None` if the sample is missing.
@@ -260,10 +336,11 @@ impl MerlTable {
     /// f_r of flat sample `s`, or `None` if the sample is missing.
     #[inline]
     pub fn value_at(&self, s: usize) -> Option<Rgb> {
+        let raw = self.raw.values();
         let r = [
-            self.raw[s],
-            self.raw[SAMPLES + s],
-            self.raw[2 * SAMPLES + s],
+            stored(raw, s),
+            stored(raw, SAMPLES + s),
+            stored(raw, 2 * SAMPLES + s),
         ];
         if r.iter().any(|&v| v < 0.0) {
             return None;
@@ -273,16 +350,19 @@ impl MerlTable {
 
     /// Marks flat sample `s` as missing.
     pub fn mark_missing(&mut self, s: usize) {
+        let raw = self.values_mut();
         for c in 0..3 {
-            self.raw[c * SAMPLES + s] = -1.0;
+            raw[c * SAMPLES + s] = (-1.0f64).to_le_bytes();
         }
     }
 
     /// Scales sample `s` by a per-channel factor (for noise experiments).
     pub fn scale_sample(&mut self, s: usize, factor: Rgb) {
+        let raw = self.values_mut();
         for (c, f) in factor.iter().enumerate() {
-            if self.raw[c * SAMPLES + s] >= 0.0 {
-                self.raw[c * SAMPLES + s] *= f;
+            let v = stored(raw, c * SAMPLES + s);
+            if v >= 0.0 {
+                raw[c * SAMPLES + s] = (v * f).to_le_bytes();
             }
         }
     }
@@ -348,9 +428,19 @@ pub struct MerlBrdf {
 }
 
 impl MerlBrdf {
-    /// Reads a MERL `.binary` file.
+    /// Reads a MERL `.binary` file into memory.
     pub fn open(path: &Path) -> Result<Self, FitError> {
-        let table = MerlTable::read(path)?;
+        Self::named(path, MerlTable::read(path)?)
+    }
+
+    /// Maps a MERL `.binary` file ([`MerlTable::map`]: faster, for a short-lived process; the
+    /// file must not be truncated in place while the source lives).
+    pub fn map(path: &Path) -> Result<Self, FitError> {
+        Self::named(path, MerlTable::map(path)?)
+    }
+
+    /// The table of the file at `path`, named after the file's stem.
+    fn named(path: &Path, table: MerlTable) -> Result<Self, FitError> {
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())

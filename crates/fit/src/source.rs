@@ -10,13 +10,32 @@ use crate::rgl::RglBsdf;
 use std::path::Path;
 
 /// An input: `nbrdf:NAME`, `analytic:SPEC`, a fit `.json` (its tabulated model), an RGL
-/// `.bsdf` or a MERL file (any other name).
+/// `.bsdf` or a MERL file (any other name, read into memory).
 /// `nbrdf` is the network file used for `nbrdf:` inputs (`None`: the embedded MERL-100
 /// proxies), opened on first use.
 pub fn open_source(
     input: &str,
     nbrdf: Option<&Path>,
     library: &mut Option<NbrdfLibrary>,
+) -> Result<Box<dyn Brdf>, FitError> {
+    open(input, nbrdf, library, false)
+}
+
+/// [`open_source`] for a short-lived process: a MERL file is mapped ([`MerlBrdf::map`]), not
+/// read, and must not be truncated in place while the source lives.
+pub fn open_source_mapped(
+    input: &str,
+    nbrdf: Option<&Path>,
+    library: &mut Option<NbrdfLibrary>,
+) -> Result<Box<dyn Brdf>, FitError> {
+    open(input, nbrdf, library, true)
+}
+
+fn open(
+    input: &str,
+    nbrdf: Option<&Path>,
+    library: &mut Option<NbrdfLibrary>,
+    map: bool,
 ) -> Result<Box<dyn Brdf>, FitError> {
     if let Some(name) = input.strip_prefix("nbrdf:") {
         if library.is_none() {
@@ -34,5 +53,8 @@ pub fn open_source(
     if path.extension().is_some_and(|e| e == "bsdf") {
         return Ok(Box::new(RglBsdf::open(path)?));
     }
-    Ok(Box::new(MerlBrdf::open(path)?))
+    Ok(Box::new(match map {
+        true => MerlBrdf::map(path)?,
+        false => MerlBrdf::open(path)?,
+    }))
 }
