@@ -12,8 +12,8 @@ use crate::gpu::{GpuFitter, gpu_error};
 #[cfg(feature = "gpu")]
 use crate::grid::IsoTables;
 use crate::grid::{
-    GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error, microfacet_error,
-    microfacet_errors,
+    GridSamples, PlainSolve, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error,
+    microfacet_error, microfacet_errors,
 };
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
@@ -122,10 +122,9 @@ impl Default for FitConfig {
 
 /// Reweighted steps of the F / ρd solves of the final steps (the searches take none).
 const FINAL_IRLS: usize = 2;
-/// Reweighted steps of the analytic fits' α bracket: none, the α found is solved again with
-/// `FINAL_IRLS` (on the 100 proxies: the same medians as reweighting every step, at 0.9× the
-/// time).
-const BRACKET_IRLS: usize = 0;
+// The analytic fits' α bracket takes no reweighted step: the α found continues from its plain
+// solve with `FINAL_IRLS` (`PlainSolve`; on the 100 proxies: the same medians as reweighting
+// every step, at 0.9× the time).
 /// The rows of the final steps with a diffuse lobe: about one in 4 ([`GridSamples::diagonal`],
 /// which keeps every θh and θd bin). F and ρd of every reported model are solved on them; its
 /// reported error is then measured on the full grid.
@@ -267,21 +266,37 @@ fn fit_with(
     } else {
         set.subsample(1)
     };
-    let full_error = |m: &MicrofacetBrdf, f: &[Rgb], albedo: Rgb| {
+    // The full grid's error of a model whose F and ρd were solved on the final steps' rows,
+    // where its mean error `e_final` is known: those rows' share and one pass over the others.
+    let other_rows = diffuse
+        .then(|| set.diagonal_complement(FINAL_STRIDE))
+        .flatten();
+    let full_error = |m: &MicrofacetBrdf, f: &[Rgb], albedo: Rgb, e_final: f64| {
         let with = MicrofacetBrdf {
             fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.to_vec())),
             diffuse: albedo,
             ..m.clone()
         };
-        microfacet_error(&with, &set)
+        match &other_rows {
+            Some(others) => {
+                let n = |s: &GridSamples| s.len() as f64;
+                let e_others = if others.is_empty() {
+                    0.0
+                } else {
+                    microfacet_error(&with, others)
+                };
+                (e_final * n(&final_steps) + e_others * n(others)) / n(&set)
+            }
+            None => microfacet_error(&with, &set),
+        }
     };
     // F and ρd solved on the final steps' rows, the error measured on the full grid.
     let solve_reported = |m: &MicrofacetBrdf| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
         if !diffuse {
             return solve(m);
         }
-        let (f, kd, _) = solve_on(m, &final_steps)?;
-        let e = full_error(m, &f, kd);
+        let (f, kd, e_final) = solve_on(m, &final_steps)?;
+        let e = full_error(m, &f, kd, e_final);
         Ok((f, kd, e))
     };
     // The paper's tabulated model: one lobe, F averaged for the extraction's D and G.
@@ -334,23 +349,24 @@ fn fit_with(
                 .map(|n| n.alpha_x.ln())
                 .collect();
             // With a diffuse lobe the bracket's F and ρd are plain weighted least squares, and
-            // the α found gets the reweighted solve.
-            let (t, e, (f, kd)) = refine_on_full_grid(&starts, |t| {
+            // the α found continues with the reweighted steps from its plain solve.
+            let (t, e, (f, kd, plain)) = refine_on_full_grid(&starts, |t| {
                 let m = model(AnalyticNdf::isotropic(kind, t.exp()));
-                let bracket = diffuse
-                    .then(|| fresnel_diffuse_and_error(&m, &final_steps, BRACKET_IRLS))
-                    .flatten();
-                let (f, kd, e) = match bracket {
-                    Some(r) => r,
+                let plain = diffuse.then(|| PlainSolve::new(&m, &final_steps)).flatten();
+                let (f, kd, e) = match &plain {
+                    Some(p) => p.solved.clone(),
                     None => solve_on(&m, &final_steps)?,
                 };
-                Ok::<_, FitError>((e, (f, kd)))
+                Ok::<_, FitError>((e, (f, kd, plain)))
             })?;
             let ndf = AnalyticNdf::isotropic(kind, t.exp());
             match diffuse {
                 true => {
-                    let (f, kd, _) = solve_on(&model(ndf), &final_steps)?;
-                    let e = full_error(&model(ndf), &f, kd);
+                    let (f, kd, e_final) = match plain {
+                        Some(p) => p.reweighted(&final_steps, FINAL_IRLS),
+                        None => solve_on(&model(ndf), &final_steps)?,
+                    };
+                    let e = full_error(&model(ndf), &f, kd, e_final);
                     (ndf, (f, kd, e))
                 }
                 false => (ndf, (f, kd, e)),
@@ -453,7 +469,7 @@ fn fit_with(
                     best = (r.ndf, r.fresnel, r.albedo, r.error, "power_iteration");
                 }
                 // Where an analytic fit is still better, its NDF tabulated is the start.
-                let error = full_error(&model_of(&best.0), &best.1, best.2);
+                let error = full_error(&model_of(&best.0), &best.1, best.2, best.3);
                 best_error = Some(error);
                 if let Some((kind, p)) = best_analytic.filter(|(_, p)| p.error < error) {
                     let analytic = AnalyticNdf::isotropic(kind, p.alpha_x);
@@ -470,15 +486,15 @@ fn fit_with(
                             refine_rounds += r.rounds;
                             start = (r.ndf, r.fresnel, r.albedo, r.error, kind.name());
                         }
-                        let e = full_error(&model_of(&start.0), &start.1, start.2);
+                        let e = full_error(&model_of(&start.0), &start.1, start.2, start.3);
                         if e < error {
                             (best, best_error) = (start, Some(e));
                         }
                     }
                 }
             }
-            let error =
-                best_error.unwrap_or_else(|| full_error(&model_of(&best.0), &best.1, best.2));
+            let error = best_error
+                .unwrap_or_else(|| full_error(&model_of(&best.0), &best.1, best.2, best.3));
             (ex, (best.0, best.1, best.2, Some(error), best.4))
         }
     };

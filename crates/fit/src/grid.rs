@@ -10,7 +10,7 @@
 use crate::brdf::{Brdf, Rgb};
 use crate::fresnel::Fresnel;
 use crate::geometry::{HalfDiff, azimuth_between, from_half_diff};
-use crate::iso_grid::IsoSamples;
+use crate::iso_grid::{IsoSamples, RowIdeals};
 use crate::merl::{self, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles};
 use crate::microfacet::{MicrofacetBrdf, Ndf, correlation, g2, lambda_from_alpha_tan};
 use glam::DVec3;
@@ -125,6 +125,16 @@ impl GridSamples {
             },
             None => self.subsample(stride),
         }
+    }
+
+    /// The rows of an isotropic source that [`Self::diagonal`] leaves out (the two split the
+    /// grid); `None` for an anisotropic one.
+    pub fn diagonal_complement(&self, stride: usize) -> Option<GridSamples> {
+        Some(GridSamples {
+            rotations: self.rotations.clone(),
+            samples: OnceLock::new(),
+            iso: Some(self.iso.as_ref()?.diagonal_complement(stride)),
+        })
     }
 
     /// The valid samples, in MERL bin order for each rotation. For an isotropic source they are
@@ -506,6 +516,46 @@ pub fn fresnel_diffuse_and_error(
     let (iso, tables) = (set.iso.as_ref()?, IsoTables::new(model)?);
     let (f, q, e) = iso.fresnel_diffuse_and_error_sum(&tables, irls);
     Some((f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64))
+}
+
+/// An isotropic model's plain weighted least-squares F and ρd on a set, and its error:
+/// [`fresnel_diffuse_and_error`] without a reweighted step (an α bracket's evaluation), kept
+/// with the rows' G2 / (4 cos θo) and the plain solution, from which
+/// [`PlainSolve::reweighted`] continues as `fresnel_diffuse_and_error` with reweighted steps
+/// would, to the bit, without forming G2 / (4 cos θo) and the plain sums again.
+pub(crate) struct PlainSolve {
+    tables: IsoTables,
+    ideals: RowIdeals,
+    /// F per θd bin and ρd/π of the plain solve.
+    plain: (Vec<Rgb>, Rgb),
+    /// F, ρd and the mean error of the plain solve, as `fresnel_diffuse_and_error` gives them.
+    pub solved: (Vec<Rgb>, Rgb, f64),
+}
+
+impl PlainSolve {
+    /// `None` where [`fresnel_diffuse_and_error`] gives `None` (a set or a model that is not
+    /// isotropic).
+    pub fn new(model: &MicrofacetBrdf, set: &GridSamples) -> Option<Self> {
+        let (iso, tables) = (set.iso.as_ref()?, IsoTables::new(model)?);
+        let ideals = iso.ideals(&tables);
+        let plain = iso.plain_solve(&tables, &ideals);
+        let (f, q, e) = iso.reweighted(&tables, plain.clone(), 0, &ideals);
+        let solved = (f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64);
+        Some(PlainSolve {
+            tables,
+            ideals,
+            plain,
+            solved,
+        })
+    }
+
+    /// F, ρd and the mean error on `set` (the set solved on) after `irls` reweighted steps
+    /// from the plain solve: `fresnel_diffuse_and_error(model, set, irls)`.
+    pub fn reweighted(&self, set: &GridSamples, irls: usize) -> (Vec<Rgb>, Rgb, f64) {
+        let iso = set.iso.as_ref().expect("an isotropic set, as solved on");
+        let (f, q, e) = iso.reweighted(&self.tables, self.plain.clone(), irls, &self.ideals);
+        (f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64)
+    }
 }
 
 /// Error of an isotropic model given as tables (the parameter searches' inner loop).

@@ -168,15 +168,21 @@ impl IsoSamples {
     /// ([`Self::subsample`] leaves the odd θd bins empty for an even stride, a row being
     /// θd bin + 90 θh bin; it suits the α searches, which need every θh bin near the peak.)
     pub fn diagonal(&self, stride: usize) -> Self {
-        let stride = stride.max(1);
+        self.rows_where(|r| on_diagonal(r, stride))
+    }
+
+    /// The rows of this set that [`Self::diagonal`] leaves out.
+    pub fn diagonal_complement(&self, stride: usize) -> Self {
+        self.rows_where(|r| !on_diagonal(r, stride))
+    }
+
+    /// The rows of this set for which `keep` holds.
+    fn rows_where(&self, keep: impl Fn(usize) -> bool) -> Self {
         let rows: Vec<u16> = self
             .rows
             .iter()
             .copied()
-            .filter(|&r| {
-                let r = r as usize;
-                (r / THETA_D_RES + r % THETA_D_RES).is_multiple_of(stride)
-            })
+            .filter(|&r| keep(r as usize))
             .collect();
         let count = rows
             .iter()
@@ -295,17 +301,37 @@ impl IsoSamples {
         ideals: &RowIdeals,
         plain: Option<&RowSums>,
     ) -> (Vec<Rgb>, Rgb, f64) {
-        let sums = match plain {
-            Some(plain) => self.plain_sums(tables, plain),
-            None => self.run(&WeightedRows {
-                set: self,
-                tables,
-                l1: false,
-                ideals,
-            }),
+        let start = match plain {
+            Some(plain) => self.plain_sums(tables, plain).solve(),
+            None => self.plain_solve(tables, ideals),
         };
+        self.reweighted(tables, start, irls, ideals)
+    }
+
+    /// The plain weighted least-squares F per θd bin and ρd/π for the D of `tables` and the G
+    /// of `ideals` (one pass).
+    pub fn plain_solve(&self, tables: &IsoTables, ideals: &RowIdeals) -> (Vec<Rgb>, Rgb) {
+        self.run(&WeightedRows {
+            set: self,
+            tables,
+            l1: false,
+            ideals,
+        })
+        .solve()
+    }
+
+    /// The second half of [`Self::fresnel_diffuse_and_error_sum_with`]: from the plain solve's
+    /// F per θd bin and ρd/π (`plain`), `irls` reweighted steps and the error sum; the best
+    /// solution measured.
+    pub fn reweighted(
+        &self,
+        tables: &IsoTables,
+        plain: (Vec<Rgb>, Rgb),
+        irls: usize,
+        ideals: &RowIdeals,
+    ) -> (Vec<Rgb>, Rgb, f64) {
         let mut tables = tables.clone();
-        let (mut fresnel, mut kd) = sums.solve();
+        let (mut fresnel, mut kd) = plain;
         let mut best: Option<(Vec<Rgb>, Rgb, f64)> = None;
         for _ in 0..irls {
             tables.set_fresnel(&fresnel);
@@ -926,6 +952,12 @@ fn run_rows_avx2<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16], first: us
 #[target_feature(enable = "avx512f,fma")]
 fn run_rows_avx512<P: RowPass>(pass: &P, acc: &mut P::Acc, rows: &[u16], first: usize) {
     run_rows_baseline(pass, acc, rows, first)
+}
+
+/// Whether row `r` (θd bin + 90 θh bin) has (θh bin + θd bin) ≡ 0 mod `stride` (a stride of 0
+/// taken as 1).
+fn on_diagonal(r: usize, stride: usize) -> bool {
+    (r / THETA_D_RES + r % THETA_D_RES).is_multiple_of(stride.max(1))
 }
 
 /// The outputs of consecutive rows of an [`IsoData`] being built.
