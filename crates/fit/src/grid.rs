@@ -681,4 +681,57 @@ mod tests {
         }
         assert!(worst < 1.5e-7, "ln y: worst error {worst}");
     }
+
+    /// The final steps' rows and the rest split the grid, and the full grid's error is their
+    /// errors weighted by their sample counts (the fit's reported errors are measured so): the
+    /// same row sums added in another order, equal to f64 rounding.
+    #[test]
+    fn diagonal_and_complement_split_the_grid_and_its_error() {
+        use super::*;
+        use crate::microfacet::{AnalyticNdf, NdfKind};
+        let src = crate::analytic::parse_analytic("ggx?alpha=0.2&f0=0.04&kd=0.3,0.1,0.05").unwrap();
+        let set = GridSamples::new(&src);
+        let (quarter, rest) = (set.diagonal(4), set.diagonal_complement(4).unwrap());
+        assert_eq!(quarter.len() + rest.len(), set.len());
+        let (q, o) = (quarter.iso.as_ref().unwrap(), rest.iso.as_ref().unwrap());
+        assert!(q.rows.iter().all(|r| !o.rows.contains(r)));
+        let mut model = MicrofacetBrdf::ideal(
+            "m",
+            Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Beckmann, 0.25)),
+        );
+        model.diffuse = [0.2, 0.1, 0.05];
+        let n = |s: &GridSamples| s.len() as f64;
+        let split = (microfacet_error(&model, &quarter) * n(&quarter)
+            + microfacet_error(&model, &rest) * n(&rest))
+            / n(&set);
+        let full = microfacet_error(&model, &set);
+        assert!((split - full).abs() <= 1e-12 * full, "{split} vs {full}");
+    }
+
+    /// An α bracket's plain solve, continued with reweighted steps, is the solve with those
+    /// steps from scratch, to the bit.
+    #[test]
+    fn a_plain_solve_continues_as_the_full_solve() {
+        use super::*;
+        use crate::microfacet::{AnalyticNdf, NdfKind};
+        let src = crate::analytic::parse_analytic("beckmann?alpha=0.15&f0=0.04&kd=0.2").unwrap();
+        let set = GridSamples::new(&src).diagonal(4);
+        let model = MicrofacetBrdf::ideal(
+            "m",
+            Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Ggx, 0.2)),
+        );
+        let plain = PlainSolve::new(&model, &set).unwrap();
+        let bits = |(f, kd, e): (Vec<Rgb>, Rgb, f64)| {
+            let f: Vec<u64> = f.iter().flatten().map(|v| v.to_bits()).collect();
+            (f, kd.map(f64::to_bits), e.to_bits())
+        };
+        assert_eq!(
+            bits(plain.solved.clone()),
+            bits(fresnel_diffuse_and_error(&model, &set, 0).unwrap())
+        );
+        assert_eq!(
+            bits(plain.reweighted(&set, 2)),
+            bits(fresnel_diffuse_and_error(&model, &set, 2).unwrap())
+        );
+    }
 }
