@@ -10,7 +10,7 @@
 use crate::brdf::{Brdf, Rgb};
 use crate::fresnel::Fresnel;
 use crate::geometry::{HalfDiff, azimuth_between, from_half_diff};
-use crate::iso_grid::{IsoSamples, RowIdeals};
+use crate::iso_grid::{CoarseSamples, IsoSamples};
 use crate::merl::{self, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles};
 use crate::microfacet::{MicrofacetBrdf, Ndf, correlation, g2, lambda_from_alpha_tan};
 use glam::DVec3;
@@ -125,6 +125,12 @@ impl GridSamples {
             },
             None => self.subsample(stride),
         }
+    }
+
+    /// The rows of an isotropic set with every fourth φd bin ([`CoarseGrid`]); `None` for an
+    /// anisotropic one.
+    pub fn coarse(&self) -> Option<CoarseGrid> {
+        Some(CoarseGrid(self.iso.as_ref()?.coarse()))
     }
 
     /// The rows of an isotropic source that [`Self::diagonal`] leaves out (the two split the
@@ -518,43 +524,22 @@ pub fn fresnel_diffuse_and_error(
     Some((f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64))
 }
 
-/// An isotropic model's plain weighted least-squares F and ρd on a set, and its error:
-/// [`fresnel_diffuse_and_error`] without a reweighted step (an α bracket's evaluation), kept
-/// with the rows' G2 / (4 cos θo) and the plain solution, from which
-/// [`PlainSolve::reweighted`] continues as `fresnel_diffuse_and_error` with reweighted steps
-/// would, to the bit, without forming G2 / (4 cos θo) and the plain sums again.
-pub(crate) struct PlainSolve {
-    tables: IsoTables,
-    ideals: RowIdeals,
-    /// F per θd bin and ρd/π of the plain solve.
-    plain: (Vec<Rgb>, Rgb),
-    /// F, ρd and the mean error of the plain solve, as `fresnel_diffuse_and_error` gives them.
-    pub solved: (Vec<Rgb>, Rgb, f64),
-}
+/// The rows of an isotropic set with every fourth φd bin ([`GridSamples::coarse`]): a
+/// quarter of its samples, every (θh, θd) row kept. The analytic fits' α bracket runs here.
+pub struct CoarseGrid(CoarseSamples);
 
-impl PlainSolve {
-    /// `None` where [`fresnel_diffuse_and_error`] gives `None` (a set or a model that is not
-    /// isotropic).
-    pub fn new(model: &MicrofacetBrdf, set: &GridSamples) -> Option<Self> {
-        let (iso, tables) = (set.iso.as_ref()?, IsoTables::new(model)?);
-        let ideals = iso.ideals(&tables);
-        let plain = iso.plain_solve(&tables, &ideals);
-        let (f, q, e) = iso.reweighted(&tables, plain.clone(), 0, &ideals);
-        let solved = (f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64);
-        Some(PlainSolve {
-            tables,
-            ideals,
-            plain,
-            solved,
-        })
-    }
-
-    /// F, ρd and the mean error on `set` (the set solved on) after `irls` reweighted steps
-    /// from the plain solve: `fresnel_diffuse_and_error(model, set, irls)`.
-    pub fn reweighted(&self, set: &GridSamples, irls: usize) -> (Vec<Rgb>, Rgb, f64) {
-        let iso = set.iso.as_ref().expect("an isotropic set, as solved on");
-        let (f, q, e) = iso.reweighted(&self.tables, self.plain.clone(), irls, &self.ideals);
-        (f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64)
+impl CoarseGrid {
+    /// The mean error on these rows of `model` with its F (and with `diffuse` its ρd) solved
+    /// on them: with `diffuse` a plain weighted least-squares solve
+    /// ([`fresnel_diffuse_and_error`] without a reweighted step), without it the Fresnel
+    /// average ([`fresnel_and_error`]). `None` for a model that is not isotropic.
+    pub fn error(&self, model: &MicrofacetBrdf, diffuse: bool) -> Option<f64> {
+        let tables = IsoTables::new(model)?;
+        let e = match diffuse {
+            true => self.0.fresnel_diffuse_and_error_sum(&tables, 0).2,
+            false => self.0.fresnel_and_error_sum(&tables).1,
+        };
+        Some(e / (3 * self.0.count.max(1)) as f64)
     }
 }
 
@@ -706,32 +691,5 @@ mod tests {
             / n(&set);
         let full = microfacet_error(&model, &set);
         assert!((split - full).abs() <= 1e-12 * full, "{split} vs {full}");
-    }
-
-    /// An α bracket's plain solve, continued with reweighted steps, is the solve with those
-    /// steps from scratch, to the bit.
-    #[test]
-    fn a_plain_solve_continues_as_the_full_solve() {
-        use super::*;
-        use crate::microfacet::{AnalyticNdf, NdfKind};
-        let src = crate::analytic::parse_analytic("beckmann?alpha=0.15&f0=0.04&kd=0.2").unwrap();
-        let set = GridSamples::new(&src).diagonal(4);
-        let model = MicrofacetBrdf::ideal(
-            "m",
-            Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Ggx, 0.2)),
-        );
-        let plain = PlainSolve::new(&model, &set).unwrap();
-        let bits = |(f, kd, e): (Vec<Rgb>, Rgb, f64)| {
-            let f: Vec<u64> = f.iter().flatten().map(|v| v.to_bits()).collect();
-            (f, kd.map(f64::to_bits), e.to_bits())
-        };
-        assert_eq!(
-            bits(plain.solved.clone()),
-            bits(fresnel_diffuse_and_error(&model, &set, 0).unwrap())
-        );
-        assert_eq!(
-            bits(plain.reweighted(&set, 2)),
-            bits(fresnel_diffuse_and_error(&model, &set, 2).unwrap())
-        );
     }
 }

@@ -19,26 +19,37 @@ pub(crate) const ROWS: usize = THETA_H_RES * THETA_D_RES;
 pub(crate) const ROW: usize = PHI_D_RES;
 /// Cosines per row: μ_k for k = 0..=180.
 pub(crate) const MU_ROW: usize = PHI_D_RES + 1;
+/// The coarse rows' φd stride: bins k = 4j and cosines μ_4j. It divides 180, so a coarse row
+/// keeps the symmetry k ↔ 180 − k (j ↔ 45 − j).
+pub(crate) const COARSE_STRIDE: usize = 4;
+/// Bins per coarse row.
+pub(crate) const COARSE_ROW: usize = ROW / COARSE_STRIDE;
+/// Cosines per coarse row.
+pub(crate) const COARSE_MU_ROW: usize = COARSE_ROW + 1;
+const _: () = assert!(ROW.is_multiple_of(COARSE_STRIDE));
 
 /// Per-row cosines and per-bin correlations of the MERL grid.
 pub(crate) struct MerlGeometry {
-    /// μ_k = cos θh cos θd + sin θh sin θd cos(kπ/180), `MU_ROW` per row.
+    /// Bins per row: `ROW`, or `COARSE_ROW` for the coarse rows.
+    row: usize,
+    /// μ_k = cos θh cos θd + sin θh sin θd cos(kπ/180), `row` + 1 per row.
     pub mu: Vec<f32>,
-    /// λ(φ) of G2 for each bin, `ROW` per row (the flat MERL bin order).
+    /// λ(φ) of G2 for each bin, `row` per row (the flat MERL bin order).
     pub corr: Vec<f32>,
 }
 
 impl MerlGeometry {
-    /// μ_k of row `r`, k = 0..=180.
+    /// μ_k of row `r`, k = 0..=180 (coarse: μ_4j, j = 0..=45).
     #[inline]
     pub fn mu_row(&self, r: usize) -> &[f32] {
-        &self.mu[r * MU_ROW..(r + 1) * MU_ROW]
+        let n = self.row + 1;
+        &self.mu[r * n..(r + 1) * n]
     }
 
     /// λ(φ) of the bins of row `r`.
     #[inline]
     pub fn corr_row(&self, r: usize) -> &[f32] {
-        &self.corr[r * ROW..(r + 1) * ROW]
+        &self.corr[r * self.row..(r + 1) * self.row]
     }
 }
 
@@ -46,6 +57,42 @@ impl MerlGeometry {
 pub(crate) fn merl_geometry() -> &'static MerlGeometry {
     static GEOMETRY: OnceLock<MerlGeometry> = OnceLock::new();
     GEOMETRY.get_or_init(build)
+}
+
+/// The geometry of rows of `N` bins: the full grid's (`N` = `ROW`) or the coarse rows'
+/// (`N` = `COARSE_ROW`, gathered from the full one on first use).
+#[inline]
+pub(crate) fn row_geometry<const N: usize>() -> &'static MerlGeometry {
+    static COARSE: OnceLock<MerlGeometry> = OnceLock::new();
+    match N {
+        ROW => merl_geometry(),
+        COARSE_ROW => COARSE.get_or_init(|| coarse(merl_geometry())),
+        _ => unreachable!("rows of {N} bins: {ROW} or {COARSE_ROW}"),
+    }
+}
+
+/// Every `COARSE_STRIDE`-th cosine and bin of each row of `full`.
+fn coarse(full: &MerlGeometry) -> MerlGeometry {
+    let mut mu = vec![0.0f32; ROWS * COARSE_MU_ROW];
+    let mut corr = vec![0.0f32; ROWS * COARSE_ROW];
+    for r in 0..ROWS {
+        let (from, to) = (
+            full.mu_row(r),
+            &mut mu[r * COARSE_MU_ROW..][..COARSE_MU_ROW],
+        );
+        for (j, m) in to.iter_mut().enumerate() {
+            *m = from[COARSE_STRIDE * j];
+        }
+        let (from, to) = (full.corr_row(r), &mut corr[r * COARSE_ROW..][..COARSE_ROW]);
+        for (j, c) in to.iter_mut().enumerate() {
+            *c = from[COARSE_STRIDE * j];
+        }
+    }
+    MerlGeometry {
+        row: COARSE_ROW,
+        mu,
+        corr,
+    }
 }
 
 fn build() -> MerlGeometry {
@@ -91,7 +138,7 @@ fn build() -> MerlGeometry {
                 }
             }
         });
-    MerlGeometry { mu, corr }
+    MerlGeometry { row: ROW, mu, corr }
 }
 
 /// acos x, x clamped to [−1, 1], to 2e-8 absolute (Abramowitz & Stegun 4.4.46:

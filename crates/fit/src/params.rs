@@ -20,7 +20,7 @@ const COARSE_SCAN: usize = 12;
 /// The α searches' tolerance in ln α, relative to max(|ln α|, 1): 0.02 % in α near α = 1, where
 /// a tolerance relative to |ln α| alone vanished. (Absolute 2e-3 in ln α took 1–4 fewer of the
 /// 30–40 evaluations, but the ground truth's α came back 0.03 % off instead of 0.005 %: the ±5 %
-/// bracket of the final steps, [`refine_on_full_grid`], skips a vertex of tiny predicted gain.)
+/// bracket of the final steps, [`refine_by_bracket`], skips a vertex of tiny predicted gain.)
 const SEARCH_TOLERANCE: f64 = 2e-4;
 
 /// E|x~ cos ψ + y~ sin ψ| of the tabulated slope distribution for ψ = 0, 45°, 90°, 135°.
@@ -187,16 +187,18 @@ pub fn fit_least_squares(
     canonical(make(&p))
 }
 
-/// The final steps of an isotropic least-squares fit on the reporting (full) grid, from the
-/// search's candidates ln α ∈ `starts` ([`least_squares_candidates`]): `error(t)` is the
-/// full-grid error at ln α = t with its own Fresnel table. Each start is evaluated and the
-/// lowest, t0, kept; ln α is evaluated at t0 ± h, the bracket moved by h towards the lower side
-/// (at most `MOVES` times) until its centre is lowest, then the parabola's vertex through the
-/// three points; the lowest point evaluated wins. Returns (t, error, Fresnel) of that point.
-/// The error near its minimum is close to a parabola in ln α, and the search's subsampled grid
-/// puts its minimum within a few percent of the full grid's (`examples/fit_timing.rs` sweeps
-/// it), so one bracket of h = 0.05 (5 % in α) and one vertex usually suffice: four passes.
-pub fn refine_on_full_grid<F, E>(
+/// The final steps of an isotropic least-squares fit, from the search's candidates
+/// ln α ∈ `starts` ([`least_squares_candidates`]): `error(t)` is the error at ln α = t with the
+/// model's own Fresnel table (and ρd) on the bracket's rows, finer than the search's (the fit
+/// uses the final steps' rows with every fourth φd bin, [`crate::grid::GridSamples::coarse`]).
+/// Each start is evaluated and the lowest, t0, kept; ln α is evaluated at t0 ± h, the bracket
+/// moved by h towards the lower side (at most `MOVES` times) until its centre is lowest, then
+/// the parabola's vertex through the three points; the lowest point evaluated wins. Returns
+/// (t, error, payload) of that point. The error near its minimum is close to a parabola in
+/// ln α, and the search's subsampled grid puts its minimum within a few percent of the finer
+/// rows' (`examples/fit_timing.rs` sweeps it), so one bracket of h = 0.05 (5 % in α) and one
+/// vertex usually suffice: four evaluations.
+pub fn refine_by_bracket<F, E>(
     starts: &[f64],
     mut error: impl FnMut(f64) -> Result<(f64, F), E>,
 ) -> Result<(f64, f64, F), E> {
