@@ -12,13 +12,16 @@ use crate::gpu::{GpuFitter, gpu_error};
 #[cfg(feature = "gpu")]
 use crate::grid::IsoTables;
 use crate::grid::{
-    GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error, microfacet_error,
-    microfacet_errors,
+    CoarseGrid, GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error,
+    microfacet_error, microfacet_errors,
 };
 use crate::material::{FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
-use crate::params::{fit_least_squares, fit_moments, least_squares_candidates, refine_by_bracket};
+use crate::params::{
+    candidates_of, fit_least_squares, fit_moments, least_squares_candidates, refine_by_bracket,
+};
 use crate::refine::{Refinement, model_of, tabulate};
+use crate::tabulated::TabulatedNdf;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -58,12 +61,13 @@ pub struct FitConfig {
     /// Which models to fit and report.
     pub models: Models,
     /// The least-squares searches run on a subsampled grid ([`GridSamples::subsample`]: every
-    /// `search_stride`-th (θh, θd) row of an isotropic source, every `search_stride`-th sample
-    /// of an anisotropic one); an isotropic fit then brackets α
+    /// `search_stride`-th (θh, θd) row of an isotropic source, an isotropic fit's α search on
+    /// every fourth φd bin of those rows ([`GridSamples::coarse`]); every `search_stride`-th
+    /// sample of an anisotropic one); an isotropic fit then brackets α
     /// ([`crate::params::refine_by_bracket`]) on every fourth φd bin of the final steps' rows
-    /// ([`GridSamples::coarse`]), solves F (and ρd) for the α found on those rows: the full grid,
-    /// or with a diffuse lobe a quarter of it ([`GridSamples::diagonal`]); the reported errors
-    /// use every sample.
+    /// (the full grid, or with a diffuse lobe a quarter of it, [`GridSamples::diagonal`]) and
+    /// solves F for the α found: averaged over the full grid, or with a diffuse lobe solved with
+    /// ρd on the bracket's rows. The reported errors use every sample.
     pub search_stride: usize,
     /// Fit a Lambertian lobe ρd with every model and keep F in [0, 1] ([`crate::diffuse`]);
     /// false: the paper's single specular lobe with F averaged. Isotropic fits only: an
@@ -122,17 +126,26 @@ impl Default for FitConfig {
 
 /// Reweighted steps of the F / ρd solves of the final steps (the searches take none).
 const FINAL_IRLS: usize = 2;
-// The analytic fits' α bracket runs on the final steps' rows with every fourth φd bin
-// (`GridSamples::coarse`), with a diffuse lobe without reweighted steps; the α found is then
-// solved, with `FINAL_IRLS` steps, on the final steps' rows. (On the 100 proxies plain steps
-// gave the same medians as reweighted ones at 0.9× the time. The coarse rows gave the same
-// medians and 90th percentiles in both pipelines; 399 of the 400 analytic fits within 0.2 %,
-// polyethylene's GGX 3 % worse, its plain error being flat and bumpy in α. Every fourth row
-// instead, a diagonal of stride 16, made sharp lobes' fits up to 2.9 times worse.)
+// The analytic fits' α search runs on every fourth φd bin of the search's rows, the bracket on
+// every fourth φd bin of the final steps' rows (`GridSamples::coarse`), with a diffuse lobe
+// without reweighted steps; the α found is then solved with `FINAL_IRLS` steps. (On the 100
+// proxies plain steps gave the same medians as reweighted ones at 0.9× the time. The coarse
+// bracket gave the same medians and 90th percentiles in both pipelines; 399 of the 400
+// analytic fits within 0.2 %, polyethylene's GGX 3 % worse, its plain error being flat and
+// bumpy in α. Every fourth row instead, a diagonal of stride 16, made sharp lobes' fits up to
+// 2.9 times worse. The coarse search: the diffuse pipeline's 300 fits unchanged to the digits
+// printed, the single lobe's medians too, 4 Beckmann fits better (at most 3.4 %) and 4 worse
+// (at most 4.2 %).)
 /// The rows of the final steps with a diffuse lobe: about one in 4 ([`GridSamples::diagonal`],
-/// which keeps every θh and θd bin). F and ρd of every reported model are solved on them; its
-/// reported error is then measured on the full grid.
+/// which keeps every θh and θd bin). F and ρd of every reported model are solved on their every
+/// fourth φd bin, a sixteenth of the grid, and its reported error is measured on the full grid;
+/// the physical Fresnel curves' errors are measured on these rows. (On the 100 proxies, the
+/// solves on the sixteenth against the quarter: 14 of the 200 analytic fits' errors moved, by
+/// at most 0.15 %.)
 const FINAL_STRIDE: usize = 4;
+
+/// A tabulated candidate: its NDF, F per θd bin and ρd.
+type Candidate = (TabulatedNdf, Vec<Rgb>, Rgb);
 
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
@@ -263,44 +276,36 @@ fn fit_with(
             Ok((f, [0.0; 3], e))
         };
     let solve = |m: &MicrofacetBrdf| solve_on(m, &set);
-    // The final steps: with a diffuse lobe (each step four passes) on a quarter of the rows,
-    // and the reported error of the model found (its F and ρd from them) on the full grid.
+    // The final steps' rows: with a diffuse lobe a quarter of the rows, the full grid without.
     let final_steps = if diffuse {
         set.diagonal(FINAL_STRIDE)
     } else {
         set.subsample(1)
     };
-    // The full grid's error of a model whose F and ρd were solved on the final steps' rows,
-    // where its mean error `e_final` is known: those rows' share and one pass over the others.
-    let other_rows = diffuse
-        .then(|| set.diagonal_complement(FINAL_STRIDE))
-        .flatten();
-    let full_error = |m: &MicrofacetBrdf, f: &[Rgb], albedo: Rgb, e_final: f64| {
-        let with = MicrofacetBrdf {
-            fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.to_vec())),
-            diffuse: albedo,
-            ..m.clone()
-        };
-        match &other_rows {
-            Some(others) => {
-                let n = |s: &GridSamples| s.len() as f64;
-                let e_others = if others.is_empty() {
-                    0.0
-                } else {
-                    microfacet_error(&with, others)
-                };
-                (e_final * n(&final_steps) + e_others * n(others)) / n(&set)
-            }
-            None => microfacet_error(&with, &set),
-        }
+    // A model with its F table and ρd solved.
+    let solved = |m: &MicrofacetBrdf, f: &[Rgb], albedo: Rgb| MicrofacetBrdf {
+        fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.to_vec())),
+        diffuse: albedo,
+        ..m.clone()
     };
-    // F and ρd solved on the final steps' rows, the error measured on the full grid.
+    let analytic = cfg.models.ggx || cfg.models.beckmann;
+    // Every fourth φd bin of the final steps' rows ([`GridSamples::coarse`]): the analytic
+    // fits' α bracket runs on them, and with a diffuse lobe every model's F / ρd solve and the
+    // tabulated NDF's refinement.
+    let coarse = (analytic || diffuse)
+        .then(|| final_steps.coarse())
+        .flatten();
+    // A model's F and ρd, and its error on the full grid: with a diffuse lobe F and ρd solved
+    // on the coarse rows (`FINAL_IRLS` reweighted steps), without one averaged over the grid.
     let solve_reported = |m: &MicrofacetBrdf| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
-        if !diffuse {
+        let on_coarse = coarse
+            .as_ref()
+            .filter(|_| diffuse)
+            .and_then(|c| c.fresnel_diffuse_and_error(m, FINAL_IRLS));
+        let Some((f, kd, _)) = on_coarse else {
             return solve(m);
-        }
-        let (f, kd, e_final) = solve_on(m, &final_steps)?;
-        let e = full_error(m, &f, kd, e_final);
+        };
+        let e = microfacet_error(&solved(m, &f, kd), &set);
         Ok((f, kd, e))
     };
     // The paper's tabulated model: one lobe, F averaged for the extraction's D and G.
@@ -338,30 +343,37 @@ fn fit_with(
 
     let t = Instant::now();
     let search = set.subsample(cfg.search_stride);
-    let analytic = cfg.models.ggx || cfg.models.beckmann;
-    let bracket = analytic.then(|| final_steps.coarse()).flatten();
+    // An isotropic fit's α search on every fourth φd bin of those rows.
+    let coarse_search = (analytic && !cfg.anisotropic)
+        .then(|| search.coarse())
+        .flatten();
     let fit_kind = |kind: NdfKind| -> Result<ParamRecord, FitError> {
         let moments = fit_moments(kind, &ex.ndf);
         let model = |ndf: AnalyticNdf| MicrofacetBrdf::ideal("lsq", Ndf::Analytic(ndf));
-        // Isotropic: the α bracket on the coarse rows, F and ρd on the final steps' rows, the
-        // error on the full grid (coarse to fine).
+        // Isotropic: the α search and bracket on coarse rows, F and ρd on the final steps'
+        // rows, the error on the full grid (coarse to fine).
         let (lsq, (lsq_fresnel, lsq_diffuse, error)) = if cfg.anisotropic {
             let lsq = fit_least_squares(moments, true, diffuse, &search);
             (lsq, solve(&model(lsq))?)
         } else {
             // The search's candidates compete on the bracket's rows.
-            let starts: Vec<f64> = least_squares_candidates(moments, diffuse, &search)
-                .iter()
-                .map(|n| n.alpha_x.ln())
-                .collect();
+            let starts: Vec<f64> = match &coarse_search {
+                // (`error` is `None` only for an anisotropic model.)
+                Some(rows) => candidates_of(moments, |n| {
+                    rows.error(&model(n), diffuse).unwrap_or(f64::INFINITY)
+                }),
+                None => least_squares_candidates(moments, diffuse, &search),
+            }
+            .iter()
+            .map(|n| n.alpha_x.ln())
+            .collect();
             // The bracket's F (and ρd) are averaged (plain weighted least squares) on the
-            // coarse rows; the α found is solved on the final steps' rows (with a diffuse
-            // lobe, with reweighted steps).
+            // coarse rows; the α found is solved again (`solve_reported`).
             let (t, e, solved) = refine_by_bracket(&starts, |t| {
                 let m = model(AnalyticNdf::isotropic(kind, t.exp()));
-                match bracket.as_ref().and_then(|b| b.error(&m, diffuse)) {
+                match coarse.as_ref().and_then(|b| b.error(&m, diffuse)) {
                     Some(e) => Ok::<_, FitError>((e, None)),
-                    None => solve_on(&m, &final_steps).map(|(f, kd, e)| (e, Some((f, kd)))),
+                    None => solve(&m).map(|(f, kd, e)| (e, Some((f, kd)))),
                 }
             })?;
             let ndf = AnalyticNdf::isotropic(kind, t.exp());
@@ -447,53 +459,40 @@ fn fit_with(
             })?;
             separation_rounds = sep.rounds;
             let ex = sep.extraction;
-            // The candidates compete on the final steps' rows; the one kept is measured on the
-            // full grid. A refinement solves its start's F and ρd itself, sharing that NDF's
-            // G2 / (4 cos θo) and plain sums with its rounds.
-            let refinement = cfg
-                .refine
-                .then(|| Refinement::new(&ex.ndf, &final_steps))
-                .flatten();
-            let (f, kd, e) = match &refinement {
-                Some(r) => r.start(),
-                None => solve_on(&tabulated_model(&ex), &final_steps)?,
+            // A tabulated NDF refined on the coarse rows from F and ρd solved there
+            // (`Refinement::start`, which shares the NDF's G2 / (4 cos θo) and plain sums with
+            // the rounds), or unrefined solved as any model (`solve_reported`); its error on
+            // the full grid, and the refinement's rounds.
+            let rows = coarse.as_ref().filter(|_| cfg.refine).map(CoarseGrid::rows);
+            let candidate = |ndf: &TabulatedNdf| -> Result<(Candidate, f64, usize), FitError> {
+                let Some(r) = rows.and_then(|rows| Refinement::new(ndf, rows)) else {
+                    let (f, kd, error) = solve_reported(&model_of(ndf))?;
+                    return Ok(((ndf.clone(), f, kd), error, 0));
+                };
+                let start = r.start();
+                let (c, rounds) = match r.run(&start) {
+                    Some(r) => ((r.ndf, r.fresnel, r.albedo), r.rounds),
+                    None => ((ndf.clone(), start.0, start.1), 0),
+                };
+                let error = microfacet_error(&solved(&model_of(&c.0), &c.1, c.2), &set);
+                Ok((c, error, rounds))
             };
-            let mut best = (ex.ndf.clone(), f, kd, e, "power_iteration");
-            let mut best_error = None;
-            if cfg.refine {
-                let start = (best.1.clone(), best.2, best.3);
-                if let Some(r) = refinement.and_then(|r| r.run(&start)) {
-                    refine_rounds = r.rounds;
-                    best = (r.ndf, r.fresnel, r.albedo, r.error, "power_iteration");
-                }
-                // Where an analytic fit is still better, its NDF tabulated is the start.
-                let error = full_error(&model_of(&best.0), &best.1, best.2, best.3);
-                best_error = Some(error);
-                if let Some((kind, p)) = best_analytic.filter(|(_, p)| p.error < error) {
-                    let analytic = AnalyticNdf::isotropic(kind, p.alpha_x);
-                    let t = ex.ndf.tables();
-                    if let Some(ndf) = tabulate(analytic, t.nu, t.ng) {
-                        let refinement = Refinement::new(&ndf, &final_steps);
-                        let (f, kd, e) = match &refinement {
-                            Some(r) => r.start(),
-                            None => solve_on(&model_of(&ndf), &final_steps)?,
-                        };
-                        let refined = refinement.and_then(|r| r.run(&(f.clone(), kd, e)));
-                        let mut start = (ndf.clone(), f, kd, e, kind.name());
-                        if let Some(r) = refined {
-                            refine_rounds += r.rounds;
-                            start = (r.ndf, r.fresnel, r.albedo, r.error, kind.name());
-                        }
-                        let e = full_error(&model_of(&start.0), &start.1, start.2, start.3);
-                        if e < error {
-                            (best, best_error) = (start, Some(e));
-                        }
+            let (mut best, mut error, rounds) = candidate(&ex.ndf)?;
+            let mut origin = "power_iteration";
+            refine_rounds = rounds;
+            // Where an analytic fit is still better, its NDF tabulated is the other start.
+            if let Some((kind, p)) = best_analytic.filter(|(_, p)| cfg.refine && p.error < error) {
+                let analytic = AnalyticNdf::isotropic(kind, p.alpha_x);
+                let t = ex.ndf.tables();
+                if let Some(ndf) = tabulate(analytic, t.nu, t.ng) {
+                    let (c, e, rounds) = candidate(&ndf)?;
+                    refine_rounds += rounds;
+                    if e < error {
+                        (best, error, origin) = (c, e, kind.name());
                     }
                 }
             }
-            let error = best_error
-                .unwrap_or_else(|| full_error(&model_of(&best.0), &best.1, best.2, best.3));
-            (ex, (best.0, best.1, best.2, Some(error), best.4))
+            (ex, (best.0, best.1, best.2, Some(error), origin))
         }
     };
     let (ndf, tab_fresnel, tab_diffuse, tab_error, origin) = tab;

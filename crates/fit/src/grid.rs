@@ -133,16 +133,6 @@ impl GridSamples {
         Some(CoarseGrid(self.iso.as_ref()?.coarse()))
     }
 
-    /// The rows of an isotropic source that [`Self::diagonal`] leaves out (the two split the
-    /// grid); `None` for an anisotropic one.
-    pub fn diagonal_complement(&self, stride: usize) -> Option<GridSamples> {
-        Some(GridSamples {
-            rotations: self.rotations.clone(),
-            samples: OnceLock::new(),
-            iso: Some(self.iso.as_ref()?.diagonal_complement(stride)),
-        })
-    }
-
     /// The valid samples, in MERL bin order for each rotation. For an isotropic source they are
     /// built from the compact form on first use (x from ln(1 + x), to f32 precision).
     pub fn samples(&self) -> &[GridSample] {
@@ -525,7 +515,9 @@ pub fn fresnel_diffuse_and_error(
 }
 
 /// The rows of an isotropic set with every fourth φd bin ([`GridSamples::coarse`]): a
-/// quarter of its samples, every (θh, θd) row kept. The analytic fits' α bracket runs here.
+/// quarter of its samples, every (θh, θd) row kept. The analytic fits' α search and bracket
+/// run on such rows; with a diffuse lobe, on those of the final steps' rows, every model's
+/// F / ρd solve and the tabulated NDF's refinement.
 pub struct CoarseGrid(CoarseSamples);
 
 impl CoarseGrid {
@@ -540,6 +532,24 @@ impl CoarseGrid {
             false => self.0.fresnel_and_error_sum(&tables).1,
         };
         Some(e / (3 * self.0.count.max(1)) as f64)
+    }
+
+    /// F per θd bin, ρd and the mean error on these rows of `model` with `irls` reweighted
+    /// steps, as [`fresnel_diffuse_and_error`] gives them. `None` for a model that is not
+    /// isotropic.
+    pub fn fresnel_diffuse_and_error(
+        &self,
+        model: &MicrofacetBrdf,
+        irls: usize,
+    ) -> Option<(Vec<Rgb>, Rgb, f64)> {
+        let tables = IsoTables::new(model)?;
+        let (f, q, e) = self.0.fresnel_diffuse_and_error_sum(&tables, irls);
+        Some((f, q.map(|q| q * PI), e / (3 * self.0.count.max(1)) as f64))
+    }
+
+    /// The rows themselves.
+    pub(crate) fn rows(&self) -> &CoarseSamples {
+        &self.0
     }
 }
 
@@ -665,31 +675,5 @@ mod tests {
             worst = worst.max((a - b).abs() / b.abs().max(1.0));
         }
         assert!(worst < 1.5e-7, "ln y: worst error {worst}");
-    }
-
-    /// The final steps' rows and the rest split the grid, and the full grid's error is their
-    /// errors weighted by their sample counts (the fit's reported errors are measured so): the
-    /// same row sums added in another order, equal to f64 rounding.
-    #[test]
-    fn diagonal_and_complement_split_the_grid_and_its_error() {
-        use super::*;
-        use crate::microfacet::{AnalyticNdf, NdfKind};
-        let src = crate::analytic::parse_analytic("ggx?alpha=0.2&f0=0.04&kd=0.3,0.1,0.05").unwrap();
-        let set = GridSamples::new(&src);
-        let (quarter, rest) = (set.diagonal(4), set.diagonal_complement(4).unwrap());
-        assert_eq!(quarter.len() + rest.len(), set.len());
-        let (q, o) = (quarter.iso.as_ref().unwrap(), rest.iso.as_ref().unwrap());
-        assert!(q.rows.iter().all(|r| !o.rows.contains(r)));
-        let mut model = MicrofacetBrdf::ideal(
-            "m",
-            Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Beckmann, 0.25)),
-        );
-        model.diffuse = [0.2, 0.1, 0.05];
-        let n = |s: &GridSamples| s.len() as f64;
-        let split = (microfacet_error(&model, &quarter) * n(&quarter)
-            + microfacet_error(&model, &rest) * n(&rest))
-            / n(&set);
-        let full = microfacet_error(&model, &set);
-        assert!((split - full).abs() <= 1e-12 * full, "{split} vs {full}");
     }
 }

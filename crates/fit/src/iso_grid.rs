@@ -248,11 +248,6 @@ impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
         self.rows_where(|r| on_diagonal(r, stride))
     }
 
-    /// The rows of this set that [`Self::diagonal`] leaves out.
-    pub fn diagonal_complement(&self, stride: usize) -> Self {
-        self.rows_where(|r| !on_diagonal(r, stride))
-    }
-
     /// The rows of this set for which `keep` holds.
     fn rows_where(&self, keep: impl Fn(usize) -> bool) -> Self {
         let rows: Vec<u16> = self
@@ -1335,8 +1330,8 @@ mod tests {
     }
 
     /// The coarse rows hold every fourth φd bin of the full ones with its cosines and λ(φ): a
-    /// model's F / ρd solve and error on them equal those on the full rows with the other bins
-    /// masked off. The same samples and geometry, summed in other lanes: equal to f32 rounding.
+    /// model's F / ρd solve, its error and the refinement's bin medians on them equal those on
+    /// the full rows with the other bins masked off. The same samples and geometry, summed in other lanes: equal to f32 rounding.
     #[test]
     fn coarse_rows_are_every_fourth_bin_of_the_full_ones() {
         let src = parse_analytic("beckmann?alpha=0.15&f0=0.04&kd=0.3,0.1,0.05").unwrap();
@@ -1408,6 +1403,20 @@ mod tests {
                     (0..3).all(|c| close(a[c], b[c])),
                     "{kind:?} θd bin {j}: {a:?} {b:?}"
                 );
+            }
+            // The refinement's bin medians at that F and ρd: every sample's s* and weight are
+            // the same f32 values, so the same buckets, summed in another order.
+            let mut tables = tables;
+            tables.set_fresnel(&fa);
+            tables.diffuse = qa;
+            let ha = coarse.bin_medians(&tables, &coarse.ideals(&tables), 2.0);
+            let hb = masked.bin_medians(&tables, &masked.ideals(&tables), 2.0);
+            let weight: f64 = ha.iter().flatten().sum();
+            assert!(weight > 0.0, "{kind:?}: no weight");
+            for (i, (a, b)) in ha.iter().zip(&hb).enumerate() {
+                for (k, (&a, &b)) in a.iter().zip(b).enumerate() {
+                    assert!(close(a, b), "{kind:?} θh bin {i} bucket {k}: {a} vs {b}");
+                }
             }
         }
     }

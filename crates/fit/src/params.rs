@@ -118,8 +118,17 @@ pub fn least_squares_candidates(
     diffuse: bool,
     set: &GridSamples,
 ) -> Vec<AnalyticNdf> {
+    candidates_of(start, |n| error_of("lsq", n, diffuse, set))
+}
+
+/// [`least_squares_candidates`] for any error function of the isotropic NDF (the fit's: on
+/// every fourth φd bin of the search's rows, [`crate::grid::CoarseGrid::error`]).
+pub(crate) fn candidates_of(
+    start: AnalyticNdf,
+    error: impl Fn(AnalyticNdf) -> f64,
+) -> Vec<AnalyticNdf> {
     let kind = start.kind;
-    let f = |t: f64| error_of("lsq", AnalyticNdf::isotropic(kind, t.exp()), diffuse, set);
+    let f = |t: f64| error(AnalyticNdf::isotropic(kind, t.exp()));
     let (lo, hi) = (ALPHA_MIN.ln(), ALPHA_MAX.ln());
     let x0 = start.alpha_x.clamp(ALPHA_MIN, ALPHA_MAX).ln();
     let tol = |t: f64| SEARCH_TOLERANCE * t.abs().max(1.0);

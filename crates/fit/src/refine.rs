@@ -4,11 +4,14 @@
 //! held the metric splits into 90 problems of one unknown: the scale s_i of D in bin i. Each
 //! sample's error |ln(1 + s a + b) − ln(1 + x)| is least at s* = (x − b) / a with slopes ±w on
 //! either side, so a bin's error is least at the weighted median of its samples' s*
-//! ([`IsoSamples::bin_medians`], one pass on half of the set's rows, w taken at the current s).
+//! ([`IsoSamples::bin_medians`], one pass over the rows, w taken at the current s; on the 100
+//! proxies, medians over every row rather than half of them gave tabulated median / p90
+//! 0.0187 / 0.0613 against 0.0188 / 0.0621, 40 fits better and 12 worse by more than 0.2 %).
 //! A round moves every bin to its median, bounded to ±`SPAN` in ln s (halving every round), and
-//! solves F and ρd again for the new D. The rounds run on the set given (the fit's
-//! final-step rows, a quarter of the grid), from the start's F and ρd ([`Refinement::start`],
-//! whose G2 / (4 cos θo) and plain sums they reuse), and stop when a round gains less than
+//! solves F and ρd again for the new D. The rounds run on the rows given (in the fit, every
+//! fourth φd bin of the final steps' rows, [`crate::grid::CoarseGrid`]: a sixteenth of the
+//! grid, every (θh, θd) row kept), from the start's F and ρd ([`Refinement::start`], whose
+//! G2 / (4 cos θo) and plain sums they reuse), and stop when a round gains less than
 //! `MIN_GAIN`. The
 //! bin scales, interpolated in θ, then multiply the D table, which is renormalised
 //! (∫ D cos θh dω = 1); G1 is either recomputed by Smith's relation from the new D or held,
@@ -17,7 +20,7 @@
 
 use crate::brdf::Rgb;
 use crate::extract::azimuthal_ab;
-use crate::grid::{GridSamples, IsoTables};
+use crate::grid::IsoTables;
 use crate::iso_grid::{IsoSamples, MEDIAN_BUCKETS, RowIdeals, RowSums};
 use crate::merl::{THETA_H_RES, bin_angles};
 use crate::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf};
@@ -31,12 +34,6 @@ use std::sync::Arc;
 /// two 0.0193 / 0.0619, three 0.0188 / 0.0621, four 0.0188 / 0.0621 (eight rounds of the
 /// earlier seven-scale scans: 0.0209 / 0.0622).
 const ROUNDS: usize = 3;
-/// The medians' rows: those of the set with (θh bin + θd bin) ≡ 0 mod `SCAN_STRIDE`
-/// ([`crate::iso_grid::IsoSamples::diagonal`]; half of the fit's final-step rows), about 11 θd
-/// rows per θh bin for a bin's one unknown. On the 100 proxies, every final-step row instead:
-/// tabulated median / p90 0.0187 / 0.0613 against 0.0189 / 0.0622 (both with 128 buckets), for
-/// a pass twice as long.
-const SCAN_STRIDE: usize = 8;
 /// The first round moves ln s by at most SPAN (a factor e² ≈ 7.4 in D); the bound halves every
 /// round. With a first bound of 0.5, most bins (50–90 of 90 on delrin) hit it in every round.
 const SPAN: f64 = 2.0;
@@ -77,27 +74,26 @@ pub(crate) type Solved = (Vec<Rgb>, Rgb, f64);
 /// An isotropic tabulated NDF on the rows of a set, with what its start and its refinement
 /// share: its G2 / (4 cos θo) on those rows and their plain weighted sums (G is held through
 /// the rounds: only D changes).
-pub(crate) struct Refinement<'a> {
+pub(crate) struct Refinement<'a, const N: usize, const M: usize, const P: usize> {
     ndf: &'a TabulatedNdf,
-    sub: &'a IsoSamples,
+    sub: &'a IsoSamples<N, M, P>,
     /// Samples in the set (the mean error's divisor, over three channels).
     samples: usize,
     tables: IsoTables,
-    ideals: RowIdeals,
+    ideals: RowIdeals<P>,
     plain: RowSums,
 }
 
-impl<'a> Refinement<'a> {
-    /// `None` when the NDF or the set is not isotropic.
-    pub fn new(ndf: &'a TabulatedNdf, set: &'a GridSamples) -> Option<Self> {
-        let sub = set.iso.as_ref().filter(|_| ndf.is_isotropic())?;
-        let tables = IsoTables::new(&model_of(ndf))?;
+impl<'a, const N: usize, const M: usize, const P: usize> Refinement<'a, N, M, P> {
+    /// `None` when the NDF is not isotropic.
+    pub fn new(ndf: &'a TabulatedNdf, sub: &'a IsoSamples<N, M, P>) -> Option<Self> {
+        let tables = IsoTables::new(&model_of(ndf)).filter(|_| ndf.is_isotropic())?;
         let ideals = sub.ideals(&tables);
         let plain = sub.row_sums(&ideals);
         Some(Refinement {
             ndf,
             sub,
-            samples: set.len().max(1),
+            samples: sub.count.max(1),
             tables,
             ideals,
             plain,
@@ -125,8 +121,6 @@ impl<'a> Refinement<'a> {
     /// The NDF refined from `start` ([`Self::start`]); `None` when nothing better was found.
     pub fn run(&self, start: &Solved) -> Option<Refined> {
         let (sub, ideals, plain) = (self.sub, &self.ideals, &self.plain);
-        let scan_rows = sub.diagonal(SCAN_STRIDE);
-        let scan_ideals = scan_rows.ideals(&self.tables);
         let mut tables = self.tables.clone();
         let d0 = tables.d32;
         tables.set_fresnel(&start.0);
@@ -143,7 +137,7 @@ impl<'a> Refinement<'a> {
         let (mut span, mut rounds) = (SPAN, 0);
         while rounds < ROUNDS {
             rounds += 1;
-            let medians = scan_rows.bin_medians(&tables, &scan_ideals, span as f32);
+            let medians = sub.bin_medians(&tables, ideals, span as f32);
             for (i, h) in medians.iter().enumerate() {
                 ln_s[i] += weighted_median(h, span);
                 tables.d32[i] = (d0[i] as f64 * ln_s[i].exp()) as f32;
@@ -334,6 +328,7 @@ pub(crate) fn tabulate(ndf: AnalyticNdf, nu: usize, ng: usize) -> Option<Tabulat
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::grid::GridSamples;
     use crate::microfacet::NdfKind;
 
     /// Smith's G1 recomputed from a tabulated GGX D matches GGX's closed form, 1 / (1 + Λ).
