@@ -11,7 +11,7 @@
 
 use crate::brdf::{Brdf, mean};
 use crate::error::FitError;
-use crate::geometry::spherical;
+use crate::geometry::{acos_poly, spherical};
 use crate::quadrature::Quadrature;
 use crate::tabulated::{NdfTables, Stretch, TabulatedNdf, phi_node, theta_node, u_node_theta};
 use rayon::prelude::*;
@@ -105,7 +105,8 @@ const ISO_TABLE_U: usize = 256;
 const ISO_TABLE_G: usize = 512;
 
 /// ∫₀^{2π} max(0, cos θo cos θh + sin θo sin θh cos φ) dφ, in closed form:
-/// 2πa if a ≥ b, 0 if a ≤ −b, else 2(a φ₀ + b sin φ₀) with φ₀ = acos(−a/b).
+/// 2πa if a ≥ b, 0 if a ≤ −b, else 2(a φ₀ + b sin φ₀) with φ₀ = acos(−a/b) (to 2e-8 in φ₀,
+/// [`crate::geometry::acos_poly`]).
 pub fn azimuthal_integral(theta_o: f64, theta_h: f64) -> f64 {
     azimuthal_ab(theta_o.cos() * theta_h.cos(), theta_o.sin() * theta_h.sin())
 }
@@ -120,7 +121,7 @@ pub(crate) fn azimuthal_ab(a: f64, b: f64) -> f64 {
         0.0
     } else {
         let c = -a / b;
-        2.0 * (a * c.acos() + b * (1.0 - c * c).sqrt())
+        2.0 * (a * acos_poly(c) + b * (1.0 - c * c).sqrt())
     }
 }
 
