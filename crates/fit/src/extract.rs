@@ -105,8 +105,8 @@ const ISO_TABLE_U: usize = 256;
 const ISO_TABLE_G: usize = 512;
 
 /// ∫₀^{2π} max(0, cos θo cos θh + sin θo sin θh cos φ) dφ, in closed form:
-/// 2πa if a ≥ b, 0 if a ≤ −b, else 2(a φ₀ + b sin φ₀) with φ₀ = acos(−a/b) (to 2e-8 in φ₀,
-/// [`crate::geometry::acos_poly`]).
+/// 2πa if a ≥ b, 0 if a ≤ −b, else 2(a φ₀ + b sin φ₀) with φ₀ = acos(−a/b) (by a polynomial,
+/// to 2e-8 in φ₀).
 pub fn azimuthal_integral(theta_o: f64, theta_h: f64) -> f64 {
     azimuthal_ab(theta_o.cos() * theta_h.cos(), theta_o.sin() * theta_h.sin())
 }
