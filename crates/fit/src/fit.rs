@@ -257,25 +257,23 @@ fn fit_with(
         }
         Ok(fresnel_average(model, &set))
     };
-    // F (and with a diffuse lobe ρd) for a model's own D and G, and its error on `on` (the
-    // full grid, or with a diffuse lobe the final steps' subsample).
-    let solve_on =
-        |m: &MicrofacetBrdf, on: &GridSamples| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
-            if diffuse && let Some(r) = fresnel_diffuse_and_error(m, on, FINAL_IRLS) {
-                return Ok(r);
-            }
-            if gpu.is_some() {
-                let f = average(m)?;
-                let with = MicrofacetBrdf {
-                    fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
-                    ..m.clone()
-                };
-                return Ok((f, [0.0; 3], microfacet_error(&with, &set)));
-            }
-            let (f, e) = fresnel_and_error(m, on);
-            Ok((f, [0.0; 3], e))
-        };
-    let solve = |m: &MicrofacetBrdf| solve_on(m, &set);
+    // F (and with a diffuse lobe ρd) for a model's own D and G, and its error, on the full
+    // grid.
+    let solve = |m: &MicrofacetBrdf| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
+        if diffuse && let Some(r) = fresnel_diffuse_and_error(m, &set, FINAL_IRLS) {
+            return Ok(r);
+        }
+        if gpu.is_some() {
+            let f = average(m)?;
+            let with = MicrofacetBrdf {
+                fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                ..m.clone()
+            };
+            return Ok((f, [0.0; 3], microfacet_error(&with, &set)));
+        }
+        let (f, e) = fresnel_and_error(m, &set);
+        Ok((f, [0.0; 3], e))
+    };
     // The final steps' rows: with a diffuse lobe a quarter of the rows, the full grid without.
     let final_steps = if diffuse {
         set.diagonal(FINAL_STRIDE)
@@ -350,8 +348,8 @@ fn fit_with(
     let fit_kind = |kind: NdfKind| -> Result<ParamRecord, FitError> {
         let moments = fit_moments(kind, &ex.ndf);
         let model = |ndf: AnalyticNdf| MicrofacetBrdf::ideal("lsq", Ndf::Analytic(ndf));
-        // Isotropic: the α search and bracket on coarse rows, F and ρd on the final steps'
-        // rows, the error on the full grid (coarse to fine).
+        // Isotropic: the α search and bracket on coarse rows, F and ρd (with a diffuse lobe)
+        // on the final steps' coarse rows, the error on the full grid (coarse to fine).
         let (lsq, (lsq_fresnel, lsq_diffuse, error)) = if cfg.anisotropic {
             let lsq = fit_least_squares(moments, true, diffuse, &search);
             (lsq, solve(&model(lsq))?)
