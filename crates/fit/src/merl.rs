@@ -175,11 +175,13 @@ impl MerlTable {
         if dims != [THETA_H_RES as i32, THETA_D_RES as i32, PHI_D_RES as i32] {
             return Ok(None);
         }
-        if raw
-            .values()
-            .iter()
-            .any(|v| !(f64::from_le_bytes(*v) <= MAX_STORED))
-        {
+        // Chunk by chunk without a branch per value, so that the scan vectorises.
+        let out_of_range = |c: &[[u8; 8]]| {
+            c.iter().fold(false, |bad, v| {
+                bad | !(f64::from_le_bytes(*v) <= MAX_STORED)
+            })
+        };
+        if raw.values().chunks(1024).any(out_of_range) {
             return Ok(None); // the general path names the sample
         }
         Ok(Some(MerlTable { raw }))
