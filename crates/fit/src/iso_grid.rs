@@ -1,9 +1,12 @@
 //! An isotropic source's samples on the MERL grid in compact form, and the two passes over
 //! them: the Fresnel average and the error metric of an isotropic microfacet model.
 //!
-//! The samples are stored row by row ([`crate::merl_geometry`]): ln(1 + x) and x per channel
-//! for each of the 180 φd bins, padded with zeros to 184 (23 chunks of eight lanes), a
-//! validity flag per bin, Σ x per channel and the valid count per row. A pass runs over rows
+//! The samples are stored row by row ([`crate::merl_geometry`]): ln(1 + x) per channel for
+//! each of the 180 φd bins, padded with zeros to 184 (23 chunks of eight lanes), a validity
+//! flag per bin, Σ x per channel and the valid count per row. x itself is kept only in copies
+//! of a few rows (a search's subsample, the coarse rows), recovered from ln(1 + x): a fresh
+//! page costs this machine's kernel about 1 ms per MB to hand out, more than the passes spend
+//! reading it, so the grid is kept small. A pass runs over rows
 //! (rayon over θh bins): per row D is one number (θh alone), F one RGB value (θd alone), Λ is
 //! read from a table uniform in cos θ at the row's 181 cosines, and G2 / (4 cos θo) is formed
 //! for the 180 bins in loops of fixed length the compiler vectorises; the sums run in eight
@@ -14,7 +17,8 @@ use crate::brdf::Brdf;
 use crate::brdf::Rgb;
 use crate::diffuse::LinearSums;
 use crate::grid::{
-    IsoTables, LAMBDA_TABLE, MAX_X, fresnel_from_sums, ln_1p, ln_1p_fused, ln_positive_fused,
+    IsoTables, LAMBDA_TABLE, MAX_X, exp_m1, fresnel_from_sums, ln_1p, ln_1p_fused,
+    ln_positive_fused,
 };
 use crate::merl::{THETA_D_RES, THETA_H_RES};
 use crate::merl_geometry::{
@@ -36,40 +40,71 @@ pub(crate) type CoarseSamples = IsoSamples<COARSE_ROW, COARSE_MU_ROW, COARSE_PAD
 /// every [`COARSE_STRIDE`]-th), `M` = `N` + 1 cosines per row and `P` lanes, `N` padded to
 /// eight.
 pub(crate) struct IsoData<const N: usize = ROW, const M: usize = MU_ROW, const P: usize = PADDED> {
-    /// ln(1 + x) per bin, row r channel c at `(3 r + c) · PADDED`; 0 where invalid and on the
+    /// Where each row is stored: slot `slot[r]` (`u32::MAX` for a row not stored); empty
+    /// where every row of the grid is, in order (slot r). A copy of some rows
+    /// ([`IsoSamples::coarse`], [`IsoSamples::subsample`]) stores those alone: fresh memory
+    /// costs a fit more to fill (the kernel zeroes every new page) than to read.
+    slot: Vec<u32>,
+    /// ln(1 + x) per bin, slot s channel c at `(3 s + c) · P`; 0 where invalid and on the
     /// padding.
     log_x: Vec<f32>,
-    /// x itself, laid out as `log_x` (the weighted sums of the diffuse solve need it).
+    /// x itself, laid out as `log_x`, on copies of some rows, where the diffuse solves'
+    /// weighted sums read it in every pass; empty on the whole grid, whose x is recovered from
+    /// ln(1 + x) where a pass needs it ([`exp_m1`], to 3e-6 relative), so that the grid's
+    /// memory is halved.
     x: Vec<f32>,
-    /// Whether the bin holds a valid sample (both directions above the horizon, a value).
+    /// Whether the bin holds a valid sample (both directions above the horizon, a value), slot
+    /// s at `s · P`.
     valid: Vec<bool>,
-    /// Σ x per channel over the row's valid bins (x as stored, f32, summed in f64).
+    /// Σ x per channel over the row's valid bins (x as stored, f32, summed in f64), per row.
     sum_x: Vec<[f64; 3]>,
-    /// Valid bins per row.
+    /// Σ x likewise over every [`COARSE_STRIDE`]-th bin, per row, from the exact x (the
+    /// coarse rows' x is recovered from ln(1 + x)); empty on coarse rows.
+    sum_coarse_x: Vec<[f64; 3]>,
+    /// Valid bins per row (0 for a row not stored).
     count: Vec<u16>,
     /// The first sample with |x| beyond [`MAX_X`] or not finite: (flat bin, x).
     pub out_of_range: Option<(usize, [f32; 3])>,
 }
 
 impl<const N: usize, const M: usize, const P: usize> IsoData<N, M, P> {
+    /// Where row `r` is stored.
+    #[inline(always)]
+    fn slot(&self, r: usize) -> usize {
+        match self.slot.is_empty() {
+            true => r,
+            false => self.slot[r] as usize,
+        }
+    }
+
     /// ln(1 + x) of row `r`, channel `c` (0 on the padding).
     #[inline(always)]
     fn log_x(&self, r: usize, c: usize) -> &[f32; P] {
-        let at = (3 * r + c) * P;
+        let at = (3 * self.slot(r) + c) * P;
         self.log_x[at..at + P].try_into().unwrap()
     }
 
-    /// x of row `r`, channel `c` (0 on the padding).
+    /// x of row `r`, channel `c` (0 where invalid and on the padding): stored, or recovered
+    /// from ln(1 + x).
     #[inline(always)]
-    fn x(&self, r: usize, c: usize) -> &[f32; P] {
-        let at = (3 * r + c) * P;
+    fn x(&self, r: usize, c: usize) -> [f32; P] {
+        if self.x.is_empty() {
+            let log_x = self.log_x(r, c);
+            let mut x = [0.0f32; P];
+            for k in 0..P {
+                x[k] = exp_m1(log_x[k]);
+            }
+            return x;
+        }
+        let at = (3 * self.slot(r) + c) * P;
         self.x[at..at + P].try_into().unwrap()
     }
 
     /// Whether each bin of row `r` holds a valid sample (false on the padding).
     #[inline(always)]
     fn valid(&self, r: usize) -> &[bool; P] {
-        self.valid[r * P..(r + 1) * P].try_into().unwrap()
+        let at = self.slot(r) * P;
+        self.valid[at..at + P].try_into().unwrap()
     }
 
     /// cos θi of row `r`'s bins where they hold a valid sample, 0 elsewhere and on the padding.
@@ -104,28 +139,27 @@ impl IsoSamples {
         let geo = merl_geometry();
         let per_i = THETA_D_RES;
         let mut log_x = vec![0.0f32; 3 * ROWS * PADDED];
-        let mut x = vec![0.0f32; 3 * ROWS * PADDED];
         let mut valid = vec![false; ROWS * PADDED];
         crate::huge_pages::advise(&mut log_x);
-        crate::huge_pages::advise(&mut x);
         crate::huge_pages::advise(&mut valid);
         let mut sum_x = vec![[0.0f64; 3]; ROWS];
+        let mut sum_coarse_x = vec![[0.0f64; 3]; ROWS];
         let mut count = vec![0u16; ROWS];
         let channels = [table.channel(0), table.channel(1), table.channel(2)];
         let out_of_range = log_x
             .par_chunks_mut(3 * per_i * PADDED)
-            .zip(x.par_chunks_mut(3 * per_i * PADDED))
             .zip(valid.par_chunks_mut(per_i * PADDED))
             .zip(sum_x.par_chunks_mut(per_i))
+            .zip(sum_coarse_x.par_chunks_mut(per_i))
             .zip(count.par_chunks_mut(per_i))
             .enumerate()
-            .map(|(i, ((((log_x, x), valid), sum_x), count))| {
+            .map(|(i, ((((log_x, valid), sum_x), sum_coarse_x), count))| {
                 let rows = RowsOut {
                     first: i * per_i,
                     log_x,
-                    x,
                     valid,
                     sum_x,
+                    sum_coarse_x,
                     count,
                 };
                 build_rows(rows, channels, geo)
@@ -135,10 +169,12 @@ impl IsoSamples {
             .flatten()
             .next();
         let data = IsoData {
+            slot: Vec::new(),
             log_x,
-            x,
+            x: Vec::new(),
             valid,
             sum_x,
+            sum_coarse_x,
             count,
             out_of_range,
         };
@@ -152,33 +188,62 @@ impl IsoSamples {
     /// subsampling rows instead (a diagonal of stride 16) made sharp lobes' fits up to 2.9
     /// times worse on the 100 proxies, this at most 3 %.
     pub fn coarse(&self) -> CoarseSamples {
-        let full = &*self.data;
-        let mut log_x = vec![0.0f32; 3 * ROWS * COARSE_PADDED];
-        let mut x = vec![0.0f32; 3 * ROWS * COARSE_PADDED];
-        let mut valid = vec![false; ROWS * COARSE_PADDED];
+        self.gather(COARSE_STRIDE)
+    }
+
+    /// A copy of this set's rows with every `stride`-th φd bin (bins `stride` j, j < `N2`), x
+    /// stored (recovered from ln(1 + x)).
+    fn gather<const N2: usize, const M2: usize, const P2: usize>(
+        &self,
+        stride: usize,
+    ) -> IsoSamples<N2, M2, P2> {
+        debug_assert_eq!(N2 * stride, ROW);
+        let (full, stored) = (&*self.data, self.rows.len());
+        let mut log_x = vec![0.0f32; 3 * stored * P2];
+        let mut x = vec![0.0f32; 3 * stored * P2];
+        let mut valid = vec![false; stored * P2];
+        let mut slot = vec![u32::MAX; ROWS];
         let (mut sum_x, mut count) = (vec![[0.0f64; 3]; ROWS], vec![0u16; ROWS]);
-        for &r in &self.rows {
+        // Whole rows keep the exact coarse sums, for their own coarse rows.
+        let mut sum_coarse_x = match stride {
+            1 => vec![[0.0f64; 3]; ROWS],
+            _ => Vec::new(),
+        };
+        for (to_slot, &r) in self.rows.iter().enumerate() {
             let r = r as usize;
-            let (from, to) = (full.valid(r), r * COARSE_PADDED);
-            for j in 0..COARSE_ROW {
-                valid[to + j] = from[COARSE_STRIDE * j];
+            slot[r] = to_slot as u32;
+            let (from, to) = (full.valid(r), to_slot * P2);
+            for j in 0..N2 {
+                valid[to + j] = from[stride * j];
             }
-            count[r] = valid[to..to + COARSE_ROW].iter().filter(|&&v| v).count() as u16;
+            count[r] = valid[to..to + N2].iter().filter(|&&v| v).count() as u16;
             for (c, sum) in sum_x[r].iter_mut().enumerate() {
-                let (from_x, from_log) = (full.x(r, c), full.log_x(r, c));
-                let to = (3 * r + c) * COARSE_PADDED;
-                for j in 0..COARSE_ROW {
-                    x[to + j] = from_x[COARSE_STRIDE * j];
-                    log_x[to + j] = from_log[COARSE_STRIDE * j];
+                let from_log = full.log_x(r, c);
+                let to = (3 * to_slot + c) * P2;
+                for j in 0..N2 {
+                    log_x[to + j] = from_log[stride * j];
                 }
-                *sum = sum_f64(&x[to..to + COARSE_ROW]);
+                for (x, &l) in x[to..to + N2].iter_mut().zip(&log_x[to..to + N2]) {
+                    *x = exp_m1(l);
+                }
+                // The sums of the exact x where the rows hold them.
+                *sum = match (stride, full.sum_coarse_x.is_empty()) {
+                    (1, _) => full.sum_x[r][c],
+                    (COARSE_STRIDE, false) => full.sum_coarse_x[r][c],
+                    _ => sum_f64(&x[to..to + N2]),
+                };
+            }
+            if let Some(s) = sum_coarse_x.get_mut(r) {
+                *s = full.sum_coarse_x[r];
             }
         }
         let data = IsoData {
+            slot,
             log_x,
             x,
             valid,
             sum_x,
+            sum_coarse_x,
             count,
             out_of_range: None,
         };
@@ -196,21 +261,30 @@ impl IsoSamples {
         }
     }
 
+    /// Every `stride`-th row of this set holding samples (all of their φd bins); above a stride
+    /// of 1 a copy of those rows with x stored: the searches and the diffuse separation run
+    /// their weighted passes on it many times.
+    pub fn subsample(&self, stride: usize) -> Self {
+        let rows = self.every(stride);
+        match stride > 1 {
+            true => rows.gather(1),
+            false => rows,
+        }
+    }
+
     /// The valid bins of row `r` with ln(1 + x) per channel: (flat bin, ln(1 + x)).
     pub fn row_samples(&self, r: usize) -> impl Iterator<Item = (usize, [f32; 3])> + '_ {
         let d = &self.data;
-        (0..ROW)
-            .filter(move |&k| d.valid[r * PADDED + k])
-            .map(move |k| {
-                let l = std::array::from_fn(|c| d.log_x[(3 * r + c) * PADDED + k]);
-                (r * ROW + k, l)
-            })
+        (0..ROW).filter(move |&k| d.valid(r)[k]).map(move |k| {
+            let l = std::array::from_fn(|c| d.log_x(r, c)[k]);
+            (r * ROW + k, l)
+        })
     }
 
     /// Whether a row's bin is valid.
     #[cfg(feature = "gpu")]
     pub fn valid(&self, s: usize) -> bool {
-        self.data.valid[s / ROW * PADDED + s % ROW]
+        self.data.valid(s / ROW)[s % ROW]
     }
 }
 
@@ -225,8 +299,9 @@ impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
         IsoSamples { data, rows, count }
     }
 
-    /// Every `stride`-th row of this set holding samples (all of their φd bins).
-    pub fn subsample(&self, stride: usize) -> Self {
+    /// Every `stride`-th row of this set holding samples (all of their φd bins), sharing its
+    /// data.
+    fn every(&self, stride: usize) -> Self {
         let rows: Vec<u16> = self.rows.iter().copied().step_by(stride.max(1)).collect();
         let count = rows
             .iter()
@@ -735,7 +810,7 @@ fn weighted_row<const N: usize, const M: usize, const P: usize>(
             // The terms, cleared once for the three channels (each overwrites them all).
             let mut terms = [[0.0f32; P]; 5];
             for (c, out) in sums.iter_mut().enumerate() {
-                let s = plain_channel(&m, &mu_i, data.x(r, c), &mut terms);
+                let s = plain_channel(&m, &mu_i, &data.x(r, c), &mut terms);
                 // A loop, not `map`: an array's map is called out of line, outside the
                 // vector code.
                 for (o, s) in out.iter_mut().zip(&s) {
@@ -746,7 +821,7 @@ fn weighted_row<const N: usize, const M: usize, const P: usize>(
         Some((fd, kd)) => {
             for (c, out) in sums.iter_mut().enumerate() {
                 let (x, log_x) = (data.x(r, c), data.log_x(r, c));
-                let (s, e) = l1_channel(&m, &mu_i, x, log_x, fd[c], kd[c]);
+                let (s, e) = l1_channel(&m, &mu_i, &x, log_x, fd[c], kd[c]);
                 for (o, s) in out.iter_mut().zip(&s) {
                     *o = lanes_total(s);
                 }
@@ -1021,9 +1096,9 @@ fn on_diagonal(r: usize, stride: usize) -> bool {
 struct RowsOut<'a> {
     first: usize,
     log_x: &'a mut [f32],
-    x: &'a mut [f32],
     valid: &'a mut [bool],
     sum_x: &'a mut [[f64; 3]],
+    sum_coarse_x: &'a mut [[f64; 3]],
     count: &'a mut [u16],
 }
 
@@ -1071,7 +1146,8 @@ fn build_rows_baseline(
     geo: &MerlGeometry,
 ) -> Option<(usize, [f32; 3])> {
     let mut bad = None;
-    for (n, (sum, count)) in out.sum_x.iter_mut().zip(out.count.iter_mut()).enumerate() {
+    let sums = out.sum_x.iter_mut().zip(out.sum_coarse_x.iter_mut());
+    for (n, ((sum, sum_coarse), count)) in sums.zip(out.count.iter_mut()).enumerate() {
         let r = out.first + n;
         let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
         let valid: &mut [bool; ROW] = (&mut out.valid[n * PADDED..n * PADDED + ROW])
@@ -1086,30 +1162,37 @@ fn build_rows_baseline(
             let missing = (0..3).fold(false, |m, c| m | (f64::from_le_bytes(v[c][k]) < 0.0));
             valid[k] = (mu[ROW - k] > 0.0) & (mu[k] > 0.0) & !missing;
         }
+        // x = f_r cos θi, 0 where invalid
+        let x = |c: usize, k: usize| {
+            let x =
+                (f64::from_le_bytes(v[c][k]) * crate::merl::SCALE[c] * mu[ROW - k] as f64) as f32;
+            if valid[k] { x } else { 0.0 }
+        };
+        // x of each channel, then ln(1 + x) over it in place.
         let mut in_range = true;
         for c in 0..3 {
-            let scale = crate::merl::SCALE[c];
             let at = (3 * n + c) * PADDED;
-            let x: &mut [f32; ROW] = (&mut out.x[at..at + ROW]).try_into().unwrap();
-            for k in 0..ROW {
-                // x = f_r cos θi
-                let xk = (f64::from_le_bytes(v[c][k]) * scale * mu[ROW - k] as f64) as f32;
-                x[k] = if valid[k] { xk } else { 0.0 };
-                in_range &= x[k].abs() <= MAX_X;
+            let row: &mut [f32; ROW] = (&mut out.log_x[at..at + ROW]).try_into().unwrap();
+            for (k, v) in row.iter_mut().enumerate() {
+                *v = x(c, k);
+                in_range &= v.abs() <= MAX_X;
             }
-            let log_x: &mut [f32; ROW] = (&mut out.log_x[at..at + ROW]).try_into().unwrap();
-            for k in 0..ROW {
-                log_x[k] = ln_1p(x[k]);
+            sum[c] = sum_f64(row);
+            let mut coarse = [0.0f32; COARSE_ROW];
+            for (j, x) in coarse.iter_mut().enumerate() {
+                *x = row[COARSE_STRIDE * j];
             }
-            sum[c] = sum_f64(x);
+            sum_coarse[c] = sum_f64(&coarse);
+            for x in row.iter_mut() {
+                *x = ln_1p(*x);
+            }
         }
-        *count = valid.iter().filter(|&&v| v).count() as u16;
         if bad.is_none() && !in_range {
-            let x = |c: usize, k: usize| out.x[(3 * n + c) * PADDED + k];
             bad = (0..ROW)
                 .find(|&k| (0..3).any(|c| !(x(c, k).abs() <= MAX_X)))
                 .map(|k| (r * ROW + k, std::array::from_fn(|c| x(c, k))));
         }
+        *count = valid.iter().filter(|&&v| v).count() as u16;
     }
     bad
 }
@@ -1349,30 +1432,34 @@ mod tests {
         let full = IsoSamples::new(&src).diagonal(4);
         let coarse = full.coarse();
         let d = &*full.data;
-        let (mut x, mut log_x, mut valid) = (d.x.clone(), d.log_x.clone(), d.valid.clone());
-        let (mut sum_x, mut count) = (vec![[0.0; 3]; ROWS], vec![0u16; ROWS]);
+        // Full rows keep ln(1 + x) alone (x recovered from it, as the coarse rows' is).
+        assert!(d.x.is_empty());
+        let (mut log_x, mut valid) = (d.log_x.clone(), d.valid.clone());
+        let mut count = vec![0u16; ROWS];
         for r in 0..ROWS {
             for k in 0..PADDED {
                 let kept = k % COARSE_STRIDE == 0 && valid[r * PADDED + k];
                 valid[r * PADDED + k] = kept;
                 count[r] += kept as u16;
-                for (c, sum) in sum_x[r].iter_mut().enumerate() {
-                    let at = (3 * r + c) * PADDED + k;
+                for c in 0..3 {
                     if !kept {
-                        (x[at], log_x[at]) = (0.0, 0.0);
+                        log_x[(3 * r + c) * PADDED + k] = 0.0;
                     }
-                    *sum += x[at] as f64;
                 }
             }
         }
+        // Σ x over the kept bins: the full rows' sums over every fourth bin.
+        let sum_x = d.sum_coarse_x.clone();
         let masked: IsoSamples = IsoSamples {
             rows: full.rows.clone(),
             count: full.rows.iter().map(|&r| count[r as usize] as usize).sum(),
             data: Arc::new(IsoData {
+                slot: Vec::new(),
                 log_x,
-                x,
+                x: Vec::new(),
                 valid,
                 sum_x,
+                sum_coarse_x: Vec::new(),
                 count,
                 out_of_range: None,
             }),
