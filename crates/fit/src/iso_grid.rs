@@ -113,9 +113,10 @@ impl<const N: usize, const M: usize, const P: usize> IsoData<N, M, P> {
         let mu: &[f32; M] = row_geometry::<N>().mu_row(r).try_into().unwrap();
         let valid = self.valid(r);
         let mut out = [0.0f32; P];
-        for k in 0..N {
-            // Bin k's cos θi is the row's cosine at N − k (180 − k on the full grid).
-            out[k] = if valid[k] { mu[N - k] } else { 0.0 };
+        // Bin k's cos θi is the row's cosine at N − k (180 − k on the full grid): the cosines
+        // 1..=N reversed (an iterator, which the compiler reverses in vectors).
+        for ((o, &m), &v) in out.iter_mut().zip(mu[1..].iter().rev()).zip(valid) {
+            *o = if v { m } else { 0.0 };
         }
         out
     }
@@ -1156,16 +1157,20 @@ fn build_rows_baseline(
         // The stored values, little-endian as in the file, read in place.
         let v: [&[[u8; 8]; ROW]; 3] =
             std::array::from_fn(|c| raw[c][r * ROW..(r + 1) * ROW].try_into().unwrap());
+        // cos θi of bin k: the cosine at 180 − k (the cosines 1..=180 reversed).
+        let mut mu_i = [0.0f32; ROW];
+        for (o, &m) in mu_i.iter_mut().zip(mu[1..].iter().rev()) {
+            *o = m;
+        }
         // Valid: both directions above the horizon and no channel missing (negative; a NaN
         // is a value, refused below as out of range). `&`, not `&&`: no branch in the loop.
         for k in 0..ROW {
             let missing = (0..3).fold(false, |m, c| m | (f64::from_le_bytes(v[c][k]) < 0.0));
-            valid[k] = (mu[ROW - k] > 0.0) & (mu[k] > 0.0) & !missing;
+            valid[k] = (mu_i[k] > 0.0) & (mu[k] > 0.0) & !missing;
         }
         // x = f_r cos θi, 0 where invalid
         let x = |c: usize, k: usize| {
-            let x =
-                (f64::from_le_bytes(v[c][k]) * crate::merl::SCALE[c] * mu[ROW - k] as f64) as f32;
+            let x = (f64::from_le_bytes(v[c][k]) * crate::merl::SCALE[c] * mu_i[k] as f64) as f32;
             if valid[k] { x } else { 0.0 }
         };
         // x of each channel, then ln(1 + x) over it in place.
@@ -1299,8 +1304,8 @@ fn row_ideal<const N: usize, const M: usize, const P: usize>(
     for k in 0..N {
         let (li, lo) = (lambda_i[k], lambda[k]);
         let (hi, lo) = if li > lo { (li, lo) } else { (lo, li) };
-        let g2 = 1.0 / (1.0 + hi + corr[k] * lo);
-        out[k] = 0.25 * g2 / mu[k];
+        // G2 / (4 cos θo) = 1 / (4 cos θo (1 + max + λ(φ) min)): one division
+        out[k] = 0.25 / (mu[k] * (1.0 + hi + corr[k] * lo));
     }
 }
 
