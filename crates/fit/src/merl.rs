@@ -181,7 +181,11 @@ impl MerlTable {
                 bad | !(f64::from_le_bytes(*v) <= MAX_STORED)
             })
         };
-        if raw.values().chunks(1024).any(out_of_range) {
+        if raw
+            .values()
+            .par_chunks(1 << 16)
+            .any(|c| c.chunks(1024).any(out_of_range))
+        {
             return Ok(None); // the general path names the sample
         }
         Ok(Some(MerlTable { raw }))
