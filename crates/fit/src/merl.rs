@@ -175,7 +175,7 @@ impl MerlTable {
         if dims != [THETA_H_RES as i32, THETA_D_RES as i32, PHI_D_RES as i32] {
             return Ok(None);
         }
-        // Chunk by chunk without a branch per value, so that the scan vectorises.
+        // In parallel, chunk by chunk without a branch per value, so that the scan vectorises.
         let out_of_range = |c: &[[u8; 8]]| {
             c.iter().fold(false, |bad, v| {
                 bad | !(f64::from_le_bytes(*v) <= MAX_STORED)
