@@ -364,14 +364,16 @@ impl IsoTables {
             _ => None,
         };
         // A fit builds tables for every α its searches try: the closed form, not the NDF's
-        // general Λ(ω), is 4× (GGX) and 1.8× (Beckmann) faster.
+        // general Λ(ω), is 4× (GGX) and 1.8× (Beckmann) faster; a tabulated NDF takes its
+        // isotropic path.
         for (k, l) in lambda_cos.iter_mut().enumerate().skip(1) {
             let mu = k as f64 / last;
-            let lambda = match analytic {
-                Some((kind, a2)) => lambda_from_alpha_tan(kind, a2 * (1.0 - mu * mu) / (mu * mu)),
-                None => model
-                    .ndf
-                    .lambda(DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)),
+            let lambda = match (analytic, &model.ndf) {
+                (Some((kind, a2)), _) => {
+                    lambda_from_alpha_tan(kind, a2 * (1.0 - mu * mu) / (mu * mu))
+                }
+                (None, Ndf::Tabulated(t)) => t.lambda_isotropic(mu),
+                (None, ndf) => ndf.lambda(DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)),
             };
             *l = (lambda * mu) as f32;
         }

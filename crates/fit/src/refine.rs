@@ -331,6 +331,28 @@ mod tests {
     use crate::grid::GridSamples;
     use crate::microfacet::NdfKind;
 
+    /// The isotropic Λ of a stretched tabulated NDF is its general Λ(ω) (the same G1₀
+    /// interpolated at the same θ₀, computed by atan2 instead of acos: 1e-12 of rounding), at
+    /// grazing cosines and near the normal too.
+    #[test]
+    fn isotropic_lambda_of_a_stretched_table_is_the_general_one() {
+        let base = tabulate(AnalyticNdf::isotropic(NdfKind::Beckmann, 0.4), 128, 64).unwrap();
+        let stretch = Stretch {
+            alpha_x: 0.55,
+            alpha_y: 0.55,
+            rotation: 0.7,
+        };
+        let t = TabulatedNdf::new(base.tables().clone(), stretch).unwrap();
+        assert!(t.is_isotropic());
+        for k in 1..=4096 {
+            let mu = k as f64 / 4096.0;
+            let w = DVec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
+            let (a, b) = (t.lambda_isotropic(mu), t.lambda(w));
+            assert!((a - b).abs() <= 1e-12 * b.max(1.0), "μ = {mu}: {a} vs {b}");
+        }
+        assert_eq!(t.lambda_isotropic(0.0), f64::INFINITY);
+    }
+
     /// Smith's G1 recomputed from a tabulated GGX D matches GGX's closed form, 1 / (1 + Λ).
     #[test]
     fn smith_g1_of_tabulated_ggx_matches_closed_form() {

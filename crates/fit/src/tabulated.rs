@@ -247,6 +247,23 @@ impl TabulatedNdf {
         self.base_d(theta_of(h0), phi_of(h0)) * (h0.z / l.z).powi(4) / (s.alpha_x * s.alpha_y)
     }
 
+    /// [`Self::lambda`] at cos θ = `mu` for an isotropic NDF ([`Self::is_isotropic`]): the
+    /// stretch only maps the polar angle, tan θ₀ = α tan θ, so that Λ = 1/G1₀(θ₀) − 1 needs
+    /// no rotation, normalisation or azimuth (a fit tabulates Λ at 4096 cosines per model).
+    pub fn lambda_isotropic(&self, mu: f64) -> f64 {
+        debug_assert!(self.is_isotropic());
+        if mu <= 0.0 {
+            return f64::INFINITY;
+        }
+        let theta0 = (self.stretch.alpha_x * (1.0 - mu * mu).max(0.0).sqrt()).atan2(mu);
+        let g1 = self.base_g1(theta0, 0.0);
+        if g1 <= 0.0 {
+            f64::INFINITY
+        } else {
+            (1.0 / g1 - 1.0).max(0.0)
+        }
+    }
+
     /// Smith Λ(w) = 1/G1₀(w₀) − 1 with w₀ ∝ (αx wx, αy wy, wz).
     pub fn lambda(&self, w: DVec3) -> f64 {
         if w.z <= 0.0 {
