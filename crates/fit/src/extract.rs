@@ -17,6 +17,7 @@ use crate::tabulated::{NdfTables, Stretch, TabulatedNdf, phi_node, theta_node, u
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
+use std::sync::{Arc, Mutex};
 
 /// When the power iteration stops.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -209,15 +210,52 @@ pub trait Solver {
 /// anisotropic: matrix-free, each row's kernel computed on the fly.
 pub struct CpuSolver;
 
+/// The isotropic kernel k(q, h) between query directions and a problem's nodes, `n` nodes per
+/// query: the last ones computed are kept, for the next problem on the same nodes. A diffuse
+/// separation extracts a dozen times on the same nodes, and the kernel, which depends on the
+/// directions alone, was most of each extraction's work.
+fn isotropic_kernel(queries: &[[f64; 3]], nodes: &[[f64; 3]]) -> Arc<Vec<f64>> {
+    type Kept = Vec<(Vec<[f64; 3]>, Vec<[f64; 3]>, Arc<Vec<f64>>)>;
+    /// The node × node kernel of the iteration and the query × node one of the tables.
+    const KEEP: usize = 2;
+    static KEPT: Mutex<Kept> = Mutex::new(Vec::new());
+    let found = KEPT.lock().ok().and_then(|kept| {
+        let hit = kept.iter().find(|(q, h, _)| q == queries && h == nodes);
+        hit.map(|(_, _, k)| k.clone())
+    });
+    if let Some(k) = found {
+        return k;
+    }
+    // The nodes' sin θ once, not once per query.
+    let sin: Vec<f64> = nodes.iter().map(|h| h[0].hypot(h[1])).collect();
+    let k: Vec<f64> = queries
+        .par_iter()
+        .flat_map_iter(|q| {
+            let sin_q = q[0].hypot(q[1]);
+            nodes
+                .iter()
+                .zip(&sin)
+                .map(move |(h, s)| azimuthal_ab(q[2] * h[2], sin_q * s))
+        })
+        .collect();
+    let k = Arc::new(k);
+    if let Ok(mut kept) = KEPT.lock() {
+        if kept.len() == KEEP {
+            kept.remove(0);
+        }
+        kept.push((queries.to_vec(), nodes.to_vec(), k.clone()));
+    }
+    k
+}
+
 impl Solver for CpuSolver {
     fn iterate(&self, p: &Problem, stopping: Stopping) -> Result<Eigen, FitError> {
         let n = p.dirs.len();
         let dense: Option<Vec<f64>> = p.isotropic.then(|| {
+            let k = isotropic_kernel(&p.dirs, &p.dirs);
             (0..n * n)
                 .into_par_iter()
-                .map(|ij| {
-                    p.row[ij / n] * p.col[ij % n] * p.kernel(&p.dirs[ij / n], &p.dirs[ij % n])
-                })
+                .map(|ij| p.row[ij / n] * p.col[ij % n] * k[ij])
                 .collect()
         });
         Ok(power_iterate(n, &p.norm, stopping, |v, out| match &dense {
@@ -245,11 +283,10 @@ impl Solver for CpuSolver {
     ) -> Result<Vec<f64>, FitError> {
         let wv: Vec<f64> = v.iter().zip(&p.col).map(|(v, w)| v * w).collect();
         if p.isotropic {
-            // The nodes' sin θ once, not once per query (768 queries a table).
-            let sin: Vec<f64> = p.dirs.iter().map(|h| h[0].hypot(h[1])).collect();
-            return Ok(queries
-                .par_iter()
-                .map(|q| project_isotropic(p, q, &sin, &wv))
+            let (k, n) = (isotropic_kernel(queries, &p.dirs), p.dirs.len());
+            return Ok(k
+                .par_chunks(n)
+                .map(|k| k.iter().zip(&wv).map(|(k, wv)| k * wv).sum())
                 .collect());
         }
         Ok(queries.par_iter().map(|q| project(p, q, &wv)).collect())
@@ -258,18 +295,6 @@ impl Solver for CpuSolver {
     fn name(&self) -> String {
         "cpu".into()
     }
-}
-
-/// Σ_h wv_h k(q, h) of an isotropic problem, the nodes' sin θ given: [`azimuthal`] with the
-/// lengths in xy taken once.
-fn project_isotropic(p: &Problem, q: &[f64; 3], sin: &[f64], wv: &[f64]) -> f64 {
-    let sin_q = q[0].hypot(q[1]);
-    p.dirs
-        .iter()
-        .zip(sin)
-        .zip(wv)
-        .map(|((h, s), wv)| azimuthal_ab(q[2] * h[2], sin_q * s) * wv)
-        .sum()
 }
 
 /// Σ_h wv_h k(q, h).
@@ -496,6 +521,32 @@ fn finish(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The kept kernels are the kernel: each entry is k(q, h) of its query and node, bit for
+    /// bit, whichever sets of directions were asked for before (three sets here, one more than
+    /// are kept, asked for twice in turn).
+    #[test]
+    fn kept_kernels_are_the_kernel() {
+        let dirs = |n: usize, phi: f64| -> Vec<[f64; 3]> {
+            (0..n)
+                .map(|k| spherical(1.5 * k as f64 / n as f64, phi).to_array())
+                .collect()
+        };
+        let sets = [dirs(7, 0.0), dirs(5, 0.3), dirs(9, 0.0)];
+        for _ in 0..2 {
+            for q in &sets {
+                let k = isotropic_kernel(q, &sets[0]);
+                for (m, q) in q.iter().enumerate() {
+                    for (j, h) in sets[0].iter().enumerate() {
+                        assert_eq!(
+                            k[m * sets[0].len() + j].to_bits(),
+                            azimuthal(q, h).to_bits()
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn azimuthal_integral_matches_quadrature() {
