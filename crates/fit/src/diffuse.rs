@@ -15,8 +15,10 @@
 //! f − ρd/π, then solve ρd" does not separate them: ρd = 0 is a fixed point, because the first
 //! extraction's NDF grows the floor that stands for ρd, and the solve then finds no diffuse term.
 //! [`separate`] instead searches the diffuse albedo s (mean of RGB, the colour taken from the
-//! analytic fits' ρd) by Brent's method on [0, π min f(o, o)]: each candidate extracts from
-//! f(o, o) − ρd/π, solves its own F and ρd, and is scored by its error on the search grid.
+//! analytic fits' ρd, or without them from the minimum of f(o, o)) on [0, π min f(o, o)]: each
+//! candidate extracts from f(o, o) − ρd/π, solves its own F and ρd, and is scored by its error
+//! on the search grid. The search tests the two ends first, where the minimum often lies, then
+//! runs Brent's method ([`separation_search`]).
 //! The extraction that wins is the tabulated NDF; its ρd is the one solved with it.
 
 use crate::brdf::{Brdf, Rgb, mean};
@@ -153,10 +155,20 @@ pub struct Separation {
 /// Relative tolerance of the separation's search in the diffuse albedo.
 pub const SEPARATION_TOLERANCE: f64 = 5e-3;
 
-/// The tabulated model of `src` with a diffuse lobe (see the module docs): Brent's method on
-/// the mean removed albedo over [0, π min f(o, o)], starting from `seed` (the analytic fits'
-/// ρd, which also gives the colour). `first` is the extraction without removal (s = 0);
-/// `extract` runs one extraction.
+/// The albedo below which the separation's tolerance is absolute (or below the largest
+/// removable albedo, if smaller): [`SEPARATION_TOLERANCE`] of it, 2.5e-4, far below what a
+/// render or the metric can tell apart.
+const SEPARATION_FLOOR: f64 = 0.05;
+
+/// The smallest removable albedo worth a search: below it ρd is still solved with F, but the
+/// NDF is extracted from f itself.
+const SEPARATION_MIN: f64 = 1e-4;
+
+/// The tabulated model of `src` with a diffuse lobe (see the module docs): the mean removed
+/// albedo searched on [0, π min f(o, o)] ([`separation_search`]) from `seed`, the analytic
+/// fits' ρd, which also gives the colour; without one (zero), from the ρd solved with `first`,
+/// the extraction without removal (s = 0), whose NDF holds part of the diffuse term in its
+/// floor, so its ρd is low but has the material's colour. `extract` runs one extraction.
 pub fn separate(
     src: &dyn Brdf,
     search: &GridSamples,
@@ -182,20 +194,25 @@ pub fn separate(
             (0..3).for_each(|c| limit[c] = limit[c].min(PI * f[c].max(0.0)));
         }
     }
-    let colour = if mean(seed) > 1e-6 {
-        seed.map(|k| k / mean(seed))
-    } else {
-        [1.0; 3]
-    };
+    // The colour of the analytic fits' ρd, or without them that of the backscattering
+    // minimum, where a diffuse term shows most.
+    let seeded = mean(seed) > 1e-6;
+    let colour = [seed, limit]
+        .into_iter()
+        .find(|c| mean(*c) > 1e-6 && mean(*c).is_finite())
+        .map_or([1.0; 3], |c| c.map(|k| k / mean(c)));
     let s_max = (0..3)
         .filter(|&c| colour[c] > 0.0)
         .map(|c| limit[c].min(1.0) / colour[c])
         .fold(f64::INFINITY, f64::min);
-    if !(s_max > 1e-4) || !s_max.is_finite() {
+    if !(s_max > SEPARATION_MIN) || !s_max.is_finite() {
         return Ok(best.into_inner());
     }
     let failure = RefCell::new(None);
     let objective = |s: f64| -> f64 {
+        if s == 0.0 {
+            return first_error;
+        }
         let albedo = colour.map(|k| k * s);
         let ex = match extract(&WithoutDiffuse { src, albedo }) {
             Ok(ex) => ex,
@@ -212,13 +229,52 @@ pub fn separate(
         }
         e
     };
-    let start = mean(seed).clamp(0.0, s_max);
-    crate::params::brent(objective, 0.0, start, s_max, SEPARATION_TOLERANCE);
+    // Without a seed, from the largest removable albedo.
+    separation_search(objective, if seeded { mean(seed) } else { s_max }, s_max);
     let best = best.into_inner();
     match failure.into_inner() {
         Some(e) if !best.error.is_finite() => Err(e),
         _ => Ok(best),
     }
+}
+
+/// The minimum of `error(s)` over s ∈ [0, hi] from `start`, to [`SEPARATION_TOLERANCE`] of
+/// max(s, min([`SEPARATION_FLOOR`], hi)); error(0) is known (the extraction without removal). The
+/// minimum often lies at an end: at 0 without a diffuse term, at hi where the lobe is wider
+/// than the backscattering slice lets the search remove (delrin). Brent's method reaches an end
+/// only by golden sections, an extraction each, so the ends are tested first. If error(0) is
+/// below error(start), the minimum lies below the start: 0 if the error a step above 0 is
+/// higher. Otherwise it lies above 0: hi if error(hi) is below error(start) and the error a step
+/// inside hi is higher. Anywhere else, Brent's method on the bracket that is left.
+fn separation_search(error: impl Fn(f64) -> f64, start: f64, hi: f64) -> f64 {
+    let tol = |s: f64| SEPARATION_TOLERANCE * s.max(SEPARATION_FLOOR.min(hi));
+    // Each s is extracted once (Brent's method starts by evaluating its start).
+    let seen = RefCell::new(Vec::<(f64, f64)>::new());
+    let error = |s: f64| {
+        if let Some(&(_, e)) = seen.borrow().iter().find(|p| p.0 == s) {
+            return e;
+        }
+        let e = error(s);
+        seen.borrow_mut().push((s, e));
+        e
+    };
+    let brent = |lo: f64, start: f64, hi: f64| crate::params::brent_to(error, lo, start, hi, tol);
+    let (step, inside) = (2.0 * tol(0.0), hi - 2.0 * tol(hi));
+    let s0 = start.clamp(step, hi);
+    if error(0.0) <= error(s0) {
+        return match error(step) >= error(0.0) {
+            true => 0.0,
+            false => brent(0.0, step, s0),
+        };
+    }
+    if error(hi) <= error(s0) {
+        return match error(inside) >= error(hi) {
+            true => hi,
+            // Below hi: the minimum lies above the start, unless the start is hi.
+            false => brent(if s0 < inside { s0 } else { 0.0 }, inside, hi),
+        };
+    }
+    brent(0.0, s0, hi)
 }
 
 /// The tabulated model of an extraction, F and ρd still to be solved.
@@ -229,6 +285,42 @@ pub(crate) fn tabulated_model(ex: &Extraction) -> MicrofacetBrdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The separation's search finds minima at either end in two or three evaluations, and
+    /// an interior one to its tolerance, from starts on either side of it.
+    #[test]
+    fn separation_search_finds_ends_and_interior_minima() {
+        use std::cell::Cell;
+        let hi = 0.4;
+        let run = |e: &dyn Fn(f64) -> f64, start: f64| {
+            let n = Cell::new(0);
+            let s = separation_search(
+                |s| {
+                    // error(0) is known to the search: only other points count.
+                    n.set(n.get() + usize::from(s != 0.0));
+                    e(s)
+                },
+                start,
+                hi,
+            );
+            (s, n.get())
+        };
+        // No diffuse term: the error rises from 0.
+        assert_eq!(run(&|s| 1.0 + s, hi), (0.0, 2));
+        assert_eq!(run(&|s| 1.0 + s, 0.0), (0.0, 1));
+        // A lobe wider than the search may remove: the error falls up to hi.
+        assert_eq!(run(&|s| 1.0 - s, hi), (hi, 2));
+        assert_eq!(run(&|s| 1.0 - s, 0.1), (hi, 3));
+        // Interior: within the tolerance (twice it, Brent's bracket) of the minimum.
+        for m in [0.003, 0.13, 0.37] {
+            for start in [0.0, 0.05, 0.2, hi] {
+                let (s, n) = run(&|s: f64| 1.0 + (s - m).powi(2), start);
+                let tol = SEPARATION_TOLERANCE * m.max(SEPARATION_FLOOR.min(hi));
+                assert!((s - m).abs() <= 2.0 * tol, "minimum {m} from {start}: {s}");
+                assert!(n <= 12, "minimum {m} from {start}: {n} evaluations");
+            }
+        }
+    }
 
     /// Samples from a known F and q, no noise: the solve gives them back.
     #[test]

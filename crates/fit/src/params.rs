@@ -282,7 +282,13 @@ pub(crate) fn brent(f: impl Fn(f64) -> f64, lo: f64, start: f64, hi: f64, tol: f
 }
 
 /// [`brent`] to the tolerance `tol(x)` in x, absolute.
-fn brent_to(f: impl Fn(f64) -> f64, lo: f64, start: f64, hi: f64, tol: impl Fn(f64) -> f64) -> f64 {
+pub(crate) fn brent_to(
+    f: impl Fn(f64) -> f64,
+    lo: f64,
+    start: f64,
+    hi: f64,
+    tol: impl Fn(f64) -> f64,
+) -> f64 {
     const CGOLD: f64 = 0.381_966_011_250_105;
     let (mut a, mut b) = (lo.min(hi), lo.max(hi));
     let mut x = start.clamp(a, b);
