@@ -429,7 +429,7 @@ fn fit_with(
     let fit_ms = ms(t);
 
     let t = Instant::now();
-    // The best analytic fit: the separation's seed and the refinement's other start.
+    // The best analytic fit: the refinement's other start.
     let best_analytic = [(NdfKind::Ggx, &ggx), (NdfKind::Beckmann, &beckmann)]
         .into_iter()
         .filter_map(|(k, p)| p.as_ref().map(|p| (k, p)))
@@ -451,8 +451,7 @@ fn fit_with(
             (ex, (ndf, f, [0.0; 3], error, "power_iteration"))
         }
         None => {
-            let seed = best_analytic.map_or([0.0; 3], |(_, p)| p.diffuse);
-            let sep = separate(src, &search, seed, ex, |b| {
+            let sep = separate(src, &search, ex, |b| {
                 extract_with(b, &cfg.extract, false, solver)
             })?;
             separation_rounds = sep.rounds;
