@@ -820,9 +820,10 @@ fn weighted_row<const N: usize, const M: usize, const P: usize>(
             }
         }
         Some((fd, kd)) => {
+            let chunks = valid_chunks(valid);
             for (c, out) in sums.iter_mut().enumerate() {
                 let (x, log_x) = (data.x(r, c), data.log_x(r, c));
-                let (s, e) = l1_channel(&m, &mu_i, &x, log_x, fd[c], kd[c]);
+                let (s, e) = l1_channel(&m, &mu_i, &x, log_x, fd[c], kd[c], &chunks);
                 for (o, s) in out.iter_mut().zip(&s) {
                     *o = lanes_total(s);
                 }
@@ -866,8 +867,8 @@ fn plain_channel<const P: usize>(
 }
 
 /// One channel of [`weighted_row`] reweighted for the L1 norm (F D = `f`, ρd/π = `kd`): the
-/// five sums and the residuals in eight lanes, chunk by chunk, each chunk's lanes in
-/// registers. Stored per bin as [`plain_channel`] does, the pass took 1.7 times as long.
+/// five sums and the residuals in eight lanes, chunk by chunk (those of `chunks`), each
+/// chunk's lanes in registers. Stored per bin as [`plain_channel`] does, the pass took 1.7 times as long.
 #[inline(always)]
 fn l1_channel<const P: usize>(
     m: &[f32; P],
@@ -876,9 +877,14 @@ fn l1_channel<const P: usize>(
     log_x: &[f32; P],
     f: f32,
     kd: f32,
+    chunks: &std::ops::Range<usize>,
 ) -> ([[f32; 8]; 5], [f32; 8]) {
     let (mut s, mut e) = ([[0.0f32; 8]; 5], [0.0f32; 8]);
     for n in 0..P / 8 {
+        // (Chunks without a valid bin add 0: ι = μ = x = ln(1 + x) = 0 there.)
+        if !chunks.contains(&n) {
+            continue;
+        }
         for l in 0..8 {
             let k = 8 * n + l;
             // x_model = F D (G2 / (4 cos θo)) + ρd/π cos θi
@@ -1252,7 +1258,11 @@ fn row_error<const N: usize, const M: usize, const P: usize>(
     };
     let log_x = [data.log_x(r, 0), data.log_x(r, 1), data.log_x(r, 2)];
     let mut acc = [0.0f32; 8];
+    let chunks = valid_chunks(valid);
     for (n, valid) in valid.chunks_exact(8).enumerate() {
+        if !chunks.contains(&n) {
+            continue;
+        }
         let mut e = [0.0f32; 8];
         for c in 0..3 {
             for (l, e) in e.iter_mut().enumerate() {
@@ -1267,6 +1277,21 @@ fn row_error<const N: usize, const M: usize, const P: usize>(
         }
     }
     lanes_total(&acc)
+}
+
+/// The 8-bin chunks of a row that hold a valid bin, from the first to the last: a row's valid
+/// bins lie between its two horizons (cos θi > 0 and cos θo > 0), and the chunks outside them,
+/// a quarter of the grid's, add nothing to a pass's sums.
+#[inline(always)]
+fn valid_chunks<const P: usize>(valid: &[bool; P]) -> std::ops::Range<usize> {
+    let any = |n: usize| valid[8 * n..8 * n + 8].iter().any(|&v| v);
+    let chunks = P / 8;
+    let first = (0..chunks).find(|&n| any(n)).unwrap_or(chunks);
+    let end = (first..chunks)
+        .rev()
+        .find(|&n| any(n))
+        .map_or(first, |n| n + 1);
+    first..end
 }
 
 /// G2 / (4 cos θo) of a model at the 180 bins of row `r`: Λ(μ) = (Λ cos θ)(μ) / μ at the
