@@ -15,11 +15,11 @@
 //! f − ρd/π, then solve ρd" does not separate them: ρd = 0 is a fixed point, because the first
 //! extraction's NDF grows the floor that stands for ρd, and the solve then finds no diffuse term.
 //! [`separate`] instead searches the diffuse albedo s (mean of RGB, in the colour of the
-//! minimum of f(o, o)) on [0, π min f(o, o)]: each
-//! candidate extracts from f(o, o) − ρd/π, solves its own F and ρd, and is scored by its error
-//! on the search grid. The search tests the two ends first, where the minimum often lies, then
-//! runs Brent's method (`separation_search`).
-//! The extraction that wins is the tabulated NDF; its ρd is the one solved with it.
+//! minimum of f(o, o)) on [0, π min f(o, o)]: each candidate extracts from f(o, o) − ρd/π,
+//! solves its own F and ρd, and is scored by its error on the search grid. The search tests
+//! the two ends first, where the minimum often lies, then runs Brent's method
+//! (`separation_search`). The extraction that wins is the tabulated NDF; its ρd is the one
+//! solved with it.
 
 use crate::brdf::{Brdf, Rgb, mean};
 use crate::error::FitError;
@@ -234,13 +234,13 @@ pub fn separate(
 }
 
 /// The minimum of `error(s)` over s ∈ [0, hi] from `start`, to [`SEPARATION_TOLERANCE`] of
-/// max(s, min([`SEPARATION_FLOOR`], hi)); error(0) is known (the extraction without removal). The
-/// minimum often lies at an end: at 0 without a diffuse term, at hi where the lobe is wider
-/// than the backscattering slice lets the search remove (delrin). Brent's method reaches an end
-/// only by golden sections, an extraction each, so the ends are tested first. If error(0) is
-/// below error(start), the minimum lies below the start: 0 if the error a step above 0 is
-/// higher. Otherwise it lies above 0: hi if error(hi) is below error(start) and the error a step
-/// inside hi is higher. Anywhere else, Brent's method on the bracket that is left.
+/// max(s, min([`SEPARATION_FLOOR`], hi)); error(0) is known (the extraction without removal).
+/// The minimum often lies at an end: at 0 without a diffuse term, at hi where the lobe is wider
+/// than the backscattering slice lets the search remove (delrin). Brent's method reaches an
+/// end only by golden sections, an extraction each, so the ends are tested first. If error(0)
+/// is below error(start), the minimum lies below the start: 0 if the error a step above 0 is
+/// higher. Otherwise it lies above 0: hi if error(hi) is below error(start) and the error a
+/// step inside hi is higher. Anywhere else, Brent's method on the bracket that is left.
 fn separation_search(error: impl Fn(f64) -> f64, start: f64, hi: f64) -> f64 {
     let tol = |s: f64| SEPARATION_TOLERANCE * s.max(SEPARATION_FLOOR.min(hi));
     // Each s is extracted once (Brent's method starts by evaluating its start).
