@@ -11,15 +11,15 @@ use crate::brdf::{Brdf, Rgb};
 use crate::fresnel::Fresnel;
 use crate::geometry::{HalfDiff, azimuth_between, from_half_diff};
 use crate::iso_grid::{CoarseSamples, IsoSamples};
+use crate::lambda_table::lambda_cos_table;
 use crate::merl::{self, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles};
-use crate::microfacet::{MicrofacetBrdf, Ndf, correlation, g2, lambda_from_alpha_tan};
+use crate::microfacet::{MicrofacetBrdf, Ndf, correlation, g2};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::OnceLock;
 
-/// Entries of the Λ cos θ tables of the fast path, uniform in cos θ over [0, 1].
-pub(crate) const LAMBDA_TABLE: usize = 4096;
+pub(crate) use crate::lambda_table::LAMBDA_TABLE;
 
 /// The largest x = f_r cos θi a source may give on the MERL grid: a GGX mirror of α = 10⁻⁴ at
 /// its peak stays below 10⁹; beyond 10¹² the f32 sums over 1.5·10⁶ samples of the Fresnel
@@ -355,29 +355,7 @@ impl IsoTables {
                 .ndf
                 .d(crate::geometry::spherical(bin_angles(i, 0, 0).theta_h, 0.0)) as f32
         });
-        let last = (LAMBDA_TABLE - 1) as f64;
-        // Λ cos θ at μ_k = k / (n − 1), k ≥ 1; at μ = 0 it is ∞ · 0: extrapolated linearly.
-        let mut lambda_cos = Box::new([0.0f32; LAMBDA_TABLE]);
-        // An isotropic analytic NDF in closed form: Λ of α² tan²θ = α² (1 − μ²) / μ².
-        let analytic = match &model.ndf {
-            Ndf::Analytic(a) if a.is_isotropic() => Some((a.kind, a.alpha_x * a.alpha_x)),
-            _ => None,
-        };
-        // A fit builds tables for every α its searches try: the closed form, not the NDF's
-        // general Λ(ω), is 4× (GGX) and 1.8× (Beckmann) faster; a tabulated NDF takes its
-        // isotropic path.
-        for (k, l) in lambda_cos.iter_mut().enumerate().skip(1) {
-            let mu = k as f64 / last;
-            let lambda = match (analytic, &model.ndf) {
-                (Some((kind, a2)), _) => {
-                    lambda_from_alpha_tan(kind, a2 * (1.0 - mu * mu) / (mu * mu))
-                }
-                (None, Ndf::Tabulated(t)) => t.lambda_isotropic(mu),
-                (None, ndf) => ndf.lambda(DVec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu)),
-            };
-            *l = (lambda * mu) as f32;
-        }
-        lambda_cos[0] = (2.0 * lambda_cos[1] - lambda_cos[2]).max(0.0);
+        let lambda_cos = lambda_cos_table(&model.ndf);
         let fresnel =
             std::array::from_fn(|j| model.fresnel.eval(bin_angles(0, j, 0).theta_d.cos()));
         Some(IsoTables {

@@ -61,6 +61,7 @@ pub mod grid;
 pub(crate) mod huge_pages;
 pub mod input;
 pub(crate) mod iso_grid;
+pub(crate) mod lambda_table;
 pub(crate) mod mapped_file;
 pub mod material;
 pub mod merl;
