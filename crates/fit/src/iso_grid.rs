@@ -26,6 +26,7 @@ use crate::merl_geometry::{
     row_geometry,
 };
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 use std::sync::Arc;
 
 /// Bins per row rounded up to the sums' eight lanes.
@@ -139,17 +140,20 @@ impl IsoSamples {
         let table = src.merl_table();
         let geo = merl_geometry();
         let per_i = THETA_D_RES;
-        let mut log_x = vec![0.0f32; 3 * ROWS * PADDED];
-        let mut valid = vec![false; ROWS * PADDED];
-        crate::huge_pages::advise(&mut log_x);
-        crate::huge_pages::advise(&mut valid);
+        // Allocated, not zeroed: the rows write every value, padding included (zeroing the
+        // 19 MB first, which a reused allocation costs in full, took 1.6 ms serially).
+        let (n_log, n_valid) = (3 * ROWS * PADDED, ROWS * PADDED);
+        let mut log_x: Vec<f32> = Vec::with_capacity(n_log);
+        let mut valid: Vec<bool> = Vec::with_capacity(n_valid);
+        crate::huge_pages::advise(&mut log_x.spare_capacity_mut()[..n_log]);
+        crate::huge_pages::advise(&mut valid.spare_capacity_mut()[..n_valid]);
         let mut sum_x = vec![[0.0f64; 3]; ROWS];
         let mut sum_coarse_x = vec![[0.0f64; 3]; ROWS];
         let mut count = vec![0u16; ROWS];
         let channels = [table.channel(0), table.channel(1), table.channel(2)];
-        let out_of_range = log_x
+        let out_of_range = log_x.spare_capacity_mut()[..n_log]
             .par_chunks_mut(3 * per_i * PADDED)
-            .zip(valid.par_chunks_mut(per_i * PADDED))
+            .zip(valid.spare_capacity_mut()[..n_valid].par_chunks_mut(per_i * PADDED))
             .zip(sum_x.par_chunks_mut(per_i))
             .zip(sum_coarse_x.par_chunks_mut(per_i))
             .zip(count.par_chunks_mut(per_i))
@@ -169,6 +173,12 @@ impl IsoSamples {
             .into_iter()
             .flatten()
             .next();
+        // SAFETY: `build_rows` wrote every element of both, each row's bins and its padding
+        // (a panic there unwinds before this line, leaving them empty).
+        unsafe {
+            log_x.set_len(n_log);
+            valid.set_len(n_valid);
+        }
         let data = IsoData {
             slot: Vec::new(),
             log_x,
@@ -203,6 +213,38 @@ impl IsoSamples {
         let mut log_x = vec![0.0f32; 3 * stored * P2];
         let mut x = vec![0.0f32; 3 * stored * P2];
         let mut valid = vec![false; stored * P2];
+        // Each stored row's bins copied and its x recovered, rows side by side (rayon over
+        // slots); its count and Σ x returned and placed by row after.
+        let per_slot: Vec<(u16, [f64; 3])> = log_x
+            .par_chunks_mut(3 * P2)
+            .zip(x.par_chunks_mut(3 * P2))
+            .zip(valid.par_chunks_mut(P2))
+            .zip(&self.rows)
+            .map(|(((log_x, x), valid), &r)| {
+                let r = r as usize;
+                let from = full.valid(r);
+                for j in 0..N2 {
+                    valid[j] = from[stride * j];
+                }
+                let count = valid[..N2].iter().filter(|&&v| v).count() as u16;
+                let sums = std::array::from_fn(|c| {
+                    let (from_log, to) = (full.log_x(r, c), c * P2);
+                    for j in 0..N2 {
+                        log_x[to + j] = from_log[stride * j];
+                    }
+                    for (x, &l) in x[to..to + N2].iter_mut().zip(&log_x[to..to + N2]) {
+                        *x = exp_m1(l);
+                    }
+                    // The sums of the exact x where the rows hold them.
+                    match (stride, full.sum_coarse_x.is_empty()) {
+                        (1, _) => full.sum_x[r][c],
+                        (COARSE_STRIDE, false) => full.sum_coarse_x[r][c],
+                        _ => sum_f64(&x[to..to + N2]),
+                    }
+                });
+                (count, sums)
+            })
+            .collect();
         let mut slot = vec![u32::MAX; ROWS];
         let (mut sum_x, mut count) = (vec![[0.0f64; 3]; ROWS], vec![0u16; ROWS]);
         // Whole rows keep the exact coarse sums, for their own coarse rows.
@@ -210,30 +252,9 @@ impl IsoSamples {
             1 => vec![[0.0f64; 3]; ROWS],
             _ => Vec::new(),
         };
-        for (to_slot, &r) in self.rows.iter().enumerate() {
+        for (to_slot, (&r, &(n, sums))) in self.rows.iter().zip(&per_slot).enumerate() {
             let r = r as usize;
-            slot[r] = to_slot as u32;
-            let (from, to) = (full.valid(r), to_slot * P2);
-            for j in 0..N2 {
-                valid[to + j] = from[stride * j];
-            }
-            count[r] = valid[to..to + N2].iter().filter(|&&v| v).count() as u16;
-            for (c, sum) in sum_x[r].iter_mut().enumerate() {
-                let from_log = full.log_x(r, c);
-                let to = (3 * to_slot + c) * P2;
-                for j in 0..N2 {
-                    log_x[to + j] = from_log[stride * j];
-                }
-                for (x, &l) in x[to..to + N2].iter_mut().zip(&log_x[to..to + N2]) {
-                    *x = exp_m1(l);
-                }
-                // The sums of the exact x where the rows hold them.
-                *sum = match (stride, full.sum_coarse_x.is_empty()) {
-                    (1, _) => full.sum_x[r][c],
-                    (COARSE_STRIDE, false) => full.sum_coarse_x[r][c],
-                    _ => sum_f64(&x[to..to + N2]),
-                };
-            }
+            (slot[r], count[r], sum_x[r]) = (to_slot as u32, n, sums);
             if let Some(s) = sum_coarse_x.get_mut(r) {
                 *s = full.sum_coarse_x[r];
             }
@@ -1102,8 +1123,10 @@ fn on_diagonal(r: usize, stride: usize) -> bool {
 /// The outputs of consecutive rows of an [`IsoData`] being built.
 struct RowsOut<'a> {
     first: usize,
-    log_x: &'a mut [f32],
-    valid: &'a mut [bool],
+    /// Uninitialised on entry; every value is written, the padding with 0.
+    log_x: &'a mut [MaybeUninit<f32>],
+    /// Uninitialised on entry; every flag is written, the padding with `false`.
+    valid: &'a mut [MaybeUninit<bool>],
     sum_x: &'a mut [[f64; 3]],
     sum_coarse_x: &'a mut [[f64; 3]],
     count: &'a mut [u16],
@@ -1157,9 +1180,8 @@ fn build_rows_baseline(
     for (n, ((sum, sum_coarse), count)) in sums.zip(out.count.iter_mut()).enumerate() {
         let r = out.first + n;
         let mu: &[f32; MU_ROW] = geo.mu_row(r).try_into().unwrap();
-        let valid: &mut [bool; ROW] = (&mut out.valid[n * PADDED..n * PADDED + ROW])
-            .try_into()
-            .unwrap();
+        // The row's flags and values are formed here and written out whole, padding included.
+        let mut valid = [false; PADDED];
         // The stored values, little-endian as in the file, read in place.
         let v: [&[[u8; 8]; ROW]; 3] =
             std::array::from_fn(|c| raw[c][r * ROW..(r + 1) * ROW].try_into().unwrap());
@@ -1182,21 +1204,28 @@ fn build_rows_baseline(
         // x of each channel, then ln(1 + x) over it in place.
         let mut in_range = true;
         for c in 0..3 {
-            let at = (3 * n + c) * PADDED;
-            let row: &mut [f32; ROW] = (&mut out.log_x[at..at + ROW]).try_into().unwrap();
-            for (k, v) in row.iter_mut().enumerate() {
+            let mut row = [0.0f32; PADDED];
+            for (k, v) in row[..ROW].iter_mut().enumerate() {
                 *v = x(c, k);
                 in_range &= v.abs() <= MAX_X;
             }
-            sum[c] = sum_f64(row);
+            sum[c] = sum_f64(&row[..ROW]);
             let mut coarse = [0.0f32; COARSE_ROW];
             for (j, x) in coarse.iter_mut().enumerate() {
                 *x = row[COARSE_STRIDE * j];
             }
             sum_coarse[c] = sum_f64(&coarse);
-            for x in row.iter_mut() {
-                *x = ln_1p(*x);
+            let at = (3 * n + c) * PADDED;
+            // ln(1 + 0) = 0 on the padding.
+            for (o, x) in out.log_x[at..at + PADDED].iter_mut().zip(row) {
+                o.write(ln_1p(x));
             }
+        }
+        for (o, v) in out.valid[n * PADDED..(n + 1) * PADDED]
+            .iter_mut()
+            .zip(valid)
+        {
+            o.write(v);
         }
         if bad.is_none() && !in_range {
             bad = (0..ROW)
