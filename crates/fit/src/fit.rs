@@ -323,7 +323,7 @@ fn fit_with(
 
     // With a diffuse lobe, the physical Fresnel curves fitted to a model's table, each with its
     // error on the final steps' rows: one pass over a quarter of the grid for the three, which
-    // on the five files of `examples/fit_timing.rs` came within 0.7 % of the full grid's.
+    // on the 100 MERL proxies came within 0.85 % of the full grid's (the sixteenth: 1.33 %).
     let physical = |m: &MicrofacetBrdf, table: &FresnelTable, albedo: Rgb| {
         diffuse.then(|| {
             let with = MicrofacetBrdf {
