@@ -172,7 +172,7 @@ macro_rules! layout_check {
 /// struct is named by its last path segment (`every_repr_c_struct_is_checked` finds the
 /// `#[repr(C)]` structs by that name).
 fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
-    use facet_fit::gpu::{GpuNode, GpuSample, GpuState};
+    use facet_fit::gpu::{GpuNode, GpuState};
     use facet_glint::cone_rule::Ring;
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
     use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial};
@@ -185,9 +185,6 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         }),
         layout_check!(GpuState, "fit/normalise.wgsl", "State", {
             iteration, lambda, pad0, pad1,
-        }),
-        layout_check!(GpuSample, "fit/fresnel.wgsl", "Sample", {
-            i, gi, go, inv_cos_i, inv_cos_o, corr, pad => [pad0, pad1],
         }),
         layout_check!(DpfParams, "glint/dpf_build.wgsl", "Params", {
             n_theta, n_dphi, n_rings, ndf_kind, alpha_x, alpha_y, rotation,

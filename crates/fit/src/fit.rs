@@ -156,8 +156,9 @@ fn ms(t: Instant) -> f64 {
 #[cfg(not(feature = "gpu"))]
 enum GpuFitter {}
 
-/// Where the extraction and the Fresnel averages run. The parameter searches and the error
-/// metric always run on the CPU. (With the `gpu` feature only.)
+/// Where the extraction and the passes over the whole grid (the Fresnel average, the error
+/// metric of every reported error) run. The parameter searches, the F and ρd solves and the
+/// refinement, on subsets of the grid, always run on the CPU. (With the `gpu` feature only.)
 #[cfg(feature = "gpu")]
 #[derive(Clone, Copy)]
 pub enum Backend<'a, 'g> {
@@ -236,15 +237,13 @@ fn fit_with(
     }
     // The diffuse lobe is solved on the isotropic grid, on the CPU.
     let diffuse = cfg.diffuse && !cfg.anisotropic && set.iso.is_some();
-    // The GPU averages Fresnel over isotropic sample sets, uploaded once for all models.
+    // The GPU runs the passes over the whole grid of an isotropic source, its samples uploaded
+    // once for all models: the Fresnel average and the error metric.
     #[cfg(feature = "gpu")]
     let uploaded = match gpu {
-        Some(g) if set.rotations.len() == 1 && !diffuse => Some((
-            g,
-            g.fresnel
-                .upload(g.gpu, &set)
-                .map_err(|e| gpu_error(src.name(), e))?,
-        )),
+        Some(g) if set.rotations.len() == 1 => {
+            Some((g, g.upload(&set).map_err(|e| gpu_error(src.name(), e))?))
+        }
         _ => None,
     };
     let average = |model: &MicrofacetBrdf| -> Result<Vec<crate::brdf::Rgb>, FitError> {
@@ -256,6 +255,17 @@ fn fit_with(
                 .map_err(|e| gpu_error(src.name(), e));
         }
         Ok(fresnel_average(model, &set))
+    };
+    // A model's error on the full grid (on the GPU where the samples are uploaded).
+    let full_error = |m: &MicrofacetBrdf| -> Result<f64, FitError> {
+        #[cfg(feature = "gpu")]
+        if let (Some((g, samples)), Some(tables)) = (&uploaded, IsoTables::new(m)) {
+            return g
+                .error
+                .mean(g.gpu, samples, &tables)
+                .map_err(|e| gpu_error(src.name(), e));
+        }
+        Ok(microfacet_error(m, &set))
     };
     // F (and with a diffuse lobe ρd) for a model's own D and G, and its error, on the full
     // grid.
@@ -269,7 +279,7 @@ fn fit_with(
                 fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
                 ..m.clone()
             };
-            return Ok((f, [0.0; 3], microfacet_error(&with, &set)));
+            return Ok((f, [0.0; 3], full_error(&with)?));
         }
         let (f, e) = fresnel_and_error(m, &set);
         Ok((f, [0.0; 3], e))
@@ -293,23 +303,28 @@ fn fit_with(
     let coarse = (analytic || diffuse)
         .then(|| final_steps.coarse())
         .flatten();
-    // A model's F and ρd, and its error on `rows`: with a diffuse lobe F and ρd solved on the
-    // coarse rows (`FINAL_IRLS` reweighted steps), without one averaged over the grid (and the
-    // error on the grid).
-    let solve_for =
-        |m: &MicrofacetBrdf, rows: &GridSamples| -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
-            let on_coarse = coarse
-                .as_ref()
-                .filter(|_| diffuse)
-                .and_then(|c| c.fresnel_diffuse_and_error(m, FINAL_IRLS));
-            let Some((f, kd, _)) = on_coarse else {
-                return solve(m);
-            };
-            let e = microfacet_error(&solved(m, &f, kd), rows);
-            Ok((f, kd, e))
+    // A model's F and ρd, and its error on `rows` (the full grid where `None`): with a diffuse
+    // lobe F and ρd solved on the coarse rows (`FINAL_IRLS` reweighted steps), without one
+    // averaged over the grid (and the error on the grid).
+    let solve_for = |m: &MicrofacetBrdf,
+                     rows: Option<&GridSamples>|
+     -> Result<(Vec<Rgb>, Rgb, f64), FitError> {
+        let on_coarse = coarse
+            .as_ref()
+            .filter(|_| diffuse)
+            .and_then(|c| c.fresnel_diffuse_and_error(m, FINAL_IRLS));
+        let Some((f, kd, _)) = on_coarse else {
+            return solve(m);
         };
+        let with = solved(m, &f, kd);
+        let e = match rows {
+            Some(rows) => microfacet_error(&with, rows),
+            None => full_error(&with)?,
+        };
+        Ok((f, kd, e))
+    };
     // ... with its error on the full grid.
-    let solve_reported = |m: &MicrofacetBrdf| solve_for(m, &set);
+    let solve_reported = |m: &MicrofacetBrdf| solve_for(m, None);
     // The paper's tabulated model: one lobe, F averaged for the extraction's D and G.
     let single = if diffuse {
         None
@@ -390,14 +405,11 @@ fn fit_with(
         // 0.04 %), as the physical curves' errors are: a comparison figure, which took a
         // fifth of the analytic fits' time on the full grid.
         let moments_error = match &single {
-            Some((f, _)) => microfacet_error(
-                &MicrofacetBrdf {
-                    fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
-                    ..model(moments)
-                },
-                &set,
-            ),
-            None => solve_for(&model(moments), &final_steps)?.2,
+            Some((f, _)) => full_error(&MicrofacetBrdf {
+                fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                ..model(moments)
+            })?,
+            None => solve_for(&model(moments), Some(&final_steps))?.2,
         };
         let params = |n: &AnalyticNdf, e| Params {
             alpha_x: n.alpha_x,
@@ -445,15 +457,14 @@ fn fit_with(
     let mut refine_rounds = 0;
     let (ex, tab) = match single {
         Some((f, e)) => {
-            let error = e.or_else(|| {
-                cfg.models.tabulated.then(|| {
-                    let with = MicrofacetBrdf {
-                        fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
-                        ..tabulated_model(&ex)
-                    };
-                    microfacet_error(&with, &set)
-                })
-            });
+            let error = match e {
+                Some(e) => Some(e),
+                None if cfg.models.tabulated => Some(full_error(&MicrofacetBrdf {
+                    fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
+                    ..tabulated_model(&ex)
+                })?),
+                None => None,
+            };
             let ndf = ex.ndf.clone();
             (ex, (ndf, f, [0.0; 3], error, "power_iteration"))
         }
@@ -478,7 +489,7 @@ fn fit_with(
                     Some(r) => ((r.ndf, r.fresnel, r.albedo), r.rounds),
                     None => ((ndf.clone(), start.0, start.1), 0),
                 };
-                let error = microfacet_error(&solved(&model_of(&c.0), &c.1, c.2), &set);
+                let error = full_error(&solved(&model_of(&c.0), &c.1, c.2))?;
                 Ok((c, error, rounds))
             };
             let (mut best, mut error, rounds) = candidate(&ex.ndf)?;

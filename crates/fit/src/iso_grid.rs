@@ -30,7 +30,7 @@ use std::mem::MaybeUninit;
 use std::sync::Arc;
 
 /// Bins per row rounded up to the sums' eight lanes.
-const PADDED: usize = ROW.div_ceil(8) * 8;
+pub(crate) const PADDED: usize = ROW.div_ceil(8) * 8;
 /// [`PADDED`] for the coarse rows ([`CoarseSamples`]).
 const COARSE_PADDED: usize = COARSE_ROW.div_ceil(8) * 8;
 
@@ -294,6 +294,14 @@ impl IsoSamples {
         }
     }
 
+    /// ln(1 + x) and the validity flags of every row of the grid as stored (row r, channel c
+    /// at (3 r + c) · [`PADDED`], flags at r · [`PADDED`]); `None` for a copy of some rows.
+    #[cfg(feature = "gpu")]
+    pub fn whole_grid(&self) -> Option<(&[f32], &[bool])> {
+        let d = &self.data;
+        d.slot.is_empty().then_some((&d.log_x[..], &d.valid[..]))
+    }
+
     /// The valid bins of row `r` with ln(1 + x) per channel: (flat bin, ln(1 + x)).
     pub fn row_samples(&self, r: usize) -> impl Iterator<Item = (usize, [f32; 3])> + '_ {
         let d = &self.data;
@@ -301,12 +309,6 @@ impl IsoSamples {
             let l = std::array::from_fn(|c| d.log_x(r, c)[k]);
             (r * ROW + k, l)
         })
-    }
-
-    /// Whether a row's bin is valid.
-    #[cfg(feature = "gpu")]
-    pub fn valid(&self, s: usize) -> bool {
-        self.data.valid(s / ROW)[s % ROW]
     }
 }
 

@@ -31,8 +31,8 @@
 //!
 //! ## Features
 //!
-//! `gpu` (default): the same extraction and Fresnel average as WGSL compute passes on a wgpu
-//! adapter, through facet-gpu. Without it facet-fit is CPU-only and builds no wgpu.
+//! `gpu` (default): the same extraction and passes over the whole grid (the Fresnel average,
+//! the error metric) as WGSL compute passes on a wgpu adapter, through facet-gpu. Without it facet-fit is CPU-only and builds no wgpu.
 #![cfg_attr(
     feature = "gpu",
     doc = "With it, [`gpu`] holds the passes and [`fit::fit_material_on`] with \

@@ -1,17 +1,24 @@
 //! The fitter on the GPU: the power iteration's kernel–vector product, its normalisation and
-//! the D / G1 table integrals (`shaders/fit/kernel.wgsl`, `normalise.wgsl`), and the Fresnel
-//! average over the MERL grid (`shaders/fit/fresnel.wgsl`). f32 throughout; the CPU f64 path is
-//! the reference the tests compare against.
+//! the D / G1 table integrals (`shaders/fit/kernel.wgsl`, `normalise.wgsl`), and the passes over
+//! the whole MERL grid, its samples uploaded once per source: the Fresnel average
+//! (`shaders/fit/fresnel.wgsl`) and the error metric (`shaders/fit/error.wgsl`). f32
+//! throughout; the CPU f64 path is the reference the tests compare against.
 
+mod error_metric;
 mod fresnel_average;
+mod grid;
 mod power_iteration;
 
-pub use fresnel_average::{FresnelAverage, GpuSamples};
+pub use error_metric::ErrorMetric;
+pub use fresnel_average::FresnelAverage;
+pub use grid::{GpuGrid, GpuSamples};
 pub use power_iteration::PowerIteration;
 
 use crate::error::FitError;
+use crate::grid::GridSamples;
 use bytemuck::{Pod, Zeroable};
 use facet_gpu::{Gpu, GpuError};
+use std::sync::OnceLock;
 
 /// A node or query of the power iteration (WGSL `Node` in `fit/node.inc.wgsl`).
 #[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
@@ -39,20 +46,6 @@ pub struct GpuState {
     pub pad1: u32,
 }
 
-/// One MERL-grid sample for the Fresnel average (WGSL `Sample` in `fit/fresnel.wgsl`).
-#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct GpuSample {
-    pub i: u32,
-    pub gi: f32,
-    pub go: f32,
-    pub inv_cos_i: f32,
-    pub inv_cos_o: f32,
-    pub corr: f32,
-    pub pad: [f32; 2],
-}
-
 /// The GPU pipelines of the fitter, built once and reused for every material.
 pub struct GpuFitter<'g> {
     /// The GPU the pipelines were built on.
@@ -61,22 +54,42 @@ pub struct GpuFitter<'g> {
     pub power: PowerIteration,
     /// The Fresnel average.
     pub fresnel: FresnelAverage,
+    /// The error metric.
+    pub error: ErrorMetric,
+    /// The MERL grid's geometry, uploaded on the first isotropic fit.
+    grid: OnceLock<GpuGrid>,
 }
 
 impl<'g> GpuFitter<'g> {
     /// Builds every pipeline of the fitter on `gpu`.
     pub fn new(gpu: &'g Gpu) -> Result<Self, GpuError> {
-        let (power, fresnel) = gpu.scoped(|| {
+        let (power, fresnel, error) = gpu.scoped(|| {
             Ok::<_, GpuError>((
                 PowerIteration::new(&gpu.device)?,
                 FresnelAverage::new(&gpu.device)?,
+                ErrorMetric::new(&gpu.device)?,
             ))
         })??;
         Ok(GpuFitter {
             gpu,
             power,
             fresnel,
+            error,
+            grid: OnceLock::new(),
         })
+    }
+
+    /// Uploads an isotropic source's samples for the passes over the grid, and the grid's
+    /// geometry with the first.
+    pub fn upload(&self, set: &GridSamples) -> Result<GpuSamples, GpuError> {
+        let grid = match self.grid.get() {
+            Some(g) => g,
+            None => {
+                let g = GpuGrid::new(self.gpu)?;
+                self.grid.get_or_init(|| g)
+            }
+        };
+        GpuSamples::upload(self.gpu, grid, set)
     }
 }
 
