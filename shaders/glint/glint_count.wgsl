@@ -12,6 +12,7 @@ const WG: u32 = 64u;
 @group(0) @binding(3) var<storage, read> split_table: array<u32>;
 
 #include "glint/flakes.inc.wgsl"
+#include "glint/chains8.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 
 @compute @workgroup_size(WG)

@@ -27,6 +27,7 @@ struct EvalQuery {
 @group(0) @binding(7) var<storage, read> split_table: array<u32>;
 
 #include "glint/flakes.inc.wgsl"
+#include "glint/chains8.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
 

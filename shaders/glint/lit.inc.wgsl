@@ -2,17 +2,19 @@
 // Binomial(n, P) at a keyed uniform, split down the quadtree by keyed hypergeometric draws as
 // the positions split, a leaf's lit flakes a run of its flakes from a keyed start; a node inside the
 // footprint adds its lit count, only boundary nodes descend. One walk serves the two queries of
-// a shading point (light sample and BSDF sample), each blended over four direction cells: eight
-// chains of lit counts share the positions' splits.
-// Needs glint/tea.inc.wgsl and glint/flakes.inc.wgsl (with `field: Field`).
+// a shading point (light sample and BSDF sample), each blended over up to four direction cells:
+// up to eight chains of lit counts share the positions' splits.
+// Needs glint/tea.inc.wgsl, glint/flakes.inc.wgsl (with `field: Field`) and the walk's width:
+// glint/chains8.inc.wgsl (every query blends its cells) or glint/chains2.inc.wgsl (each query
+// reads one cell, select_cell).
 
 // Set from Rust (facet_glint::lit), written once there.
 override LIT_EXACT_MEAN: f32;
 override SPLIT_EXACT_MAX: u32;
 override BLEND_BAND: f32;
 
-// Chains of lit counts in one walk: 2 queries × 4 direction cells.
-const CHAINS: u32 = 8u;
+// Direction cells a pair of queries reads: 2 queries × 4 cells.
+const CELLS: u32 = 8u;
 // The walk's stack: a node pops and pushes at most 4 children, so a walk to depth MAX_DEPTH
 // holds at most 3 · MAX_DEPTH + 1 nodes (facet_glint::lit::STACK_DEPTH, checked by a test).
 const STACK: u32 = 61u;
@@ -162,12 +164,6 @@ struct LitNode {
 
 var<private> lit_stack: array<LitNode, STACK>;
 
-// Whether any chain has lit flakes (chains past the live ones hold 0). Written out, not a
-// loop: llvmpipe caps the iterations of each shader invocation's loops at 65 535.
-fn any_lit(l: array<u32, CHAINS>) -> bool {
-    return (l[0] | l[1] | l[2] | l[3] | l[4] | l[5] | l[6] | l[7]) != 0u;
-}
-
 // Only the first nc chains are live (llvmpipe caps each loop's iterations per invocation, so
 // loops run over live chains only).
 fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<u32, CHAINS>, keys_in: array<vec2<u32>, CHAINS>, nc: u32) -> array<u32, CHAINS> {
@@ -193,14 +189,7 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
         let s01 = inv * (vec2<f32>(lo.x, hi.y) - center);
         let s11 = inv * (hi - center);
         if (max(max(dot(s00, s00), dot(s10, s10)), max(dot(s01, s01), dot(s11, s11))) <= 1.0) {
-            acc[0] += nd.lit[0];
-            acc[1] += nd.lit[1];
-            acc[2] += nd.lit[2];
-            acc[3] += nd.lit[3];
-            acc[4] += nd.lit[4];
-            acc[5] += nd.lit[5];
-            acc[6] += nd.lit[6];
-            acc[7] += nd.lit[7];
+            acc = add_lit(acc, nd.lit);
             continue;
         }
         let h = node_hash(nd.level, nd.ix, nd.iy);
@@ -264,7 +253,7 @@ fn blend_axis(x: f32) -> vec4<f32> {
 
 // The cells coords reads and their weights (facet_glint::lit::blend_cells); without blending,
 // the one cell coords is in, weight 1.
-fn cell_keys(coords: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, weights: ptr<function, array<f32, CHAINS>>, first: u32) {
+fn cell_keys(coords: vec2<f32>, keys: ptr<function, array<vec2<u32>, CELLS>>, weights: ptr<function, array<f32, CELLS>>, first: u32) {
     let base = floor(coords);
     let bx = i32(base.x) + (1 << 24u);
     let by = i32(base.y) + (1 << 24u);
@@ -296,19 +285,20 @@ fn count_pair(q: Query) -> vec2<f32> {
     let area = footprint_area(q.a, q.b);
     let expected = field.density * area * q.p;
     let filt = vec2<bool>(field.filtered != 0u) & (expected > vec2<f32>(field.threshold));
-    var cell_key: array<vec2<u32>, CHAINS>;
-    var cell_weight: array<f32, CHAINS>;
+    var cell_key: array<vec2<u32>, CELLS>;
+    var cell_weight: array<f32, CELLS>;
     cell_keys(q.coords0, &cell_key, &cell_weight, 0u);
     cell_keys(q.coords1, &cell_key, &cell_weight, 4u);
-    // The live chains, compacted: key, weight, query, root lit count.
+    // The live chains, compacted: key, weight, query, root lit count (a walk of width 2 is
+    // included only where each query reads one cell).
     var keys: array<vec2<u32>, CHAINS>;
     var weights: array<f32, CHAINS>;
     var query: array<u32, CHAINS>;
     var root: array<u32, CHAINS>;
     var nc = 0u;
-    for (var c = 0u; c < CHAINS; c++) {
+    for (var c = 0u; c < CELLS; c++) {
         let j = c / 4u;
-        if (cell_weight[c] > 0.0 && q.p[j] > 0.0 && !filt[j]) {
+        if (cell_weight[c] > 0.0 && q.p[j] > 0.0 && !filt[j] && nc < CHAINS) {
             let r = pcg3d(vec3<u32>(cell_key[c].x, cell_key[c].y, 0xffffffffu));
             keys[nc] = cell_key[c];
             weights[nc] = cell_weight[c];

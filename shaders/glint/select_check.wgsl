@@ -7,6 +7,7 @@ var<private> field: Field;
 var<private> split_table: array<u32, 1>;
 
 #include "glint/flakes.inc.wgsl"
+#include "glint/chains8.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 
 // Per query: direction coordinates (x, y) and the uniform (z).

@@ -28,6 +28,8 @@ override Q_SHADE: u32;
 const NDF_TABULATED: u32 = 2u;
 
 #include "glint/flakes.inc.wgsl"
+// Each query reads one direction cell (bsdf_setup's cell_u): a walk of two chains.
+#include "glint/chains2.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
 
