@@ -4,13 +4,13 @@
 //! `cargo bench --bench fit`; α errors are printed to stderr beside the timings.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use facet_fit::analytic::parse_analytic;
 use facet_fit::extract::{ExtractConfig, extract_anisotropic, extract_isotropic};
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::microfacet::NdfKind;
-use facet_fit::nbrdf::NbrdfLibrary;
-use facet_fit::params::fit_moments;
+use facet_fit::fitting::params::fit_moments;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::microfacet::NdfKind;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -40,7 +40,7 @@ fn full_fit(c: &mut Criterion) {
     });
     // The paper's scope: extraction, G1 table and Fresnel (the source's sample set included).
     let paper_scope = FitConfig {
-        models: facet_fit::fit::Models::NONE,
+        models: facet_fit::fitting::Models::NONE,
         ..cfg
     };
     c.bench_function("extract_g1_fresnel_n90", |b| {
@@ -48,7 +48,7 @@ fn full_fit(c: &mut Criterion) {
     });
     // The tabulated model alone: extraction, Fresnel and its error.
     let tabulated_only = FitConfig {
-        models: facet_fit::fit::Models {
+        models: facet_fit::fitting::Models {
             tabulated: true,
             ggx: false,
             beckmann: false,

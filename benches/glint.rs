@@ -4,7 +4,7 @@
 //! `cargo bench --bench glint`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
 use facet_glint::dpf::{DpfConfig, DpfPyramid, dpf};
 use facet_glint::flakes::{FlakeField, Footprint};
 use facet_glint::glint_brdf::{GlintConfig, glint_count};
@@ -60,8 +60,8 @@ fn queries(c: &mut Criterion) {
         seed: 1,
     };
     let (wi, wo) = (
-        facet_fit::geometry::spherical(0.4, 0.0),
-        facet_fit::geometry::spherical(0.45, 3.0),
+        facet_fit::model::geometry::spherical(0.4, 0.0),
+        facet_fit::model::geometry::spherical(0.45, 3.0),
     );
     let gamma = 1f64.to_radians();
     let p = dpf(&ndf(), wi, wo, gamma);
@@ -99,7 +99,7 @@ fn queries(c: &mut Criterion) {
     let model_ndf = AnalyticNdf::isotropic(NdfKind::Beckmann, 0.1);
     let levels = facet_glint::gpu::build_levels(&gpu, &ndf(), DpfConfig::preview(), &[0]).unwrap();
     let evaluator = facet_glint::gpu::GlintEvaluator::new(&gpu.device).unwrap();
-    let fresnel = facet_fit::fresnel::FresnelTable::on_merl_bins(vec![[1.0; 3]; 90]);
+    let fresnel = facet_fit::model::fresnel::FresnelTable::on_merl_bins(vec![[1.0; 3]; 90]);
     for r in [1e-4, 1e-3, 1e-2] {
         let qs: Vec<_> = (0..100_000)
             .map(|k| {

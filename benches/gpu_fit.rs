@@ -5,13 +5,13 @@
 //! One-shot figures (the largest grid, throughput) go to stderr.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use facet_fit::analytic::parse_analytic;
 use facet_fit::extract::{CpuSolver, ExtractConfig, Solver, build_problem, extract_with};
-use facet_fit::fit::{Backend, FitConfig, fit_material_on};
+use facet_fit::fitting::params::fit_moments;
+use facet_fit::fitting::{Backend, FitConfig, fit_material_on};
 use facet_fit::gpu::GpuFitter;
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::microfacet::NdfKind;
-use facet_fit::params::fit_moments;
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::microfacet::NdfKind;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
 use facet_gpu::Gpu;
 use std::time::{Duration, Instant};
 

@@ -9,9 +9,9 @@ use crate::fit_cmd::DEFAULT_MATERIAL;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, ValueEnum};
 use facet_fit::extract::ExtractConfig;
-use facet_fit::fit::{Backend, FitConfig, Models, fit_material_on};
+use facet_fit::fitting::{Backend, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
-use facet_fit::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
 use facet_gpu::Gpu;
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
 use facet_render::camera::CameraFrame;
@@ -270,7 +270,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
 /// θi ≤ 60°; `fast_cone_rule_matches_the_direct_integral` in tests/glint.rs says why), and the
 /// max over all cells above 1 % of the peak.
 fn dpf_pyramid(gpu: &Gpu, mode: Mode, sizes: &Sizes) -> Result<Value> {
-    use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+    use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
     use facet_glint::cone_rule::ConeRule;
     use facet_glint::dpf::{DpfConfig, DpfTable, LEVELS_DEG};
     let cfg = if mode == Mode::Smoke {
@@ -344,7 +344,7 @@ fn dpf_pyramid(gpu: &Gpu, mode: Mode, sizes: &Sizes) -> Result<Value> {
 
 /// The default material (a gold GGX conductor) as an in-memory MERL table.
 fn fit_source() -> Result<MerlBrdf> {
-    let model = facet_fit::analytic::parse_analytic(DEFAULT_MATERIAL)
+    let model = facet_fit::model::analytic::parse_analytic(DEFAULT_MATERIAL)
         .map_err(|e| anyhow::anyhow!("{DEFAULT_MATERIAL}: {e}"))?;
     MerlBrdf::from_table(DEFAULT_MATERIAL, MerlTable::sample(&model))
         .map_err(|e| anyhow::anyhow!("{DEFAULT_MATERIAL}: {e}"))
@@ -632,7 +632,8 @@ fn gold_ggx(alpha: f64) -> Result<Material> {
 /// A fit of gold GGX(α) written as a MERL table, rendered by `model` of the fit.
 fn gold_fit(alpha: f64, model: facet_render::scene::FacetModel) -> Result<Material> {
     let spec = format!("ggx?alpha={alpha}&conductor=gold");
-    let truth = facet_fit::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let truth =
+        facet_fit::model::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
     let src = MerlBrdf::from_table(&spec, MerlTable::sample(&truth))
         .map_err(|e| anyhow::anyhow!("{spec}: {e}"))?;
     let fit = facet_fit::fit_material(&src, &spec, &FitConfig::isotropic())?;

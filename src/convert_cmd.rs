@@ -2,11 +2,11 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::input::same_file;
-use facet_fit::nbrdf::NbrdfLibrary;
-use facet_fit::rgl::{BsdfResolution, RglBsdf, write_rgl};
-use facet_fit::source::open_source_mapped;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::io::input::same_file;
+use facet_fit::sources::nbrdf::NbrdfLibrary;
+use facet_fit::sources::open_source_mapped;
+use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, write_rgl};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -95,7 +95,7 @@ pub fn run(args: &ConvertArgs) -> Result<ExitCode> {
                 out.display(),
                 args.input,
                 table.missing_count(),
-                facet_fit::merl::SAMPLES,
+                facet_fit::sources::merl::SAMPLES,
                 load_ms + t.elapsed().as_secs_f64() * 1e3
             );
         }

@@ -4,8 +4,8 @@ use crate::fit_cmd::BackendArg;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use facet_fit::extract::{ExtractConfig, extract_isotropic};
-use facet_fit::microfacet::{MicrofacetBrdf, Ndf};
-use facet_fit::source::open_source_mapped;
+use facet_fit::model::microfacet::{MicrofacetBrdf, Ndf};
+use facet_fit::sources::open_source_mapped;
 use facet_glint::dpf::{DpfConfig, DpfPyramid, LEVELS_DEG, dpf, query_directions};
 use facet_gpu::Gpu;
 use std::path::{Path, PathBuf};
@@ -52,12 +52,12 @@ pub struct DpfArgs {
 
 fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
     let mut library = None;
-    let path = facet_fit::nbrdf::NbrdfLibrary::override_path(nbrdf.as_deref());
+    let path = facet_fit::sources::nbrdf::NbrdfLibrary::override_path(nbrdf.as_deref());
     if let Some(rest) = spec.strip_prefix("analytic:") {
-        return Ok(facet_fit::analytic::parse_analytic(rest)?.ndf);
+        return Ok(facet_fit::model::analytic::parse_analytic(rest)?.ndf);
     }
     if spec.ends_with(".json") {
-        let fit = facet_fit::material::FittedMaterial::load(Path::new(spec))?;
+        let fit = facet_fit::model::material::FittedMaterial::load(Path::new(spec))?;
         return Ok(fit.tabulated.ndf.clone());
     }
     let src = open_source_mapped(spec, path.as_deref(), &mut library)?;
@@ -65,7 +65,7 @@ fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
     let model = MicrofacetBrdf {
         name: spec.into(),
         ndf: Ndf::Tabulated(Arc::new(ex.ndf)),
-        fresnel: facet_fit::fresnel::Fresnel::Schlick { f0: [1.0; 3] },
+        fresnel: facet_fit::model::fresnel::Fresnel::Schlick { f0: [1.0; 3] },
         diffuse: [0.0; 3],
     };
     Ok(model.ndf)

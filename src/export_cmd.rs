@@ -4,8 +4,8 @@
 use anyhow::{Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::export::{ExportOptions, KindRequest, ModelRequest, Target, export};
-use facet_fit::input::same_file;
-use facet_fit::material::FittedMaterial;
+use facet_fit::io::input::same_file;
+use facet_fit::model::material::FittedMaterial;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -93,7 +93,7 @@ pub fn output_path(fit: &Path, out: Option<&Path>, target: Target) -> PathBuf {
         None => {
             let stem = fit
                 .file_stem()
-                .map(|s| facet_fit::input::safe_file_stem(&s.to_string_lossy()))
+                .map(|s| facet_fit::io::input::safe_file_stem(&s.to_string_lossy()))
                 .unwrap_or_else(|| "material".into());
             PathBuf::from(format!("{stem}.{}", target.extension()))
         }
@@ -134,7 +134,7 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode> {
             anyhow::anyhow!(
                 "{}: cannot write: {}",
                 out.display(),
-                facet_fit::input::io_problem(&e)
+                facet_fit::io::input::io_problem(&e)
             )
         })?;
     println!("{}", exported.report.summary());

@@ -3,15 +3,15 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::extract::Stopping;
-use facet_fit::fit::{Backend, FitConfig, Models, fit_material_on};
-use facet_fit::fresnel_fit::FresnelChoice;
+use facet_fit::fitting::fresnel_fit::FresnelChoice;
+use facet_fit::fitting::{Backend, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
-use facet_fit::input::same_file;
-use facet_fit::material::FittedMaterial;
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::nbrdf::NbrdfLibrary;
-use facet_fit::quadrature::Quadrature;
-use facet_fit::source::open_source_mapped;
+use facet_fit::io::input::same_file;
+use facet_fit::model::material::FittedMaterial;
+use facet_fit::numerics::quadrature::Quadrature;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
+use facet_fit::sources::open_source_mapped;
 use facet_gpu::Gpu;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
@@ -342,7 +342,7 @@ impl Outputs<'_> {
     /// The JSON and CSV paths for a fit named `name` (from data: made a safe file stem; a
     /// second fit of one name gets -2, -3, ...), refused when one would replace an input.
     fn claim(&mut self, name: &str) -> Result<(PathBuf, PathBuf)> {
-        let base = facet_fit::input::safe_file_stem(name);
+        let base = facet_fit::io::input::safe_file_stem(name);
         let mut name = base.clone();
         for k in 2.. {
             if self.names.insert(name.clone()) {
@@ -397,7 +397,7 @@ fn fit_one(
 
 /// θ (degrees), D, P = D cos⁴θ and G1 of the tabulated NDF at φ = 0, and F(θd) per channel.
 fn write_tables(fit: &FittedMaterial, path: &Path) -> Result<()> {
-    let facet_fit::microfacet::Ndf::Tabulated(ndf) = &fit.tabulated.ndf else {
+    let facet_fit::model::microfacet::Ndf::Tabulated(ndf) = &fit.tabulated.ndf else {
         unreachable!()
     };
     let mut s = String::from("theta_deg,ndf_d,slope_pdf_p,g1,fresnel_r,fresnel_g,fresnel_b\n");
@@ -442,7 +442,7 @@ fn print_summary(rows: &[FittedMaterial]) {
     );
     for f in rows {
         let r = &f.record;
-        let param = |p: &Option<facet_fit::material::ParamRecord>| match p {
+        let param = |p: &Option<facet_fit::model::material::ParamRecord>| match p {
             Some(p) => (
                 format!("{:.4}/{:.4}", p.alpha_x, p.alpha_y),
                 format!("{:.4}", p.error),
@@ -512,7 +512,7 @@ pub fn fit_default(out: &Path) -> Result<(FittedMaterial, std::path::PathBuf)> {
     );
     let (gpu, sampled) = open_gpu_during(BackendArg::Auto, false, || -> Result<_> {
         let t = Instant::now();
-        let model = facet_fit::analytic::parse_analytic(DEFAULT_MATERIAL)?;
+        let model = facet_fit::model::analytic::parse_analytic(DEFAULT_MATERIAL)?;
         let src = MerlBrdf::from_table("default-gold-ggx", MerlTable::sample(&model))
             .map_err(anyhow::Error::msg)?;
         Ok((src, t.elapsed().as_secs_f64() * 1e3))

@@ -12,7 +12,7 @@ pub fn folder(dir: &Path, flag: &str) -> Result<()> {
         anyhow::anyhow!(
             "{flag} {}: cannot create the folder: {}",
             dir.display(),
-            facet_fit::input::io_problem(&e)
+            facet_fit::io::input::io_problem(&e)
         )
     })
 }

@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use facet_fit::input::same_file;
+use facet_fit::io::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};

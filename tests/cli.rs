@@ -546,7 +546,7 @@ fn material_flag_replaces_the_material_as_predicted() {
     if facet_gpu::gpu_for_tests("material_flag_replaces_the_material_as_predicted").is_none() {
         return;
     }
-    use facet_fit::material::{FittedMaterial, ModelChoice};
+    use facet_fit::model::material::{FittedMaterial, ModelChoice};
     use glam::DVec3;
     let dir = common::scratch("cli_material");
     // The fit: a grey GGX conductor.
@@ -644,7 +644,7 @@ fn material_flag_replaces_the_material_as_predicted() {
             let i = (y * size + x) as usize;
             gpu += DVec3::from_array(after[i].map(f64::from));
             blue += DVec3::from_array(before[i].map(f64::from));
-            let e = facet_fit::albedo::directional_albedo(
+            let e = facet_fit::model::albedo::directional_albedo(
                 brdf,
                 DVec3::new(th.sin(), 0.0, th.cos()),
                 64,
@@ -726,7 +726,8 @@ fn demo_runs_and_writes_what_the_readme_says() {
     // The PNG is the EXR through the tone map at exposure 0.
     check_tone_map(&png, &px, 0.0, 97);
     let fit =
-        facet_fit::material::FittedMaterial::load(&cwd.join("out/default-gold-ggx.json")).unwrap();
+        facet_fit::model::material::FittedMaterial::load(&cwd.join("out/default-gold-ggx.json"))
+            .unwrap();
     let ggx = fit.record.ggx.as_ref().unwrap();
     assert!(
         (ggx.alpha_x - 0.15).abs() < 0.003 && (ggx.alpha_y - 0.15).abs() < 0.003,

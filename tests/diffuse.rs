@@ -4,10 +4,10 @@
 mod common;
 
 use common::merl_from_spec;
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::fresnel::Fresnel;
-use facet_fit::fresnel_fit::FresnelChoice;
-use facet_fit::material::{FittedMaterial, ModelChoice};
+use facet_fit::fitting::fresnel_fit::FresnelChoice;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::model::fresnel::Fresnel;
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 
 #[test]
 fn plastics_come_back_with_kd_and_alpha() {
@@ -180,7 +180,7 @@ fn physical_fresnel_of_a_gold_conductor() {
 /// digits, and a matte plastic and a metal for range.
 #[test]
 fn refined_tabulated_model_beats_the_analytic_fits_on_proxies() {
-    let lib = facet_fit::nbrdf::NbrdfLibrary::embedded();
+    let lib = facet_fit::sources::nbrdf::NbrdfLibrary::embedded();
     for name in [
         "alumina-oxide",
         "nylon",
@@ -189,8 +189,8 @@ fn refined_tabulated_model_beats_the_analytic_fits_on_proxies() {
         "yellow-matte-plastic",
         "chrome",
     ] {
-        let table = facet_fit::merl::MerlTable::sample(&lib.get(name).unwrap());
-        let src = facet_fit::merl::MerlBrdf::from_table(name, table).unwrap();
+        let table = facet_fit::sources::merl::MerlTable::sample(&lib.get(name).unwrap());
+        let src = facet_fit::sources::merl::MerlBrdf::from_table(name, table).unwrap();
         let r = fit_material(&src, name, &FitConfig::isotropic())
             .unwrap()
             .record;

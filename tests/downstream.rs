@@ -81,7 +81,7 @@ fn downstream_example_fits_saves_loads_and_renders() {
     let stdout = run(Command::new(&exe).arg(&out), "facet-downstream");
     assert!(stdout.contains("rendered 64×64"), "{stdout}");
 
-    let fit = facet_fit::material::FittedMaterial::load(&out.join("fit.json")).unwrap();
+    let fit = facet_fit::model::material::FittedMaterial::load(&out.join("fit.json")).unwrap();
     let ggx = fit.record.ggx.as_ref().unwrap();
     assert!(ggx.alpha_x.is_finite() && ggx.alpha_x > 0.0, "{ggx:?}");
 

@@ -412,7 +412,7 @@ fn bad_input_is_an_error_naming_the_file() {
         &["would replace the fit"],
     );
     // The fit survived every refused export.
-    assert!(facet_fit::material::FittedMaterial::load(&dir.join("ggx-only.json")).is_ok());
+    assert!(facet_fit::model::material::FittedMaterial::load(&dir.join("ggx-only.json")).is_ok());
 }
 
 /// A `--no-diffuse --model ggx` fit records no Fresnel fits: the export fits its curve to the

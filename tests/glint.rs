@@ -2,7 +2,7 @@
 
 mod common;
 
-use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
 use facet_glint::dpf::{DpfConfig, DpfPyramid, DpfTable, cone_solid_angle, dpf, query_directions};
 use facet_glint::lit::select_cell;
 use facet_glint::tea::{pcg3d, pipeline_constants, tea, tea_unit};
@@ -58,7 +58,7 @@ fn dpf_integrates_to_the_cone_solid_angle() {
         let mut total = 0.0;
         let split = (gamma + 0.8).min(PI);
         for (lo, hi, n) in [(0.0, split, 64), (split, PI, 24)] {
-            for (x, w) in facet_fit::quadrature::gauss_legendre(n) {
+            for (x, w) in facet_fit::numerics::quadrature::gauss_legendre(n) {
                 let psi = lo + x * (hi - lo);
                 let nchi = 96;
                 for k in 0..nchi {
@@ -217,10 +217,10 @@ fn gpu_pyramid_matches_the_cpu_reference() {
         return;
     };
     let cfg = DpfConfig::preview();
-    let fit = facet_fit::fit::fit_material(
+    let fit = facet_fit::fitting::fit_material(
         &common::merl_from_spec("ggx?alpha=0.25&f0=0.04"),
         "test",
-        &facet_fit::fit::FitConfig::isotropic(),
+        &facet_fit::fitting::FitConfig::isotropic(),
     )
     .unwrap();
     let tabulated = fit.tabulated.ndf.clone();

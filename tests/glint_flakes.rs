@@ -1,7 +1,7 @@
 //! Statistics of flake counting against theory and against an explicit-flake reference.
 
-use facet_fit::fresnel::Fresnel;
-use facet_fit::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use facet_fit::model::fresnel::Fresnel;
+use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use facet_glint::dpf::dpf;
 use facet_glint::flakes::{Flake, FlakeField, Footprint, direction_cell};
 use facet_glint::glint_brdf::{GlintConfig, glint_count, glint_eval};
@@ -17,7 +17,7 @@ fn ndf() -> Ndf {
 }
 
 fn dir(theta_deg: f64, phi_deg: f64) -> DVec3 {
-    facet_fit::geometry::spherical(theta_deg.to_radians(), phi_deg.to_radians())
+    facet_fit::model::geometry::spherical(theta_deg.to_radians(), phi_deg.to_radians())
 }
 
 /// Deterministic footprints: random centre, random orientation, semi-axes in [r/2, 3r/2].
@@ -42,7 +42,7 @@ fn explicit_lit(f: &Flake, wi: DVec3, wo: DVec3, gamma: f64) -> bool {
     );
     let tan2 = -ALPHA * ALPHA * (1.0 - u).ln();
     let theta = tan2.sqrt().atan();
-    let m = facet_fit::geometry::spherical(theta, 2.0 * PI * v);
+    let m = facet_fit::model::geometry::spherical(theta, 2.0 * PI * v);
     let r = 2.0 * wi.dot(m) * m - wi;
     wi.dot(m) > 0.0 && r.dot(wo) >= gamma.cos()
 }
@@ -194,7 +194,7 @@ fn large_footprint_limit(model: MicrofacetBrdf) {
     ] {
         let p = dpf(&model.ndf, wi, wo, cfg.gamma);
         let glint = glint_eval(&model, &field, &fp, wi, wo, p, &cfg);
-        let smooth = facet_fit::brdf::Brdf::eval(&model, wi, wo).unwrap();
+        let smooth = facet_fit::model::brdf::Brdf::eval(&model, wi, wo).unwrap();
         println!("glint {glint:.5?} smooth {smooth:.5?}");
         assert!((0..3).all(|c| (glint[c] / smooth[c] - 1.0).abs() < 0.01));
     }
@@ -288,7 +288,8 @@ fn sampling_estimates_the_albedo() {
     for a in 0..nt {
         let t = (a as f64 + 0.5) / nt as f64 * PI / 2.0;
         for b in 0..np {
-            let wi = facet_fit::geometry::spherical(t, (b as f64 + 0.5) / np as f64 * 2.0 * PI);
+            let wi =
+                facet_fit::model::geometry::spherical(t, (b as f64 + 0.5) / np as f64 * 2.0 * PI);
             quad += f(wi) * t.sin() * (PI / 2.0 / nt as f64) * (2.0 * PI / np as f64);
         }
     }
@@ -407,7 +408,7 @@ fn gpu_glint_brdf_matches_cpu() {
     let Some(gpu) = facet_gpu::gpu_for_tests("gpu_glint_brdf_matches_cpu") else {
         return;
     };
-    use facet_fit::fresnel::FresnelTable;
+    use facet_fit::model::fresnel::FresnelTable;
     use facet_glint::dpf::{DpfConfig, DpfPyramid};
     use facet_glint::gpu::{GlintEvalQuery, GlintEvaluator, build_levels};
     let analytic = AnalyticNdf::isotropic(NdfKind::Beckmann, ALPHA);
@@ -677,7 +678,7 @@ fn blended_counts_do_not_pop_at_cell_edges() {
 fn tabulated_glints_converge_to_the_smooth_tabulated_brdf() {
     let path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo/default_fit.json");
-    let fit = facet_fit::material::FittedMaterial::load(&path).unwrap();
+    let fit = facet_fit::model::material::FittedMaterial::load(&path).unwrap();
     let model = fit.tabulated.clone();
     assert!(matches!(model.ndf, Ndf::Tabulated(_)));
     let field = FlakeField {
@@ -697,7 +698,7 @@ fn tabulated_glints_converge_to_the_smooth_tabulated_brdf() {
     ] {
         let p = dpf(&model.ndf, wi, wo, cfg.gamma);
         let glint = glint_eval(&model, &field, &fp, wi, wo, p, &cfg);
-        let smooth = facet_fit::brdf::Brdf::eval(&model, wi, wo).unwrap();
+        let smooth = facet_fit::model::brdf::Brdf::eval(&model, wi, wo).unwrap();
         println!("tabulated: glint {glint:.5?} smooth {smooth:.5?}");
         assert!((0..3).all(|c| (glint[c] / smooth[c] - 1.0).abs() < 0.01));
     }

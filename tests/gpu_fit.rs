@@ -5,14 +5,14 @@
 mod common;
 
 use common::merl_from_spec;
-use facet_fit::analytic::parse_analytic;
-use facet_fit::brdf::Brdf;
 use facet_fit::extract::{CpuSolver, ExtractConfig, extract_with};
-use facet_fit::fit::{Backend, FitConfig, fit_material_on};
-use facet_fit::fresnel::Fresnel;
+use facet_fit::fitting::{Backend, FitConfig, fit_material_on};
 use facet_fit::gpu::GpuFitter;
-use facet_fit::grid::{GridSamples, IsoTables, microfacet_error};
-use facet_fit::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use facet_fit::metric::grid::{GridSamples, IsoTables, microfacet_error};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::brdf::Brdf;
+use facet_fit::model::fresnel::Fresnel;
+use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use facet_gpu::gpu_for_tests;
 use std::sync::Arc;
 
@@ -48,7 +48,7 @@ fn compare(name: &str, src: &dyn Brdf, cfg: &FitConfig, fitter: &GpuFitter) {
         .zip(&cpu.fresnel.rgb)
         .flat_map(|(a, b)| (0..3).map(move |c| (a[c] / b[c] - 1.0).abs()))
         .fold(0.0, f64::max);
-    let alpha = |r: &facet_fit::material::FitRecord| {
+    let alpha = |r: &facet_fit::model::material::FitRecord| {
         let g = r.ggx.as_ref().unwrap();
         [g.alpha_x, g.alpha_y, g.moments.alpha_x, g.moments.alpha_y]
     };

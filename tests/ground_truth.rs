@@ -4,9 +4,9 @@
 mod common;
 
 use common::merl_from_spec;
-use facet_fit::analytic::parse_analytic;
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::fresnel::Fresnel;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::fresnel::Fresnel;
 
 #[test]
 fn isotropic_alpha_within_one_percent() {
@@ -130,9 +130,9 @@ fn resolution_reduces_alpha_error() {
 /// minimum: from them alone the Beckmann simplex ended at αx = 4 with twice the error.
 #[test]
 fn anisotropic_fit_is_no_worse_than_the_best_isotropic_alpha() {
-    use facet_fit::grid::{GridSamples, microfacet_error};
-    use facet_fit::microfacet::{AnalyticNdf, NdfKind};
-    use facet_fit::params::model_with_fresnel;
+    use facet_fit::fitting::params::model_with_fresnel;
+    use facet_fit::metric::grid::{GridSamples, microfacet_error};
+    use facet_fit::model::microfacet::{AnalyticNdf, NdfKind};
     let src = parse_analytic("ggx?alpha_x=0.01&alpha_y=0.02&f0=0.04&kd=0.5,0.4,0.3").unwrap();
     let r = fit_material(&src, "test", &FitConfig::anisotropic())
         .unwrap()

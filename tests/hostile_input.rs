@@ -6,10 +6,10 @@
 mod common;
 
 use common::scratch;
-use facet_fit::analytic::parse_analytic;
-use facet_fit::material::FittedMaterial;
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::material::FittedMaterial;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -170,7 +170,7 @@ fn special_files_are_refused_at_once() {
 #[test]
 fn sizes_declared_by_files_are_checked() {
     let dir = scratch("hostile_sizes");
-    let fit = facet_fit::fit::fit_material(
+    let fit = facet_fit::fitting::fit_material(
         &common::merl_from_spec("ggx?alpha=0.3"),
         "t",
         &facet_fit::FitConfig::isotropic(),
@@ -213,7 +213,7 @@ fn values_that_would_break_the_extraction_are_refused_up_front() {
     for d in [90i32, 90, 180] {
         bytes.extend(d.to_le_bytes());
     }
-    for _ in 0..3 * facet_fit::merl::SAMPLES {
+    for _ in 0..3 * facet_fit::sources::merl::SAMPLES {
         bytes.extend(1e308f64.to_le_bytes());
     }
     let path = dir.join("huge-values.binary");
@@ -225,8 +225,8 @@ fn values_that_would_break_the_extraction_are_refused_up_front() {
     );
     // A source whose f_r cos θi passes MAX_X on the MERL grid is refused with the value.
     let mut t = MerlTable::sample(&parse_analytic("ggx?alpha=0.3").unwrap());
-    (0..facet_fit::merl::SAMPLES).for_each(|s| t.scale_sample(s, [1e13; 3]));
-    let err = facet_fit::fit::fit_material(
+    (0..facet_fit::sources::merl::SAMPLES).for_each(|s| t.scale_sample(s, [1e13; 3]));
+    let err = facet_fit::fitting::fit_material(
         &MerlBrdf::from_table("bright", t).unwrap(),
         "t",
         &facet_fit::FitConfig::isotropic(),
@@ -360,7 +360,7 @@ fn outputs_stay_inside_out_and_never_replace_an_input() {
     let out = root.join("out");
     let out_s = out.to_str().unwrap();
     // A fit JSON whose name climbs out of --out, and a proxy library whose key does.
-    let fit = facet_fit::fit::fit_material(
+    let fit = facet_fit::fitting::fit_material(
         &common::merl_from_spec("ggx?alpha=0.3"),
         "t",
         &facet_fit::FitConfig::isotropic(),
@@ -570,7 +570,7 @@ fn a_mapped_merl_file_is_refused_as_a_read_one() {
     };
     let standard = |value: f64| {
         let mut b = header([90, 90, 180]);
-        for _ in 0..3 * facet_fit::merl::SAMPLES {
+        for _ in 0..3 * facet_fit::sources::merl::SAMPLES {
             b.extend(value.to_le_bytes());
         }
         b

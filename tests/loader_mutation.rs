@@ -22,11 +22,11 @@
 mod common;
 
 use facet_fit::Brdf;
-use facet_fit::analytic::parse_analytic;
-use facet_fit::material::{FittedMaterial, ModelChoice};
-use facet_fit::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
-use facet_fit::nbrdf::NbrdfLibrary;
-use facet_fit::rgl::{BsdfResolution, RglBsdf, rgl_tensor};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::sources::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
+use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, rgl_tensor};
 use facet_render::scene::data_uri::encode_base64;
 use facet_render::scene::{EnvironmentMap, LoadOptions, Scene};
 use glam::{DVec3, Vec2, Vec3};
@@ -1644,7 +1644,7 @@ fn fuzz_seeds() -> Vec<(&'static str, &'static str, Vec<u8>)> {
     small.extend([0.5f64, 0.6, 0.7].iter().flat_map(|v| v.to_le_bytes()));
     // A fit of the demo's, its tables thinned (every 8th NDF node, every 16th G1 node, every
     // 9th Fresnel angle) to a few KB; still a valid fit.
-    let mut fit: facet_fit::material::FitRecord =
+    let mut fit: facet_fit::model::material::FitRecord =
         serde_json::from_slice(&std::fs::read(repo("assets/demo/default_fit.json")).unwrap())
             .unwrap();
     let every = |v: &[f64], k: usize| v.iter().step_by(k).copied().collect::<Vec<f64>>();
@@ -1652,7 +1652,7 @@ fn fuzz_seeds() -> Vec<(&'static str, &'static str, Vec<u8>)> {
     assert_eq!(t.nphi, 1);
     (t.d, t.g1) = (every(&t.d, 8), every(&t.g1, 16));
     (t.nu, t.ng) = (t.d.len(), t.g1.len());
-    let thin = |f: &mut facet_fit::fresnel::FresnelTable| {
+    let thin = |f: &mut facet_fit::model::fresnel::FresnelTable| {
         f.theta_d = every(&f.theta_d, 9);
         f.rgb = f.rgb.iter().step_by(9).copied().collect();
     };

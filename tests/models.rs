@@ -4,16 +4,16 @@
 mod common;
 
 use common::{Rng, merl_from_spec, scratch};
-use facet_fit::analytic::parse_analytic;
-use facet_fit::brdf::Brdf;
 use facet_fit::extract::{ExtractConfig, Stopping, extract_isotropic};
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::fresnel::Fresnel;
-use facet_fit::geometry::spherical;
-use facet_fit::grid::{GridSamples, error_metric, microfacet_error, microfacet_errors};
-use facet_fit::material::{FittedMaterial, ModelChoice};
-use facet_fit::microfacet::{AnalyticNdf, MicrofacetBrdf, NdfKind};
-use facet_fit::tabulated::{Stretch, TabulatedNdf};
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::metric::grid::{GridSamples, error_metric, microfacet_error, microfacet_errors};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::brdf::Brdf;
+use facet_fit::model::fresnel::Fresnel;
+use facet_fit::model::geometry::spherical;
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, NdfKind};
+use facet_fit::model::tabulated::{Stretch, TabulatedNdf};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -87,8 +87,8 @@ fn sampling_matches_its_pdf() {
             let h = tab.sample([rng.next(), rng.next()]);
             assert!(h.z > 0.0 && (h.length() - 1.0).abs() < 1e-9);
             let c = ((1.0 - h.z) * nc as f64).min(nc as f64 - 1.0) as usize;
-            let p = (facet_fit::geometry::phi_of(h) / (2.0 * PI) * np as f64).min(np as f64 - 1.0)
-                as usize;
+            let p = (facet_fit::model::geometry::phi_of(h) / (2.0 * PI) * np as f64)
+                .min(np as f64 - 1.0) as usize;
             hist[c * np + p] += 1.0 / n as f64;
         }
         let mut expect = vec![0.0; nc * np];
@@ -114,9 +114,9 @@ fn sampling_matches_its_pdf() {
 
 #[test]
 fn grid_fast_path_matches_direct_evaluation() {
-    let src = facet_fit::merl::MerlBrdf::from_table(
+    let src = facet_fit::sources::merl::MerlBrdf::from_table(
         "noisy-gold",
-        facet_fit::merl::MerlTable::sample(
+        facet_fit::sources::merl::MerlTable::sample(
             &parse_analytic("ggx?alpha=0.25&conductor=gold&kd=0.05").unwrap(),
         ),
     )

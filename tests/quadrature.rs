@@ -5,9 +5,9 @@ mod common;
 
 use common::merl_from_spec;
 use facet_fit::extract::{ExtractConfig, extract_isotropic};
-use facet_fit::microfacet::NdfKind;
-use facet_fit::params::fit_moments;
-use facet_fit::quadrature::Quadrature;
+use facet_fit::fitting::params::fit_moments;
+use facet_fit::model::microfacet::NdfKind;
+use facet_fit::numerics::quadrature::Quadrature;
 
 #[test]
 fn sqrt_theta_rules_beat_the_papers_uniform_theta() {

@@ -5,9 +5,9 @@ mod common;
 
 use common::{merl_from_spec, scratch, spectral_from_rgb};
 use facet_fit::Brdf;
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::grid::{GridSamples, error_metric};
-use facet_fit::rgl::{BsdfResolution, RglBsdf, write_rgl};
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::metric::grid::{GridSamples, error_metric};
+use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, write_rgl};
 use std::process::Command;
 
 /// A GGX plastic written as a MERL table, written as a `.bsdf` and read back: within 0.01 of
@@ -65,7 +65,7 @@ fn a_spectral_file_reads_as_its_rgb() {
     let rgb = RglBsdf::open(&rgb_path).unwrap();
     let spectral = RglBsdf::open(&spec_path).unwrap();
     assert!(spectral.is_spectral() && !rgb.is_spectral());
-    let d = |t: f64, p: f64| facet_fit::geometry::spherical(t, p);
+    let d = |t: f64, p: f64| facet_fit::model::geometry::spherical(t, p);
     for (wi, wo) in [
         (d(0.3, 0.0), d(0.5, 3.0)),
         (d(1.0, 1.0), d(0.2, 2.0)),
@@ -89,14 +89,14 @@ fn the_files_pdf_matches_its_albedo() {
     let path = dir.join("metal.bsdf");
     write_rgl(&path, &merl, BsdfResolution::standard(), "").unwrap();
     let back = RglBsdf::open(&path).unwrap();
-    let wi = facet_fit::geometry::spherical(0.6, 0.0);
+    let wi = facet_fit::model::geometry::spherical(0.6, 0.0);
     let n = 600;
     let (mut mass, mut albedo) = (0.0, 0.0);
     for a in 0..n {
         let ct = (a as f64 + 0.5) / n as f64;
         for b in 0..n {
             let phi = 2.0 * std::f64::consts::PI * (b as f64 + 0.5) / n as f64;
-            let wo = facet_fit::geometry::spherical(ct.acos(), phi);
+            let wo = facet_fit::model::geometry::spherical(ct.acos(), phi);
             mass += back.pdf(wi, wo);
             albedo += back.eval(wi, wo).unwrap()[0] * ct;
         }

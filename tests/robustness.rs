@@ -3,11 +3,11 @@
 mod common;
 
 use common::{Rng, merl_from_spec, scratch};
-use facet_fit::analytic::parse_analytic;
 use facet_fit::error::FitError;
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::geometry::from_half_diff;
-use facet_fit::merl::{MerlBrdf, MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles};
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::geometry::from_half_diff;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles};
 use std::path::Path;
 
 fn ggx_alpha(src: &MerlBrdf) -> (f64, f64) {
@@ -95,7 +95,7 @@ fn merl_write_read_round_trip_is_exact() {
     for &(i, j, k) in &[(10, 20, 30), (45, 5, 170), (80, 60, 90)] {
         let v = table.value(i, j, k).unwrap();
         let u = (i as f64 + 0.5) / 90.0;
-        let mid = facet_fit::geometry::HalfDiff {
+        let mid = facet_fit::model::geometry::HalfDiff {
             theta_h: u * u * std::f64::consts::FRAC_PI_2,
             phi_h: 0.0,
             theta_d: (j as f64 + 0.5) / 90.0 * std::f64::consts::FRAC_PI_2,
@@ -119,7 +119,7 @@ fn merl_write_read_round_trip_is_exact() {
 fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
     let dir = scratch("merl_mapped");
     let mut table = spec_table("ggx?alpha=0.1&f0=0.04&kd=0.2");
-    table.mark_missing(facet_fit::merl::index(30, 40, 50));
+    table.mark_missing(facet_fit::sources::merl::index(30, 40, 50));
     let path = dir.join("plastic.binary");
     table.write(&path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
@@ -129,7 +129,12 @@ fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
     #[cfg(target_os = "linux")]
     assert!(format!("{mapped:?}").ends_with("mapped)"), "{mapped:?}");
     assert_eq!(mapped.missing_count(), read.missing_count());
-    for s in [0, 1234, facet_fit::merl::index(30, 40, 50), SAMPLES - 1] {
+    for s in [
+        0,
+        1234,
+        facet_fit::sources::merl::index(30, 40, 50),
+        SAMPLES - 1,
+    ] {
         assert_eq!(
             mapped.value_at(s).map(|v| v.map(f64::to_bits)),
             read.value_at(s).map(|v| v.map(f64::to_bits))
@@ -137,9 +142,9 @@ fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
     }
     // Both sources give the fit the same samples: the same fit, to the bit.
     let cfg = facet_fit::FitConfig {
-        models: facet_fit::fit::Models {
+        models: facet_fit::fitting::Models {
             tabulated: true,
-            ..facet_fit::fit::Models::NONE
+            ..facet_fit::fitting::Models::NONE
         },
         ..facet_fit::FitConfig::isotropic()
     };
@@ -151,7 +156,7 @@ fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
         fit(&MerlBrdf::map(&path).unwrap()),
         fit(&MerlBrdf::open(&path).unwrap())
     );
-    let s = facet_fit::merl::index(10, 20, 30);
+    let s = facet_fit::sources::merl::index(10, 20, 30);
     mapped.scale_sample(s, [2.0; 3]);
     let v = read.value_at(s).unwrap();
     assert_eq!(mapped.value_at(s).unwrap(), v.map(|v| v * 2.0));
@@ -171,7 +176,7 @@ fn interpolated_lookup_beats_nearest_between_bins() {
     let mut rng = Rng(3);
     let (mut e_near, mut e_interp) = (0.0, 0.0);
     for _ in 0..2000 {
-        let c = facet_fit::geometry::HalfDiff {
+        let c = facet_fit::model::geometry::HalfDiff {
             theta_h: rng.next() * 1.2,
             phi_h: 0.0,
             theta_d: rng.next() * 1.2,
@@ -181,7 +186,7 @@ fn interpolated_lookup_beats_nearest_between_bins() {
         if wi.z < 0.2 || wo.z < 0.2 {
             continue;
         }
-        use facet_fit::brdf::Brdf;
+        use facet_fit::model::brdf::Brdf;
         let t = model.eval(wi, wo).unwrap()[0];
         e_near += (table.lookup_nearest(wi, wo).unwrap()[0] / t - 1.0).abs();
         e_interp += (table.lookup_interpolated(wi, wo).unwrap()[0] / t - 1.0).abs();
@@ -306,14 +311,14 @@ fn bad_specs_and_proxies_get_clear_errors() {
     let dir = scratch("bad_nbrdf");
     let bad = dir.join("bad.json");
     std::fs::write(&bad, r#"{"m": {"W1": [[1.0]], "b1": [0.0], "W2": [[1.0]], "b2": [0.0], "W3": [[1.0]], "b3": [0.0]}}"#).unwrap();
-    let lib = facet_fit::nbrdf::NbrdfLibrary::open(&bad).unwrap();
+    let lib = facet_fit::sources::nbrdf::NbrdfLibrary::open(&bad).unwrap();
     let err = lib.get("m").err().unwrap().to_string();
     assert!(
         err.contains("bad.json") && err.contains("W1 must be 6×1"),
         "{err}"
     );
     std::fs::write(&bad, "[1, 2").unwrap();
-    let err = facet_fit::nbrdf::NbrdfLibrary::open(&bad)
+    let err = facet_fit::sources::nbrdf::NbrdfLibrary::open(&bad)
         .err()
         .unwrap()
         .to_string();

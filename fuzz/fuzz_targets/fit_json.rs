@@ -1,7 +1,7 @@
 //! Fit JSON loader (`FittedMaterial::parse`): the input as text (invalid UTF-8 replaced).
 #![no_main]
 
-use facet_fit::material::{FittedMaterial, ModelChoice};
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fuzz::{assert_brdf_sane, assert_names, run};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;

@@ -9,7 +9,7 @@
 //! The table is changed in place and restored after each run.
 #![no_main]
 
-use facet_fit::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
+use facet_fit::sources::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
 use facet_fuzz::{assert_brdf_sane, assert_names, run};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
@@ -19,7 +19,7 @@ use std::sync::{Mutex, OnceLock};
 fn valid() -> &'static Mutex<Vec<u8>> {
     static FILE: OnceLock<Mutex<Vec<u8>>> = OnceLock::new();
     FILE.get_or_init(|| {
-        let model = facet_fit::analytic::parse_analytic("ggx?alpha=0.2").unwrap();
+        let model = facet_fit::model::analytic::parse_analytic("ggx?alpha=0.2").unwrap();
         let dir = std::env::temp_dir().join(format!("facet-fuzz-merl-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let file = dir.join("ggx.binary");

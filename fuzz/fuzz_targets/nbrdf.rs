@@ -2,7 +2,7 @@
 //! evaluated at a few directions.
 #![no_main]
 
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fuzz::{assert_brdf_sane, assert_names, run};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;

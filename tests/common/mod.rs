@@ -1,9 +1,9 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use facet_fit::analytic::parse_analytic;
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::PathBuf;
 
 /// An analytic BRDF written as a MERL table (bin lower edges) and read back as a source.
@@ -47,7 +47,7 @@ impl Rng {
 /// 360, 370, …, 830 nm holding at every node the flat spectrum of the node's mean RGB (so that
 /// it reads back as that grey).
 pub fn spectral_from_rgb(rgb_file: &[u8]) -> Vec<u8> {
-    use facet_fit::tensor_file::{TensorFile, TensorWriter};
+    use facet_fit::sources::rgl::tensor_file::{TensorFile, TensorWriter};
     let t = TensorFile::parse(rgb_file.to_vec()).unwrap();
     let mut w = TensorWriter::default();
     for name in t.names() {

@@ -5,11 +5,11 @@
 //!
 //! `cargo run --release -p facet-fit --example alpha_scan -- NAME...`
 
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::grid::{GridSamples, fresnel_diffuse_and_error};
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::metric::grid::{GridSamples, fresnel_diffuse_and_error};
+use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 
 /// Reweighted steps of each scanned α's F / ρd solve.
 const IRLS: usize = 4;

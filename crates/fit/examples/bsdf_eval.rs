@@ -5,8 +5,8 @@
 //! `cargo run --release -p facet-fit --example bsdf_eval -- FILE.bsdf [PAIRS] | python3 crates/fit/examples/mitsuba_check.py FILE.bsdf`
 
 use facet_fit::Brdf;
-use facet_fit::geometry::spherical;
-use facet_fit::rgl::RglBsdf;
+use facet_fit::model::geometry::spherical;
+use facet_fit::sources::rgl::RglBsdf;
 use std::path::Path;
 
 fn main() {

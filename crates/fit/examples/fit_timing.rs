@@ -7,10 +7,10 @@
 //! `SINGLE_LOBE=1` times the paper's pipeline (`FitConfig::single_lobe`) instead of the default.
 
 use facet_fit::Brdf;
-use facet_fit::analytic::parse_analytic;
-use facet_fit::fit::{FitConfig, Models, fit_material};
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::fitting::{FitConfig, Models, fit_material};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -136,7 +136,7 @@ fn main() {
 /// Time of the two passes and the sample set (temporary probe).
 #[allow(dead_code)]
 pub fn probe(src: &MerlBrdf) {
-    use facet_fit::grid::{GridSamples, fresnel_average, microfacet_error};
+    use facet_fit::metric::grid::{GridSamples, fresnel_average, microfacet_error};
     let t = Instant::now();
     let set = GridSamples::new(src);
     let t_first = t.elapsed().as_secs_f64() * 1e3;
@@ -165,7 +165,7 @@ pub fn probe(src: &MerlBrdf) {
     });
     for irls in [0, 1, 2] {
         let t = time(&|| {
-            std::hint::black_box(facet_fit::grid::fresnel_diffuse_and_error(
+            std::hint::black_box(facet_fit::metric::grid::fresnel_diffuse_and_error(
                 &model, &set, irls,
             ));
         });
@@ -180,9 +180,9 @@ pub fn probe(src: &MerlBrdf) {
 #[allow(dead_code)]
 pub fn sweep(src: &MerlBrdf) {
     use facet_fit::extract::extract_isotropic;
-    use facet_fit::grid::{GridSamples, microfacet_error};
-    use facet_fit::microfacet::NdfKind;
-    use facet_fit::params::{fit_least_squares, fit_moments, model_with_fresnel};
+    use facet_fit::fitting::params::{fit_least_squares, fit_moments, model_with_fresnel};
+    use facet_fit::metric::grid::{GridSamples, microfacet_error};
+    use facet_fit::model::microfacet::NdfKind;
     let set = GridSamples::new(src);
     let ex = extract_isotropic(src, &Default::default()).unwrap();
     for kind in NdfKind::ALL {

@@ -6,9 +6,9 @@
 //!
 //! `cargo run --release -p facet-fit --example proxy_sweep [-- NAME_FILTER]`
 
-use facet_fit::fit::{FitConfig, Models, fit_material};
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::fitting::{FitConfig, Models, fit_material};
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::time::Instant;
 
 struct Row {

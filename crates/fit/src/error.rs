@@ -7,7 +7,7 @@ use std::path::PathBuf;
 pub enum FitError {
     /// A file that is not a regular file, too large for its kind, or unreadable.
     #[error(transparent)]
-    Input(#[from] crate::input::InputError),
+    Input(#[from] crate::io::input::InputError),
     /// Reading or writing a file failed.
     #[error("{path}: {source}")]
     Io {

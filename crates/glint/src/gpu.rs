@@ -5,8 +5,8 @@ use crate::cone_rule::{ConeRule, LevelRule, Ring, lobe_width};
 use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG};
 use crate::lobe_rule::{LOBE_EPS, TAIL_START, TOUCH_MERGE};
 use bytemuck::{Pod, Zeroable};
-use facet_fit::geometry::spherical;
-use facet_fit::microfacet::Ndf;
+use facet_fit::model::geometry::spherical;
+use facet_fit::model::microfacet::Ndf;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Uniforms of the build (WGSL `Params`).
@@ -41,8 +41,8 @@ fn ndf_upload(ndf: &Ndf) -> (DpfParams, Vec<f32>) {
     match ndf {
         Ndf::Analytic(a) => {
             let kind = match a.kind {
-                facet_fit::microfacet::NdfKind::Ggx => 0,
-                facet_fit::microfacet::NdfKind::Beckmann => 1,
+                facet_fit::model::microfacet::NdfKind::Ggx => 0,
+                facet_fit::model::microfacet::NdfKind::Beckmann => 1,
             };
             let p = DpfParams {
                 ndf_kind: kind,
@@ -455,8 +455,8 @@ impl GlintEvaluator {
         gpu: &Gpu,
         field: &crate::flakes::FlakeField,
         cfg: &crate::glint_brdf::GlintConfig,
-        ndf: &facet_fit::microfacet::AnalyticNdf,
-        fresnel: &facet_fit::fresnel::FresnelTable,
+        ndf: &facet_fit::model::microfacet::AnalyticNdf,
+        fresnel: &facet_fit::model::fresnel::FresnelTable,
         dpf: &GpuDpf,
         queries: &[GlintEvalQuery],
     ) -> Result<Vec<[f64; 3]>, GpuError> {
@@ -536,8 +536,8 @@ pub fn eval_params<'a>(
     let (ndf_kind, alpha_x, alpha_y, rotation) = match ndf {
         Ndf::Analytic(a) => (
             match a.kind {
-                facet_fit::microfacet::NdfKind::Ggx => 0,
-                facet_fit::microfacet::NdfKind::Beckmann => 1,
+                facet_fit::model::microfacet::NdfKind::Ggx => 0,
+                facet_fit::model::microfacet::NdfKind::Beckmann => 1,
             },
             a.alpha_x,
             a.alpha_y,

@@ -11,7 +11,7 @@
 //! glint counting, evaluation and sampling in WGSL.
 //!
 //! ```
-//! use facet_fit::microfacet::{AnalyticNdf, Ndf, NdfKind};
+//! use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
 //! use facet_glint::dpf::{dpf, query_directions};
 //!
 //! let ndf = Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Beckmann, 0.1));

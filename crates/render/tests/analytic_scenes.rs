@@ -11,9 +11,9 @@
 //! against the GPU's random pixel positions.
 
 use facet_fit::Brdf;
-use facet_fit::material::{FittedMaterial, ModelChoice};
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::microfacet::{AnalyticNdf, NdfKind, correlation, g2};
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::model::microfacet::{AnalyticNdf, NdfKind, correlation, g2};
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{
@@ -863,7 +863,7 @@ fn rotated_anisotropic_ggx_sphere_matches_the_cpu_evaluator() {
     else {
         return;
     };
-    let model = facet_fit::analytic::parse_analytic("ggx?alpha=0.3&f0=1").unwrap();
+    let model = facet_fit::model::analytic::parse_analytic("ggx?alpha=0.3&f0=1").unwrap();
     let src = MerlBrdf::from_table("ggx", MerlTable::sample(&model)).unwrap();
     let fit = facet_fit::fit_material(&src, "test", &facet_fit::FitConfig::isotropic()).unwrap();
     let with = |alpha_x: f64, alpha_y: f64, rotation: f64| {

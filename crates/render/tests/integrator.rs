@@ -1,9 +1,9 @@
 //! The wavefront integrator against theory: white furnaces, the glints' smooth limit and their
 //! filtered switch, only-what-is-needed resources, determinism. GPU tests (lavapipe in CI).
 
-use facet_fit::material::FittedMaterial;
-use facet_fit::merl::{MerlBrdf, MerlTable};
-use facet_fit::microfacet::MicrofacetBrdf;
+use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::microfacet::MicrofacetBrdf;
+use facet_fit::sources::merl::{MerlBrdf, MerlTable};
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{
@@ -47,13 +47,14 @@ fn lambert(albedo: f32) -> Material {
 fn conductor_fit() -> Arc<FittedMaterial> {
     static FIT: OnceLock<Arc<FittedMaterial>> = OnceLock::new();
     FIT.get_or_init(|| {
-        let model = facet_fit::analytic::parse_analytic("ggx?alpha=0.3&f0=1").unwrap();
+        let model = facet_fit::model::analytic::parse_analytic("ggx?alpha=0.3&f0=1").unwrap();
         let src = MerlBrdf::from_table("ggx-0.3", MerlTable::sample(&model)).unwrap();
         let fit =
             facet_fit::fit_material(&src, "test", &facet_fit::FitConfig::isotropic()).unwrap();
         let mut r = fit.record.clone();
-        let one =
-            |t: &mut facet_fit::fresnel::FresnelTable| t.rgb.iter_mut().for_each(|c| *c = [1.0; 3]);
+        let one = |t: &mut facet_fit::model::fresnel::FresnelTable| {
+            t.rgb.iter_mut().for_each(|c| *c = [1.0; 3])
+        };
         one(&mut r.fresnel);
         for p in [r.ggx.as_mut(), r.beckmann.as_mut()].into_iter().flatten() {
             one(&mut p.fresnel);
@@ -146,7 +147,7 @@ fn white_furnace_lambert_sphere_is_one() {
 }
 
 /// A conductor with F = 1 under a uniform environment of radiance 1 renders its directional
-/// albedo E(θo), computed on the CPU by facet_fit::albedo for the same fitted model.
+/// albedo E(θo), computed on the CPU by facet_fit::model::albedo for the same fitted model.
 #[test]
 fn white_furnace_conductor_matches_cpu_albedo() {
     let Some(gpu) = gpu_for_tests("white_furnace_conductor_matches_cpu_albedo") else {
@@ -159,17 +160,20 @@ fn white_furnace_conductor_matches_cpu_albedo() {
         let fit = conductor_fit();
         let brdf: &MicrofacetBrdf = fit
             .model(match model {
-                FacetModel::Ggx => facet_fit::material::ModelChoice::Ggx,
-                FacetModel::Beckmann => facet_fit::material::ModelChoice::Beckmann,
-                FacetModel::Tabulated => facet_fit::material::ModelChoice::Tabulated,
+                FacetModel::Ggx => facet_fit::model::material::ModelChoice::Ggx,
+                FacetModel::Beckmann => facet_fit::model::material::ModelChoice::Beckmann,
+                FacetModel::Tabulated => facet_fit::model::material::ModelChoice::Tabulated,
             })
             .unwrap();
         // E(θo) tabulated every degree, interpolated per pixel.
         let table: Vec<f64> = (0..=90)
             .map(|deg| {
                 let t = (deg as f64).to_radians();
-                facet_fit::albedo::directional_albedo(brdf, DVec3::new(t.sin(), 0.0, t.cos()), 128)
-                    [0]
+                facet_fit::model::albedo::directional_albedo(
+                    brdf,
+                    DVec3::new(t.sin(), 0.0, t.cos()),
+                    128,
+                )[0]
             })
             .collect();
         let expect = |theta: f64| {

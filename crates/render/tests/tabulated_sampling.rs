@@ -3,12 +3,12 @@
 //! extracted table (plain, and stretched and rotated) and an anisotropic table, from normal to
 //! grazing views.
 
-use facet_fit::chi2;
-use facet_fit::geometry::spherical;
-use facet_fit::material::FittedMaterial;
-use facet_fit::microfacet::Ndf;
-use facet_fit::microfacet::{AnalyticNdf, NdfKind};
-use facet_fit::tabulated::{NdfTables, Stretch, TabulatedNdf, phi_node, u_node_theta};
+use facet_fit::model::geometry::spherical;
+use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::microfacet::Ndf;
+use facet_fit::model::microfacet::{AnalyticNdf, NdfKind};
+use facet_fit::model::tabulated::{NdfTables, Stretch, TabulatedNdf, phi_node, u_node_theta};
+use facet_fit::numerics::chi2;
 use facet_gpu::{buffer, dispatch, shader};
 use facet_render::resources::materials::tabulated_block;
 use glam::DVec3;

@@ -1,7 +1,7 @@
 //! `SceneResources::update_material`: an edit written in place renders exactly as resources
 //! built from scratch for the edited scene (same seed, same image).
 
-use facet_fit::material::FittedMaterial;
+use facet_fit::model::material::FittedMaterial;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, FacetModel, Material, Scene};
 use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};

@@ -3,8 +3,8 @@
 
 use crate::material::{EditedMaterial, MaterialKey};
 use crate::preview::{Command, Orbit, Preview, PreviewScene};
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::material::FittedMaterial;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::model::material::FittedMaterial;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
 use std::time::Instant;
@@ -100,7 +100,7 @@ impl ViewerApp {
             shown_frame: 0,
             sent_exposure: 0.0,
             preview_rect: None,
-            nbrdf: facet_fit::nbrdf::NbrdfLibrary::override_path(None),
+            nbrdf: facet_fit::sources::nbrdf::NbrdfLibrary::override_path(None),
             proxy_names: None,
             screenshot: None,
         }
@@ -172,7 +172,7 @@ impl ViewerApp {
         std::thread::spawn(move || {
             let r = (|| {
                 let mut lib = None;
-                let src = facet_fit::source::open_source(&spec, nbrdf.as_deref(), &mut lib)
+                let src = facet_fit::sources::open_source(&spec, nbrdf.as_deref(), &mut lib)
                     .map_err(|e| e.to_string())?;
                 *st.lock().unwrap() = "extracting the NDF and fitting".into();
                 fit_material(&*src, &spec, &FitConfig::isotropic()).map_err(|e| e.to_string())
@@ -219,7 +219,7 @@ impl ViewerApp {
     pub fn proxies(&mut self) -> &Result<Vec<String>, String> {
         let path = self.nbrdf.clone();
         self.proxy_names.get_or_insert_with(|| {
-            facet_fit::nbrdf::NbrdfLibrary::open_or_embedded(path.as_deref())
+            facet_fit::sources::nbrdf::NbrdfLibrary::open_or_embedded(path.as_deref())
                 .map(|lib| lib.names().map(str::to_owned).collect())
                 .map_err(|e| e.to_string())
         })

@@ -1,6 +1,6 @@
 //! The edited material: a fit record, the model shown, and the edits applied on top of it.
 
-use facet_fit::material::{FitRecord, FittedMaterial};
+use facet_fit::model::material::{FitRecord, FittedMaterial};
 use facet_render::scene::{FacetMaterial, FacetModel, GlintParams, Material};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -216,7 +216,7 @@ impl EditedMaterial {
     /// The edited record as saved: edited α and ρd, Fresnel tables times the tint.
     pub fn edited_record(&self) -> FitRecord {
         let mut r = self.record.clone();
-        let tint = |t: &mut facet_fit::fresnel::FresnelTable| {
+        let tint = |t: &mut facet_fit::model::fresnel::FresnelTable| {
             for v in &mut t.rgb {
                 for (x, k) in v.iter_mut().zip(self.tint) {
                     *x *= k;
@@ -265,7 +265,7 @@ impl EditedMaterial {
 
     /// What the renderer's material depends on, for change detection (cheap to compare).
     pub fn key(&self) -> MaterialKey {
-        let p = |p: &Option<facet_fit::material::ParamRecord>| {
+        let p = |p: &Option<facet_fit::model::material::ParamRecord>| {
             p.as_ref().map(|p| {
                 [
                     p.alpha_x,

@@ -3,7 +3,7 @@
 
 use crate::material::{EditedMaterial, MaterialKey, Shown};
 use egui::{Color32, Pos2, Rect, Stroke, Ui, pos2, vec2};
-use facet_fit::material::{FittedMaterial, ModelChoice};
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use glam::DVec3;
 use std::sync::{Arc, Mutex};
 
@@ -55,7 +55,7 @@ pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
     ui.heading("Plots");
     // NDF slice at φ = 0, log10 D against θ in degrees.
     let thetas: Vec<f64> = (0..=160).map(|i| i as f64 * 0.5).collect();
-    let slice = |ndf: &facet_fit::microfacet::Ndf| -> Vec<f64> {
+    let slice = |ndf: &facet_fit::model::microfacet::Ndf| -> Vec<f64> {
         thetas
             .iter()
             .map(|t| {

@@ -4,7 +4,7 @@
 use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use facet_fit::material::FittedMaterial;
+use facet_fit::model::material::FittedMaterial;
 use facet_render::scene::FacetModel;
 use facet_viewer::ViewerApp;
 use facet_viewer::material::Shown;
@@ -243,8 +243,8 @@ fn diffuse_albedo_edits_reach_the_renderer_and_reset_to_the_fit() {
         let app = h.state();
         let m = app.material.render_material().unwrap().facet.unwrap();
         let choice = match shown {
-            Shown::Tabulated => facet_fit::material::ModelChoice::Tabulated,
-            _ => facet_fit::material::ModelChoice::Ggx,
+            Shown::Tabulated => facet_fit::model::material::ModelChoice::Tabulated,
+            _ => facet_fit::model::material::ModelChoice::Ggx,
         };
         // Clamped to [0, 1]; the renderer's model carries it.
         assert_eq!(

@@ -6,9 +6,9 @@
 //! adapter (`FACET_BACKEND` and `FACET_ADAPTER` choose another), writing `OUT_DIR/fit.json` and
 //! `OUT_DIR/sphere.png`.
 
-use facet_fit::fit::{FitConfig, fit_material};
-use facet_fit::material::{FittedMaterial, ModelChoice};
-use facet_fit::nbrdf::NbrdfLibrary;
+use facet_fit::fitting::{FitConfig, fit_material};
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_glint::dpf::{dpf, query_directions};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, FacetModel, Material, shapes};

@@ -3,8 +3,8 @@
 
 use super::GpuSamples;
 use super::grid::grid_constants;
-use crate::brdf::Rgb;
-use crate::grid::{GridSamples, IsoTables, fresnel_from_sums};
+use crate::metric::grid::{GridSamples, IsoTables, fresnel_from_sums};
+use crate::model::brdf::Rgb;
 use facet_gpu::{Gpu, GpuError, shader};
 
 /// The Fresnel average over the MERL grid on the GPU (`shaders/fit/fresnel.wgsl`).

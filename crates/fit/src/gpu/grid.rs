@@ -2,10 +2,10 @@
 //! (`merl_geometry.rs`, `iso_grid.rs`): its geometry uploaded once per fitter, a source's
 //! ln(1 + x) and validity flags once per source, read in place by the passes over the grid.
 
-use crate::grid::{GridSamples, IsoTables};
-use crate::iso_grid::PADDED;
-use crate::merl::THETA_D_RES;
-use crate::merl_geometry::{ROW, ROWS, merl_geometry};
+use crate::metric::grid::{GridSamples, IsoTables};
+use crate::metric::iso_grid::PADDED;
+use crate::metric::merl_geometry::{ROW, ROWS, merl_geometry};
+use crate::sources::merl::THETA_D_RES;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch};
 
 /// The overrides of `grid.inc.wgsl`, for the pipelines that include it.

@@ -15,7 +15,7 @@ pub use grid::{GpuGrid, GpuSamples};
 pub use power_iteration::PowerIteration;
 
 use crate::error::FitError;
-use crate::grid::GridSamples;
+use crate::metric::grid::GridSamples;
 use bytemuck::{Pod, Zeroable};
 use facet_gpu::{Gpu, GpuError};
 use std::sync::OnceLock;

@@ -6,9 +6,9 @@ use crate::error::RenderError;
 use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
 use crate::scene::{FacetModel, GlintParams, Material};
-use facet_fit::material::ModelChoice;
-use facet_fit::microfacet::{Ndf, NdfKind};
-use facet_fit::tabulated::TabulatedNdf;
+use facet_fit::model::material::ModelChoice;
+use facet_fit::model::microfacet::{Ndf, NdfKind};
+use facet_fit::model::tabulated::TabulatedNdf;
 
 /// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
 pub const FRESNEL_NODES: usize = 91;

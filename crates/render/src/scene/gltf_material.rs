@@ -10,7 +10,7 @@
 //! `glint.density` is required, `gamma_deg` defaults to 2 and `threshold` to 50.
 //! Images are decoded here, one at a time, so that a missing or broken image only costs its
 //! texture (a warning naming the image, its file and the problem, and the material), never the
-//! whole scene. An image file is read through [`facet_fit::input`] ([`Cap::TEXTURE`]); its header
+//! whole scene. An image file is read through [`facet_fit::io::input`] ([`Cap::TEXTURE`]); its header
 //! is read first and a size over [`MAX_TEXTURE_SIDE`] on a side, or one that would bring the
 //! scene's textures past [`MAX_SCENE_TEXELS`], is refused before any pixel is decoded; the
 //! decoder then runs under [`image::Limits`] (the same sides, [`MAX_DECODE_BYTES`]).
@@ -19,8 +19,8 @@ use super::gltf_buffers::Buffers;
 use super::uri::{UriTarget, resolve};
 use super::{FacetMaterial, FacetModel, GlintParams, Material, Texture};
 use crate::error::RenderError;
-use facet_fit::input::{self, Cap};
-use facet_fit::material::{FittedMaterial, ModelChoice};
+use facet_fit::io::input::{self, Cap};
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use glam::{Vec3, Vec4};
 use serde_json::Value;
 use std::collections::HashMap;

@@ -143,7 +143,7 @@ pub struct FacetMaterial {
     /// The fit JSON it was loaded from.
     pub source: PathBuf,
     /// The fit.
-    pub fit: Arc<facet_fit::material::FittedMaterial>,
+    pub fit: Arc<facet_fit::model::material::FittedMaterial>,
     /// Which of its models to render.
     pub model: FacetModel,
     /// Glint parameters: render the model's NDF as discrete flakes.

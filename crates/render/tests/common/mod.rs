@@ -177,8 +177,8 @@ impl GltfBuilder {
 pub fn small_fit() -> &'static Path {
     static FIT: OnceLock<PathBuf> = OnceLock::new();
     FIT.get_or_init(|| {
-        use facet_fit::fit::{FitConfig, Models, fit_material};
-        let src = facet_fit::analytic::parse_analytic("ggx?alpha=0.3&f0=0.04").unwrap();
+        use facet_fit::fitting::{FitConfig, Models, fit_material};
+        let src = facet_fit::model::analytic::parse_analytic("ggx?alpha=0.3&f0=0.04").unwrap();
         let mut cfg = FitConfig::isotropic();
         cfg.extract.resolution = 32;
         cfg.models = Models {

@@ -1,0 +1,1165 @@
+//! A fit's analytic model written for another renderer: a Mitsuba 3 `<bsdf>`, a pbrt-v4
+//! `MakeNamedMaterial`, or a glTF 2.0 material, with what it approximates.
+//!
+//! Each export takes one analytic fit (GGX by default; Beckmann on request, where the target
+//! has it), its α (αx, αy along the fit's rotated axes), its Lambertian albedo ρd and one of
+//! the physical Fresnel curves fitted to its table ([`crate::fitting::fresnel_fit`]), and states in the
+//! file what it approximates: the Fresnel curve used with its recorded error in Facet's metric
+//! ([`FitQuality::error`], the model with that curve in place of its table), the error of the
+//! model with its table for comparison, and what the target cannot represent ([`Report`]).
+//!
+//! The material is exported as a **conductor** or a **plastic** (a diffuse base under a
+//! dielectric interface). [`KindRequest::Auto`] takes a conductor when
+//!
+//! - the Schlick F0 of the fit, averaged over the channels, is at least [`CONDUCTOR_MIN_F0`]
+//!   (every common dielectric lies below 0.2, η ≈ 2.6, every metal above 0.5), or
+//! - ρd is at most [`CONDUCTOR_MAX_ALBEDO`] in every channel (a plastic would keep nothing but
+//!   its Fresnel) and the conductor curve's error is below [`CONDUCTOR_MARGIN`] × the
+//!   dielectric's (recorded errors, else the RMS distances to the table): a coloured F that one
+//!   η cannot make, as a metallic paint's.
+//!
+//! The error comparison alone decides nothing: the conductor curve (η and k per channel)
+//! contains the dielectric one (k = 0), so its error is never much above the dielectric's, and
+//! a colourless table fits both alike.
+
+use crate::error::FitError;
+use crate::fitting::fresnel_fit::{FitQuality, FresnelChoice, FresnelFits};
+use crate::model::brdf::Rgb;
+use crate::model::fresnel::dielectric;
+use crate::model::material::{FitRecord, FittedMaterial, ParamRecord};
+use crate::model::microfacet::NdfKind;
+use serde::Serialize;
+use serde_json::json;
+use std::path::Path;
+
+/// The mean Schlick F0 from which [`KindRequest::Auto`] exports a conductor.
+pub const CONDUCTOR_MIN_F0: f64 = 0.2;
+
+/// The largest ρd (every channel) with which [`KindRequest::Auto`] weighs the Fresnel errors.
+pub const CONDUCTOR_MAX_ALBEDO: f64 = 0.01;
+
+/// How much lower than the dielectric's the conductor curve's error must be for
+/// [`KindRequest::Auto`] to take a conductor below [`CONDUCTOR_MIN_F0`].
+pub const CONDUCTOR_MARGIN: f64 = 0.9;
+
+/// The renderer an export is written for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// Mitsuba 3: a `<bsdf>` element (`roughconductor` or `roughplastic`) as the root of an
+    /// XML file, loadable by `mi.load_file` or an `<include>`.
+    Mitsuba,
+    /// pbrt-v4: a `MakeNamedMaterial` statement (`conductor` or `coateddiffuse`).
+    Pbrt,
+    /// glTF 2.0: a `.gltf` holding one metallic-roughness material.
+    Gltf,
+}
+
+impl Target {
+    /// The file extension of the target's files: `xml`, `pbrt` or `gltf`.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Target::Mitsuba => "xml",
+            Target::Pbrt => "pbrt",
+            Target::Gltf => "gltf",
+        }
+    }
+
+    /// `mitsuba`, `pbrt` or `gltf`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Target::Mitsuba => "mitsuba",
+            Target::Pbrt => "pbrt",
+            Target::Gltf => "gltf",
+        }
+    }
+
+    /// Whether the target has a Beckmann distribution (Mitsuba only).
+    pub fn has_beckmann(self) -> bool {
+        self == Target::Mitsuba
+    }
+}
+
+/// Which analytic fit to export.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ModelRequest {
+    /// The GGX fit (the default: every target has GGX).
+    #[default]
+    Ggx,
+    /// The Beckmann fit; a target without Beckmann (pbrt, glTF) takes the GGX fit instead and
+    /// says so.
+    Beckmann,
+    /// Whichever fit the target can represent has the lower error (GGX for pbrt and glTF).
+    Best,
+}
+
+/// How to export the material.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KindRequest {
+    /// A conductor when the mean Schlick F0 is at least [`CONDUCTOR_MIN_F0`], or when ρd is
+    /// at most [`CONDUCTOR_MAX_ALBEDO`] and the conductor curve fits clearly better than the
+    /// dielectric ([`CONDUCTOR_MARGIN`]); else a plastic.
+    #[default]
+    Auto,
+    /// A conductor (η, k per channel; ρd dropped).
+    Conductor,
+    /// A diffuse base ρd under a dielectric interface of one η.
+    Plastic,
+}
+
+/// What an export represents the material as.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// A conductor.
+    Conductor,
+    /// A diffuse base under a dielectric interface.
+    Plastic,
+}
+
+/// What to export.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ExportOptions {
+    /// The renderer.
+    pub target: Target,
+    /// The analytic fit.
+    pub model: ModelRequest,
+    /// Conductor, plastic, or chosen by F0.
+    pub kind: KindRequest,
+}
+
+/// What an export approximates, written into it (a comment, or the glTF material's `extras`)
+/// and summed up by [`Report::summary`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    /// `mitsuba`, `pbrt` or `gltf`.
+    pub target: &'static str,
+    /// The fit file.
+    pub source_fit: String,
+    /// The fitted material's name.
+    pub material: String,
+    /// The fit the values come from: `ggx` or `beckmann`.
+    pub fit_model: &'static str,
+    /// The distribution written: `ggx` or `beckmann`.
+    pub distribution: &'static str,
+    /// Conductor or plastic.
+    pub kind: Kind,
+    /// α along the fit's rotated x axis.
+    pub alpha_x: f64,
+    /// α along the fit's rotated y axis.
+    pub alpha_y: f64,
+    /// The rotation of the α axes, degrees counter-clockwise from the tangent.
+    pub rotation_deg: f64,
+    /// ρd of the fit.
+    pub diffuse: Rgb,
+    /// The Fresnel curve the export stands for: `conductor`, `dielectric` or `schlick`.
+    pub fresnel: &'static str,
+    /// Facet's error metric of the model with that curve in place of its table, as the fit
+    /// recorded it; `None` when the fit recorded no Fresnel fits (the curve was fitted here).
+    pub fresnel_error: Option<f64>,
+    /// RMS distance of that curve to the model's F table over θd ≤ 80°.
+    pub fresnel_rms: f64,
+    /// Facet's error metric of the model with its own F table, for comparison.
+    pub table_error: f64,
+    /// Whether the fit recorded its Fresnel fits (else they were fitted here to its table).
+    pub fresnel_fits_recorded: bool,
+    /// What the target cannot represent, and what stands in for it.
+    pub notes: Vec<String>,
+}
+
+impl Report {
+    /// One line: the target, the material, the model and α, the Fresnel and its error.
+    pub fn summary(&self) -> String {
+        let error = match self.fresnel_error {
+            Some(e) => format!("error {e:.3e}"),
+            None => "error unknown (fitted at export)".into(),
+        };
+        let alpha = if self.alpha_x == self.alpha_y {
+            format!("α {:.4}", self.alpha_x)
+        } else {
+            format!(
+                "α {:.4}/{:.4} at {:.1}°",
+                self.alpha_x, self.alpha_y, self.rotation_deg
+            )
+        };
+        format!(
+            "{}: {} as a {} {} ({} fit, {alpha}), {} Fresnel {error} (with the F table {:.3e}); {} approximation(s) noted in the file",
+            self.target,
+            self.material,
+            self.distribution,
+            match self.kind {
+                Kind::Conductor => "conductor",
+                Kind::Plastic => "plastic",
+            },
+            self.fit_model,
+            self.fresnel,
+            self.table_error,
+            self.notes.len()
+        )
+    }
+
+    /// The statement as lines of text (for the XML and pbrt comments).
+    fn lines(&self) -> Vec<String> {
+        let mut v = vec![
+            format!(
+                "Exported by facet from the fit {} (material {}).",
+                self.source_fit, self.material
+            ),
+            format!(
+                "Model: the {} fit, written as a {} {}; alpha_x {}, alpha_y {}, rotation {} deg; rho_d {:?}.",
+                self.fit_model,
+                self.distribution,
+                match self.kind {
+                    Kind::Conductor => "conductor",
+                    Kind::Plastic => "plastic",
+                },
+                self.alpha_x,
+                self.alpha_y,
+                self.rotation_deg,
+                self.diffuse
+            ),
+            match self.fresnel_error {
+                Some(e) => format!(
+                    "Fresnel: the {} fit; Facet's error metric of the model with it: {e:e} (with the fit's F table: {:e}; RMS to the table {:.2e}).",
+                    self.fresnel, self.table_error, self.fresnel_rms
+                ),
+                None => format!(
+                    "Fresnel: the {} curve fitted at export to the model's F table (RMS {:.2e}); its error in Facet's metric is unknown (the fit recorded none; with the F table: {:e}).",
+                    self.fresnel, self.fresnel_rms, self.table_error
+                ),
+            },
+        ];
+        v.extend(self.notes.iter().map(|n| format!("Approximation: {n}")));
+        v
+    }
+}
+
+/// A written export: the file's text and what it approximates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Exported {
+    /// The whole file.
+    pub text: String,
+    /// What it approximates (also written inside `text`).
+    pub report: Report,
+}
+
+/// One of the Fresnel curves with its quality.
+struct Curve {
+    name: &'static str,
+    quality: FitQuality,
+}
+
+/// Writes the analytic model of `fit` for `options.target`; `path` names the fit in the
+/// statement and in errors (a fit without the asked model is an error naming it).
+pub fn export(
+    fit: &FittedMaterial,
+    path: &Path,
+    options: &ExportOptions,
+) -> Result<Exported, FitError> {
+    let bad = |problem: String| FitError::Material {
+        path: path.to_owned(),
+        problem,
+    };
+    let r = &fit.record;
+    let target = options.target;
+    let mut notes = Vec::new();
+    let (fit_kind, p) = choose(r, options, &mut notes).map_err(bad)?;
+    let (fits, recorded) = match &p.fresnel_fits {
+        Some(f) => (f.clone(), true),
+        None => (FresnelFits::of(&p.fresnel, |_| [f64::NAN; 3]), false),
+    };
+    if !recorded {
+        notes.push(if r.diffuse_lobe {
+            "the fit recorded no Fresnel fits: they were fitted here to the model's F table, with no error in Facet's metric".into()
+        } else {
+            "a single-lobe fit (facet fit's no-diffuse or aniso options): no Fresnel fits were recorded, they were fitted here to the model's F table, which also holds the light of any diffuse term (ρd = 0); their error in Facet's metric is unknown".into()
+        });
+    }
+    let mean_f0 = fits.schlick_f0.iter().sum::<f64>() / 3.0;
+    let known = |q: FitQuality| recorded.then_some(q.error).filter(|e| e.is_finite());
+    let (c, d) = (fits.conductor, fits.dielectric);
+    let conductor_fits_better = match (known(c), known(d)) {
+        (Some(c), Some(d)) => c < CONDUCTOR_MARGIN * d,
+        _ => c.rms < CONDUCTOR_MARGIN * d.rms,
+    };
+    let no_diffuse = p.diffuse.iter().all(|&a| a <= CONDUCTOR_MAX_ALBEDO);
+    let kind = match options.kind {
+        KindRequest::Conductor => Kind::Conductor,
+        KindRequest::Plastic => Kind::Plastic,
+        KindRequest::Auto if mean_f0 >= CONDUCTOR_MIN_F0 => Kind::Conductor,
+        KindRequest::Auto if no_diffuse && conductor_fits_better => Kind::Conductor,
+        KindRequest::Auto => Kind::Plastic,
+    };
+    let quality = |c: FresnelChoice| match c {
+        FresnelChoice::Conductor => fits.conductor,
+        FresnelChoice::Dielectric => fits.dielectric,
+        _ => fits.schlick,
+    };
+    // The curve each target's BSDF evaluates: glTF's is always Schlick (a conductor's F0 is
+    // its base colour; a dielectric's F0 comes from `ior` and `KHR_materials_specular`).
+    let choice = match (target, kind) {
+        (Target::Gltf, _) => FresnelChoice::Schlick,
+        (_, Kind::Conductor) => FresnelChoice::Conductor,
+        (_, Kind::Plastic) => FresnelChoice::Dielectric,
+    };
+    let curve = Curve {
+        name: match choice {
+            FresnelChoice::Conductor => "conductor",
+            FresnelChoice::Dielectric => "dielectric",
+            _ => "schlick",
+        },
+        quality: quality(choice),
+    };
+    let (ax, ay, rot) = (p.alpha_x, p.alpha_y, p.rotation);
+    let max_kd = p.diffuse.iter().cloned().fold(0.0, f64::max);
+    if kind == Kind::Conductor && max_kd > 0.0 {
+        notes.push(format!(
+            "ρd = {:?} is dropped: the conductor has no diffuse lobe",
+            p.diffuse
+        ));
+    }
+    if kind == Kind::Plastic && conductor_fits_better {
+        notes.push(format!(
+            "a dielectric's Fresnel is one colourless curve: the conductor fit (η {:?}, k {:?}) is closer (error {}, RMS {:.2e}); exported with the conductor kind it is kept, without ρd",
+            fits.conductor_eta,
+            fits.conductor_k,
+            fmt_error(known(c)),
+            c.rms
+        ));
+    }
+    if kind == Kind::Plastic && target != Target::Gltf {
+        let (f0_eta, f0) = (dielectric_f0(fits.dielectric_eta), mean_f0);
+        if (f0_eta / f0 - 1.0).abs() > 0.05 {
+            notes.push(format!(
+                "the dielectric fit's η {} has F0 {f0_eta:.4}, the table's (Schlick fit's) F0 is {f0:.4}: one exact dielectric curve cannot follow this table at both normal and grazing incidence; η {:.4} would match F0 (its error in Facet's metric is not recorded)",
+                fits.dielectric_eta,
+                schlick_ior(f0)
+            ));
+        }
+    }
+    if ax != ay && rot != 0.0 && target != Target::Gltf {
+        notes.push(format!(
+            "the α axes are rotated by {:.3}° from the tangent: {} cannot rotate the distribution (alpha_u lies along dp/du); rotate the surface's tangent frame by that angle",
+            rot.to_degrees(),
+            target.name()
+        ));
+    }
+    let g_note = match target {
+        Target::Mitsuba => {
+            "Mitsuba's Smith G is separable (G1(ωi) G1(ωo)); Facet's is height-direction correlated"
+        }
+        Target::Pbrt => {
+            "pbrt-v4's Smith G is height correlated (1/(1 + Λi + Λo)); Facet's is height-direction correlated"
+        }
+        Target::Gltf => {
+            "glTF's visibility term is height-correlated Smith G (GGX); Facet's is height-direction correlated"
+        }
+    };
+    notes.push(g_note.into());
+    let mut report = Report {
+        target: target.name(),
+        source_fit: path.display().to_string(),
+        material: r.name.clone(),
+        fit_model: fit_kind.name(),
+        distribution: if target.has_beckmann() {
+            fit_kind.name()
+        } else {
+            "ggx"
+        },
+        kind,
+        alpha_x: ax,
+        alpha_y: ay,
+        rotation_deg: rot.to_degrees(),
+        diffuse: p.diffuse,
+        fresnel: curve.name,
+        fresnel_error: known(curve.quality),
+        fresnel_rms: curve.quality.rms,
+        table_error: p.error,
+        fresnel_fits_recorded: recorded,
+        notes,
+    };
+    let id = crate::io::input::safe_file_stem(&r.name);
+    let text = match target {
+        Target::Mitsuba => mitsuba(&id, p, &fits, &mut report),
+        Target::Pbrt => pbrt(&id, p, &fits, &mut report),
+        Target::Gltf => gltf(&r.name, p, &fits, &mut report),
+    };
+    Ok(Exported { text, report })
+}
+
+fn fmt_error(e: Option<f64>) -> String {
+    e.map_or("unknown".into(), |e| format!("{e:.3e}"))
+}
+
+/// The fit to export (its kind and record), with a note when the target stands GGX in for
+/// Beckmann; `Err` says what is missing.
+fn choose<'a>(
+    r: &'a FitRecord,
+    options: &ExportOptions,
+    notes: &mut Vec<String>,
+) -> Result<(NdfKind, &'a ParamRecord), String> {
+    let target = options.target;
+    let missing = |name: &str| {
+        format!(
+            "the fit has no {name} model (it was fitted with another --model); refit it with --model {} or all",
+            name.to_lowercase()
+        )
+    };
+    match options.model {
+        ModelRequest::Ggx => r
+            .ggx
+            .as_ref()
+            .map(|p| (NdfKind::Ggx, p))
+            .ok_or_else(|| missing("GGX")),
+        ModelRequest::Beckmann if target.has_beckmann() => r
+            .beckmann
+            .as_ref()
+            .map(|p| (NdfKind::Beckmann, p))
+            .ok_or_else(|| missing("Beckmann")),
+        ModelRequest::Beckmann => {
+            let g = r.ggx.as_ref().ok_or_else(|| {
+                format!(
+                    "{} has only the GGX (Trowbridge–Reitz) distribution, and the fit has no GGX model to stand in for the Beckmann one",
+                    target.name()
+                )
+            })?;
+            notes.push(match &r.beckmann {
+                Some(b) => format!(
+                    "{} has no Beckmann distribution: the GGX fit (α {:.4}/{:.4}, error {:.3e}) stands in for the Beckmann fit (α {:.4}/{:.4}, error {:.3e})",
+                    target.name(),
+                    g.alpha_x,
+                    g.alpha_y,
+                    g.error,
+                    b.alpha_x,
+                    b.alpha_y,
+                    b.error
+                ),
+                None => format!(
+                    "{} has no Beckmann distribution (nor has the fit a Beckmann model): the GGX fit is exported",
+                    target.name()
+                ),
+            });
+            Ok((NdfKind::Ggx, g))
+        }
+        ModelRequest::Best => {
+            let mut best: Option<(NdfKind, &ParamRecord)> =
+                r.ggx.as_ref().map(|p| (NdfKind::Ggx, p));
+            if let Some(b) = &r.beckmann {
+                if target.has_beckmann() {
+                    if best.is_none_or(|(_, g)| b.error < g.error) {
+                        best = Some((NdfKind::Beckmann, b));
+                    }
+                } else if best.is_some_and(|(_, g)| b.error < g.error) {
+                    notes.push(format!(
+                        "the Beckmann fit has the lower error ({:.3e}), but {} has only GGX: the GGX fit is exported",
+                        b.error,
+                        target.name()
+                    ));
+                }
+            }
+            best.ok_or_else(|| {
+                if target.has_beckmann() {
+                    "the fit has no analytic (GGX or Beckmann) model; refit it with --model all"
+                        .into()
+                } else {
+                    missing("GGX")
+                }
+            })
+        }
+    }
+}
+
+/// F0 = ((η − 1)/(η + 1))² of a dielectric of relative index η.
+pub fn dielectric_f0(eta: f64) -> f64 {
+    ((eta - 1.0) / (eta + 1.0)).powi(2)
+}
+
+/// The η of a dielectric of normal-incidence reflectance F0: (1 + √F0)/(1 − √F0) (F0 below 1).
+pub fn schlick_ior(f0: f64) -> f64 {
+    let r = f0.clamp(0.0, 0.999_999).sqrt();
+    (1.0 + r) / (1.0 - r)
+}
+
+/// The hemispherical (cosine-weighted) reflectance of a smooth dielectric of index η seen from
+/// outside, 2 ∫ F(μ) μ dμ (midpoint rule, 1024 steps).
+fn hemispherical_reflectance(eta: f64) -> f64 {
+    const N: usize = 1024;
+    (0..N)
+        .map(|i| {
+            let mu = (i as f64 + 0.5) / N as f64;
+            2.0 * dielectric(mu, eta) * mu / N as f64
+        })
+        .sum()
+}
+
+/// The ratio of Mitsuba's `roughplastic` diffuse term at normal incidence to ρd/π, for a smooth
+/// interface: t(0)² / (η² (1 − R_int)) with 1 − R_int = (1 − R_ext)/η², i.e. t(0)² / (1 − R_ext).
+pub fn plastic_diffuse_ratio(eta: f64) -> f64 {
+    let t0 = 1.0 - dielectric_f0(eta);
+    t0 * t0 / (1.0 - hemispherical_reflectance(eta))
+}
+
+/// A number list: `a, b, c` (Mitsuba) or `a b c` (pbrt), in the shortest form that reads back
+/// to the same f64.
+fn list(v: &[f64], sep: &str) -> String {
+    v.iter()
+        .map(|x| format!("{x}"))
+        .collect::<Vec<_>>()
+        .join(sep)
+}
+
+/// Text safe inside an XML comment: no `--`, no stray control characters.
+fn xml_comment(s: &str) -> String {
+    let mut out: String = s
+        .chars()
+        .map(|c| if c.is_control() { ' ' } else { c })
+        .collect();
+    while out.contains("--") {
+        out = out.replace("--", "- -");
+    }
+    if out.ends_with('-') {
+        out.push(' ');
+    }
+    out
+}
+
+/// Text safe inside an XML attribute value.
+fn xml_attr(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// The least `int_ior` written for Mitsuba (which refuses an interface of index 1).
+const MITSUBA_MIN_IOR: f64 = 1.0001;
+
+fn mitsuba(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
+    let dist = report.distribution;
+    let mut body = vec![format!(
+        r#"    <string name="distribution" value="{dist}"/>"#
+    )];
+    let kind = report.kind;
+    let (ax, ay) = (p.alpha_x, p.alpha_y);
+    let bsdf = match kind {
+        Kind::Conductor => {
+            if ax == ay {
+                body.push(format!(r#"    <float name="alpha" value="{ax}"/>"#));
+            } else {
+                body.push(format!(r#"    <float name="alpha_u" value="{ax}"/>"#));
+                body.push(format!(r#"    <float name="alpha_v" value="{ay}"/>"#));
+            }
+            body.push(format!(
+                r#"    <rgb name="eta" value="{}"/>"#,
+                list(&fits.conductor_eta, ", ")
+            ));
+            body.push(format!(
+                r#"    <rgb name="k" value="{}"/>"#,
+                list(&fits.conductor_k, ", ")
+            ));
+            "roughconductor"
+        }
+        Kind::Plastic => {
+            let alpha = if ax == ay {
+                ax
+            } else {
+                let a = (ax * ay).sqrt();
+                report.notes.push(format!(
+                    "Mitsuba's roughplastic is isotropic: α = √(αx αy) = {a} (the same peak D(0) = 1/(π αx αy)) in place of αx {ax}, αy {ay}"
+                ));
+                a
+            };
+            // Mitsuba refuses int_ior = ext_ior; the dielectric fit's η lies in [1, 4].
+            let eta = fits.dielectric_eta.max(MITSUBA_MIN_IOR);
+            if eta != fits.dielectric_eta {
+                report.notes.push(format!(
+                    "roughplastic needs int_ior ≠ ext_ior: the dielectric fit's η {} is written as {eta}",
+                    fits.dielectric_eta
+                ));
+            }
+            report.notes.push(format!(
+                "roughplastic's diffuse term is ρ t(θi) t(θo) / (π η² (1 − R_int)) (internal scattering under the interface, nonlinear = false), not ρd/π: with ρ = ρd it is about {:.3} × ρd/π at normal incidence (smooth-interface estimate) and falls to 0 at grazing",
+                plastic_diffuse_ratio(eta)
+            ));
+            body.push(format!(r#"    <float name="alpha" value="{alpha}"/>"#));
+            body.push(format!(r#"    <float name="int_ior" value="{eta}"/>"#));
+            body.push(r#"    <float name="ext_ior" value="1"/>"#.into());
+            body.push(format!(
+                r#"    <rgb name="diffuse_reflectance" value="{}"/>"#,
+                list(&p.diffuse, ", ")
+            ));
+            body.push(r#"    <boolean name="nonlinear" value="false"/>"#.into());
+            "roughplastic"
+        }
+    };
+    let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
+    for line in report.lines() {
+        s += &format!("  {}\n", xml_comment(&line));
+    }
+    s += "-->\n";
+    s += &format!(
+        "<bsdf type=\"{bsdf}\" id=\"{}\" version=\"3.0.0\">\n",
+        xml_attr(id)
+    );
+    for b in body {
+        s += &b;
+        s.push('\n');
+    }
+    s += "</bsdf>\n";
+    s
+}
+
+fn pbrt(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
+    let (ax, ay) = (p.alpha_x, p.alpha_y);
+    let mut params = Vec::new();
+    let kind = report.kind;
+    let ty = match kind {
+        Kind::Conductor => {
+            params.push(format!(
+                "\"rgb eta\" [ {} ]",
+                list(&fits.conductor_eta, " ")
+            ));
+            params.push(format!("\"rgb k\" [ {} ]", list(&fits.conductor_k, " ")));
+            "conductor"
+        }
+        Kind::Plastic => {
+            params.push(format!("\"rgb reflectance\" [ {} ]", list(&p.diffuse, " ")));
+            params.push(format!("\"float eta\" [ {} ]", fits.dielectric_eta));
+            report.notes.push(
+                "coateddiffuse is a layered BSDF evaluated stochastically (a Lambertian base of reflectance ρd under a rough dielectric interface of η, thickness 0.01, no medium): its diffuse light passes the interface twice and scatters between the layers, so it is not ρd/π".into(),
+            );
+            "coateddiffuse"
+        }
+    };
+    params.push(format!("\"float uroughness\" [ {ax} ]"));
+    params.push(format!("\"float vroughness\" [ {ay} ]"));
+    params.push("\"bool remaproughness\" [ false ]".into());
+    let mut s = String::new();
+    for line in report.lines() {
+        s += &format!("# {}\n", line.replace(['\n', '\r'], " "));
+    }
+    // A name in a pbrt string cannot hold a double quote; `id` is a safe file stem.
+    s += &format!("MakeNamedMaterial \"{id}\"\n    \"string type\" [ \"{ty}\" ]\n");
+    for p in params {
+        s += &format!("    {p}\n");
+    }
+    s
+}
+
+fn gltf(name: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
+    let (ax, ay) = (p.alpha_x, p.alpha_y);
+    let (amin, amax) = (ax.min(ay), ax.max(ay));
+    let roughness = alpha_to_roughness(amin);
+    if amin > 1.0 {
+        report.notes.push(format!(
+            "glTF's roughness is at most 1 (α = 1): α {amin} is clamped"
+        ));
+    }
+    let mut extensions = serde_json::Map::new();
+    if amax != amin {
+        let (strength, rotation) = anisotropy(ax, ay, p.rotation);
+        if amax > 1.0 {
+            report.notes.push(format!(
+                "KHR_materials_anisotropy's strength is at most 1 (α = 1 along the stretched axis): α {amax} is clamped"
+            ));
+        }
+        extensions.insert(
+            "KHR_materials_anisotropy".into(),
+            json!({ "anisotropyStrength": strength, "anisotropyRotation": rotation }),
+        );
+        report.notes.push(
+            "KHR_materials_anisotropy needs TANGENT vectors on the mesh: its rotation is from the tangent, like the fit's".into(),
+        );
+    }
+    let kind = report.kind;
+    let (base, metallic) = match kind {
+        Kind::Conductor => {
+            report.notes.push(format!(
+                "glTF's metal Fresnel is Schlick's with F0 = baseColorFactor and F(90°) = 1: the Schlick fit stands in for the conductor's η {:?}, k {:?} (the conductor fit's error {})",
+                fits.conductor_eta,
+                fits.conductor_k,
+                fmt_error(report.fresnel_fits_recorded.then_some(fits.conductor.error))
+            ));
+            (fits.schlick_f0.map(|f| f.clamp(0.0, 1.0)), 1.0)
+        }
+        Kind::Plastic => {
+            // glTF's dielectric Fresnel is Schlick's with F0 = ((ior − 1)/(ior + 1))² ×
+            // specularColorFactor: ior from the Schlick fit's mean F0, the colour (if any) as
+            // the factor, is the Schlick fit exactly.
+            let f0 = fits.schlick_f0.iter().sum::<f64>() / 3.0;
+            let eta = schlick_ior(f0);
+            extensions.insert("KHR_materials_ior".into(), json!({ "ior": eta }));
+            let color = fits.schlick_f0.map(|s| if f0 > 0.0 { s / f0 } else { 1.0 });
+            if color.iter().any(|c| (c - 1.0).abs() > 1e-3) {
+                extensions.insert(
+                    "KHR_materials_specular".into(),
+                    json!({ "specularColorFactor": color }),
+                );
+            }
+            if (eta / fits.dielectric_eta - 1.0).abs() > 1e-3 {
+                report.notes.push(format!(
+                    "ior {eta} is the Schlick fit's (glTF's Fresnel is Schlick's), not the dielectric fit's η {} (error {})",
+                    fits.dielectric_eta,
+                    fmt_error(report.fresnel_fits_recorded.then_some(fits.dielectric.error))
+                ));
+            }
+            report.notes.push(
+                "glTF's dielectric diffuse is ρd/π weighted by 1 − F (Schlick) of the specular layer, not ρd/π beside it".into(),
+            );
+            (p.diffuse, 0.0)
+        }
+    };
+    let mut used: Vec<&String> = extensions.keys().collect();
+    used.sort();
+    let mut material = json!({
+        "name": name,
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [base[0], base[1], base[2], 1.0],
+            "metallicFactor": metallic,
+            "roughnessFactor": roughness,
+        },
+        "extras": { "facet_export": report, "statement": report.lines() },
+    });
+    if !extensions.is_empty() {
+        material["extensions"] = serde_json::Value::Object(extensions.clone());
+    }
+    let mut doc = json!({
+        "asset": {
+            "version": "2.0",
+            "generator": "facet export",
+            "extras": { "summary": report.summary() },
+        },
+        "materials": [material],
+    });
+    if !used.is_empty() {
+        doc["extensionsUsed"] = json!(used);
+    }
+    let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
+    s.push('\n');
+    s
+}
+
+/// glTF's roughness of α (α = roughness²), at most 1.
+pub fn alpha_to_roughness(alpha: f64) -> f64 {
+    alpha.sqrt().min(1.0)
+}
+
+/// `KHR_materials_anisotropy` of (αx, αy, rotation): glTF keeps α = roughness² across the
+/// stretched direction and raises it along it, α_t = mix(α, 1, strength²), so with the
+/// material's roughness √min(αx, αy), strength = √((α_max − α_min)/(1 − α_min)) (at most 1) and
+/// the rotation is the fit's, plus 90° when αy is the larger.
+pub fn anisotropy(alpha_x: f64, alpha_y: f64, rotation: f64) -> (f64, f64) {
+    let (amin, amax) = (alpha_x.min(alpha_y).min(1.0), alpha_x.max(alpha_y).min(1.0));
+    let strength = if amin < 1.0 {
+        ((amax - amin) / (1.0 - amin)).sqrt().min(1.0)
+    } else {
+        0.0
+    };
+    let rotation = if alpha_y > alpha_x {
+        rotation + std::f64::consts::FRAC_PI_2
+    } else {
+        rotation
+    };
+    (strength, rotation)
+}
+
+/// (αx along the anisotropy direction, α across it) of glTF's roughness and strength: the
+/// inverse of [`anisotropy`] with [`alpha_to_roughness`].
+pub fn gltf_alphas(roughness: f64, strength: f64) -> (f64, f64) {
+    let a = roughness * roughness;
+    (a + (1.0 - a) * strength * strength, a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::fresnel::{Fresnel, FresnelTable};
+    use crate::model::material::{Params, TabulatedRecord};
+
+    fn table_of(f: &Fresnel) -> FresnelTable {
+        FresnelTable::on_merl_bins(
+            (0..90)
+                .map(|j| f.eval((j as f64).to_radians().cos()))
+                .collect(),
+        )
+    }
+
+    /// A parameter record of α, a Fresnel curve and ρd, with fits recorded (errors made up,
+    /// distinct so that a test can tell them apart) or not.
+    fn param(ax: f64, ay: f64, rot: f64, f: &Fresnel, kd: Rgb, recorded: bool) -> ParamRecord {
+        let table = table_of(f);
+        let fits = recorded.then(|| {
+            let mut fits = FresnelFits::of(&table, |_| [0.0; 3]);
+            fits.conductor.error = 0.011;
+            fits.dielectric.error = 0.022;
+            fits.schlick.error = 0.033;
+            fits
+        });
+        ParamRecord {
+            alpha_x: ax,
+            alpha_y: ay,
+            rotation: rot,
+            error: 0.005,
+            method: "least_squares".into(),
+            moments: Params {
+                alpha_x: ax,
+                alpha_y: ay,
+                rotation: rot,
+                error: 0.1,
+            },
+            fresnel: table,
+            diffuse: kd,
+            fresnel_fits: fits,
+        }
+    }
+
+    fn record(ggx: Option<ParamRecord>, beckmann: Option<ParamRecord>) -> FitRecord {
+        let p = ggx.as_ref().or(beckmann.as_ref()).unwrap().clone();
+        let tables = crate::fitting::refine::tabulate(
+            crate::model::microfacet::AnalyticNdf::isotropic(NdfKind::Ggx, 0.3),
+            32,
+            32,
+        )
+        .unwrap()
+        .tables()
+        .clone();
+        FitRecord {
+            name: "test material".into(),
+            source: "analytic:test".into(),
+            backend: "cpu".into(),
+            resolution: 16,
+            phi_resolution: 1,
+            anisotropic: p.alpha_x != p.alpha_y,
+            quadrature: crate::numerics::quadrature::Quadrature::GaussLegendreSqrt,
+            iterations: 1,
+            residual: 0.0,
+            eigenvalue: 1.0,
+            tabulated: TabulatedRecord {
+                error: None,
+                stretch: crate::model::tabulated::Stretch::IDENTITY,
+                tables,
+                diffuse: p.diffuse,
+                origin: "power_iteration".into(),
+            },
+            fresnel: p.fresnel.clone(),
+            fresnel_fits: p.fresnel_fits.clone(),
+            ggx,
+            beckmann,
+            diffuse_lobe: p.fresnel_fits.is_some(),
+            separation_rounds: 1,
+            refine_rounds: 0,
+            timings_ms: Default::default(),
+        }
+    }
+
+    fn material(ggx: Option<ParamRecord>, beckmann: Option<ParamRecord>) -> FittedMaterial {
+        FittedMaterial::from_record(record(ggx, beckmann)).unwrap()
+    }
+
+    fn run(m: &FittedMaterial, target: Target, model: ModelRequest) -> Result<Exported, FitError> {
+        export(
+            m,
+            Path::new("fits/test.json"),
+            &ExportOptions {
+                target,
+                model,
+                kind: KindRequest::Auto,
+            },
+        )
+    }
+
+    /// glTF's roughness is √α exactly, and the anisotropy mapping inverted gives αx, αy back.
+    #[test]
+    fn roughness_and_anisotropy_invert() {
+        for a in [1e-4, 0.01, 0.2, 0.5, 1.0] {
+            // √α correctly rounded (IEEE sqrt), so roughness² is α to the last bit or two.
+            assert_eq!(alpha_to_roughness(a), a.sqrt());
+            assert!((alpha_to_roughness(a).powi(2) / a - 1.0).abs() < 4.0 * f64::EPSILON);
+        }
+        for (ax, ay, rot) in [(0.3, 0.1, 0.4), (0.05, 0.6, -1.0), (0.2, 0.2001, 0.0)] {
+            let (s, r) = anisotropy(ax, ay, rot);
+            let (along, across) = gltf_alphas(alpha_to_roughness(f64::min(ax, ay)), s);
+            assert!(
+                (along - f64::max(ax, ay)).abs() < 1e-12,
+                "{ax} {ay}: {along}"
+            );
+            assert!((across - f64::min(ax, ay)).abs() < 1e-12);
+            // The stretched direction is the fit's x axis, or its y axis (90° on) when αy is
+            // the larger.
+            let want = if ay > ax {
+                rot + std::f64::consts::FRAC_PI_2
+            } else {
+                rot
+            };
+            assert_eq!(r, want);
+        }
+    }
+
+    /// A GGX gold fit exports the fit's conductor η and k exactly, α as is, the conductor's
+    /// recorded error and the table error beside it.
+    #[test]
+    fn gold_exports_the_conductor_fit() {
+        let m = material(
+            Some(param(0.2, 0.2, 0.0, &Fresnel::GOLD, [0.0; 3], true)),
+            None,
+        );
+        let fits = m.record.ggx.as_ref().unwrap().fresnel_fits.clone().unwrap();
+        let x = run(&m, Target::Mitsuba, ModelRequest::Ggx).unwrap();
+        assert_eq!(x.report.kind, Kind::Conductor);
+        assert!(
+            x.text
+                .contains(r#"<bsdf type="roughconductor" id="test_material" version="3.0.0">"#),
+            "{}",
+            x.text
+        );
+        assert!(x.text.contains(r#"<float name="alpha" value="0.2"/>"#));
+        assert!(x.text.contains(&format!(
+            r#"<rgb name="eta" value="{}, {}, {}"/>"#,
+            fits.conductor_eta[0], fits.conductor_eta[1], fits.conductor_eta[2]
+        )));
+        assert!(x.text.contains(&format!(
+            r#"<rgb name="k" value="{}, {}, {}"/>"#,
+            fits.conductor_k[0], fits.conductor_k[1], fits.conductor_k[2]
+        )));
+        assert_eq!(x.report.fresnel_error, Some(0.011));
+        assert!(
+            x.text.contains("1.1e-2") && x.text.contains("5e-3"),
+            "{}",
+            x.text
+        );
+        let pbrt = run(&m, Target::Pbrt, ModelRequest::Ggx).unwrap();
+        assert!(pbrt.text.contains(&format!(
+            "\"rgb eta\" [ {} {} {} ]",
+            fits.conductor_eta[0], fits.conductor_eta[1], fits.conductor_eta[2]
+        )));
+        assert!(pbrt.text.contains("\"float uroughness\" [ 0.2 ]"));
+        assert!(pbrt.text.contains("\"bool remaproughness\" [ false ]"));
+        let g = run(&m, Target::Gltf, ModelRequest::Ggx).unwrap();
+        assert_eq!(g.report.fresnel, "schlick");
+        assert_eq!(g.report.fresnel_error, Some(0.033));
+        let v: serde_json::Value = serde_json::from_str(&g.text).unwrap();
+        let pbr = &v["materials"][0]["pbrMetallicRoughness"];
+        assert_eq!(pbr["metallicFactor"], 1.0);
+        assert_eq!(pbr["roughnessFactor"].as_f64().unwrap(), 0.2f64.sqrt());
+        for c in 0..3 {
+            assert_eq!(
+                pbr["baseColorFactor"][c].as_f64().unwrap(),
+                fits.schlick_f0[c]
+            );
+        }
+    }
+
+    /// A plastic: η and ρd written as the fit has them; anisotropy in Mitsuba is √(αx αy).
+    #[test]
+    fn plastic_exports_the_dielectric_fit() {
+        let kd = [0.3, 0.1, 0.05];
+        let m = material(
+            Some(param(
+                0.3,
+                0.1,
+                0.5,
+                &Fresnel::Dielectric { eta: 1.5 },
+                kd,
+                true,
+            )),
+            None,
+        );
+        let fits = m.record.ggx.as_ref().unwrap().fresnel_fits.clone().unwrap();
+        assert!((fits.dielectric_eta - 1.5).abs() < 1e-3);
+        let x = run(&m, Target::Mitsuba, ModelRequest::Ggx).unwrap();
+        assert_eq!(x.report.kind, Kind::Plastic);
+        assert_eq!(x.report.fresnel_error, Some(0.022));
+        assert!(x.text.contains(r#"type="roughplastic""#));
+        assert!(x.text.contains(&format!(
+            r#"<float name="alpha" value="{}"/>"#,
+            (0.3f64 * 0.1).sqrt()
+        )));
+        assert!(x.text.contains(&format!(
+            r#"<float name="int_ior" value="{}"/>"#,
+            fits.dielectric_eta
+        )));
+        assert!(
+            x.text
+                .contains(r#"<rgb name="diffuse_reflectance" value="0.3, 0.1, 0.05"/>"#)
+        );
+        assert!(x.text.contains("cannot rotate"), "{}", x.text);
+        assert!(
+            !x.text[x.text.find("<!--").unwrap() + 4..x.text.find("-->").unwrap()].contains("--")
+        );
+        let p = run(&m, Target::Pbrt, ModelRequest::Ggx).unwrap();
+        assert!(p.text.contains("\"string type\" [ \"coateddiffuse\" ]"));
+        assert!(p.text.contains("\"rgb reflectance\" [ 0.3 0.1 0.05 ]"));
+        assert!(
+            p.text.contains("\"float uroughness\" [ 0.3 ]")
+                && p.text.contains("\"float vroughness\" [ 0.1 ]")
+        );
+        let g = run(&m, Target::Gltf, ModelRequest::Ggx).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&g.text).unwrap();
+        let mat = &v["materials"][0];
+        assert_eq!(mat["pbrMetallicRoughness"]["metallicFactor"], 0.0);
+        assert_eq!(
+            mat["pbrMetallicRoughness"]["roughnessFactor"]
+                .as_f64()
+                .unwrap(),
+            0.1f64.sqrt()
+        );
+        // glTF's Fresnel is Schlick's: the ior is the Schlick fit's F0 (achromatic here, so no
+        // KHR_materials_specular).
+        let f0 = fits.schlick_f0.iter().sum::<f64>() / 3.0;
+        let ior = mat["extensions"]["KHR_materials_ior"]["ior"]
+            .as_f64()
+            .unwrap();
+        assert_eq!(ior, schlick_ior(f0));
+        assert!((dielectric_f0(ior) / f0 - 1.0).abs() < 1e-12);
+        assert!(mat["extensions"]["KHR_materials_specular"].is_null());
+        assert_eq!(g.report.fresnel_error, Some(0.033));
+        let an = &mat["extensions"]["KHR_materials_anisotropy"];
+        let (along, across) = gltf_alphas(
+            mat["pbrMetallicRoughness"]["roughnessFactor"]
+                .as_f64()
+                .unwrap(),
+            an["anisotropyStrength"].as_f64().unwrap(),
+        );
+        assert!((along - 0.3).abs() < 1e-12 && (across - 0.1).abs() < 1e-12);
+        assert_eq!(an["anisotropyRotation"].as_f64().unwrap(), 0.5);
+        let used: Vec<&str> = v["extensionsUsed"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e.as_str().unwrap())
+            .collect();
+        assert!(used.contains(&"KHR_materials_ior") && used.contains(&"KHR_materials_anisotropy"));
+    }
+
+    /// Beckmann: Mitsuba writes it; pbrt and glTF take the GGX fit and say so; a fit without
+    /// the asked model is an error naming the file.
+    #[test]
+    fn beckmann_and_missing_models() {
+        let gold = |a| param(a, a, 0.0, &Fresnel::GOLD, [0.0; 3], true);
+        let m = material(Some(gold(0.2)), Some(gold(0.25)));
+        let x = run(&m, Target::Mitsuba, ModelRequest::Beckmann).unwrap();
+        assert!(x.text.contains(r#"value="beckmann""#) && x.text.contains(r#"value="0.25""#));
+        let p = run(&m, Target::Pbrt, ModelRequest::Beckmann).unwrap();
+        assert_eq!((p.report.fit_model, p.report.distribution), ("ggx", "ggx"));
+        assert!(p.text.contains("[ 0.2 ]") && p.text.contains("no Beckmann distribution"));
+        let only_ggx = material(Some(gold(0.2)), None);
+        let e = run(&only_ggx, Target::Mitsuba, ModelRequest::Beckmann)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fits/test.json") && e.contains("no Beckmann model"),
+            "{e}"
+        );
+        let only_beckmann = material(None, Some(gold(0.2)));
+        let e = run(&only_beckmann, Target::Gltf, ModelRequest::Beckmann)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("fits/test.json") && e.contains("only the GGX"),
+            "{e}"
+        );
+        let e = run(&only_beckmann, Target::Pbrt, ModelRequest::Ggx)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no GGX model"), "{e}");
+        // Best: the lower error the target can represent.
+        let best = run(&only_beckmann, Target::Mitsuba, ModelRequest::Best).unwrap();
+        assert_eq!(best.report.fit_model, "beckmann");
+    }
+
+    /// Without recorded Fresnel fits the curve is fitted here and its error is unknown.
+    #[test]
+    fn unrecorded_fresnel_fits_are_fitted_with_unknown_error() {
+        let m = material(
+            Some(param(0.2, 0.2, 0.0, &Fresnel::GOLD, [0.0; 3], false)),
+            None,
+        );
+        let x = run(&m, Target::Pbrt, ModelRequest::Ggx).unwrap();
+        assert_eq!(x.report.fresnel_error, None);
+        assert!(!x.report.fresnel_fits_recorded);
+        assert!(x.text.contains("unknown"));
+        assert!(x.report.summary().contains("error unknown"));
+        // Gold's η comes back from its own table (fresnel_fit's tolerance).
+        let Fresnel::Conductor { eta, .. } = Fresnel::GOLD else {
+            unreachable!()
+        };
+        let fits = FresnelFits::of(&m.record.ggx.as_ref().unwrap().fresnel, |_| [0.0; 3]);
+        assert!((fits.conductor_eta[0] / eta[0] - 1.0).abs() < 0.02);
+        assert!(x.text.contains(&format!("{}", fits.conductor_eta[0])));
+    }
+
+    /// A coloured Schlick F0 on a plastic: glTF's ior × specularColorFactor gives it back.
+    #[test]
+    fn coloured_f0_goes_to_khr_materials_specular() {
+        let f0 = [0.02, 0.04, 0.06];
+        let m = material(
+            Some(param(
+                0.2,
+                0.2,
+                0.0,
+                &Fresnel::Schlick { f0 },
+                [0.2; 3],
+                true,
+            )),
+            None,
+        );
+        let g = run(&m, Target::Gltf, ModelRequest::Ggx).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&g.text).unwrap();
+        let ext = &v["materials"][0]["extensions"];
+        let ior = ext["KHR_materials_ior"]["ior"].as_f64().unwrap();
+        let color = &ext["KHR_materials_specular"]["specularColorFactor"];
+        for c in 0..3 {
+            let got = dielectric_f0(ior) * color[c].as_f64().unwrap();
+            assert!((got - f0[c]).abs() < 1e-9, "{c}: {got}");
+        }
+        assert!(
+            v["extensionsUsed"]
+                .as_array()
+                .unwrap()
+                .contains(&"KHR_materials_specular".into())
+        );
+    }
+
+    /// The automatic kind: F0 ≥ 0.2 is a conductor whatever ρd; below, a conductor only with
+    /// no diffuse lobe and a conductor curve clearly better than the dielectric.
+    #[test]
+    fn auto_kind_rule() {
+        let kind = |f: &Fresnel, kd: Rgb, tie: bool| {
+            let mut p = param(0.2, 0.2, 0.0, f, kd, true);
+            if tie {
+                let fits = p.fresnel_fits.as_mut().unwrap();
+                fits.conductor.error = fits.dielectric.error;
+            }
+            run(&material(Some(p), None), Target::Mitsuba, ModelRequest::Ggx)
+                .unwrap()
+                .report
+        };
+        // Gold with a diffuse lobe: a conductor, ρd dropped and said so.
+        let r = kind(&Fresnel::GOLD, [0.1; 3], false);
+        assert_eq!(r.kind, Kind::Conductor);
+        assert!(
+            r.notes.iter().any(|n| n.contains("dropped")),
+            "{:?}",
+            r.notes
+        );
+        // A colourless black dielectric: the curves tie, a plastic.
+        let glass = Fresnel::Dielectric { eta: 1.5 };
+        assert_eq!(kind(&glass, [0.0; 3], true).kind, Kind::Plastic);
+        // A coloured F of low F0 and no diffuse lobe (a metallic paint): the conductor fits
+        // better (the made-up errors: 0.011 against 0.022), a conductor; with ρd, a plastic.
+        let paint = Fresnel::Conductor {
+            eta: [2.75, 2.2, 1.07],
+            k: [0.0; 3],
+        };
+        assert_eq!(kind(&paint, [0.0; 3], false).kind, Kind::Conductor);
+        assert_eq!(kind(&paint, [0.05; 3], false).kind, Kind::Plastic);
+    }
+
+    /// A plastic's diffuse in Mitsuba at η = 1.5 is within a few percent of ρd/π at normal
+    /// incidence; the estimate is exactly 1 at η = 1 (no interface).
+    #[test]
+    fn plastic_diffuse_ratio_is_near_one() {
+        assert!((plastic_diffuse_ratio(1.0) - 1.0).abs() < 1e-12);
+        let r = plastic_diffuse_ratio(1.5);
+        assert!(r > 1.0 && r < 1.05, "{r}");
+    }
+}

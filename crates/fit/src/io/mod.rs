@@ -1,0 +1,6 @@
+//! The floor everything stands on: reading input files safely (regular files of bounded size,
+//! memory-mapped where that is faster) and writing outputs atomically.
+
+pub(crate) mod huge_pages;
+pub mod input;
+pub(crate) mod mapped_file;

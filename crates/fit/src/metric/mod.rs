@@ -1,0 +1,8 @@
+//! The passes over the MERL grid that every fit asks for: the error metric (mean
+//! |ln(1 + x_model) − ln(1 + x_data)|, x = f_r cos θi), the Fresnel average and the linear
+//! solves for F and a diffuse albedo, on the CPU (the GPU twins are in [`crate::gpu`]).
+
+pub mod grid;
+pub(crate) mod iso_grid;
+pub(crate) mod lambda_table;
+pub(crate) mod merl_geometry;

@@ -1,0 +1,340 @@
+//! A fitted material: the tabulated NDF with its Fresnel table, the GGX and Beckmann fits, and
+//! the record written as `<name>.json`. Each model is itself a [`Brdf`].
+
+use crate::error::FitError;
+use crate::fitting::fresnel_fit::FresnelFits;
+use crate::model::brdf::{Brdf, Rgb};
+use crate::model::fresnel::{Fresnel, FresnelTable};
+use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use crate::model::tabulated::{NdfTables, Stretch, TabulatedNdf};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::sync::Arc;
+
+/// α and rotation of a parametric fit, with its error.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Params {
+    /// α along the NDF's rotated x axis.
+    pub alpha_x: f64,
+    /// α along the NDF's rotated y axis (equal to `alpha_x` in an isotropic fit).
+    pub alpha_y: f64,
+    /// Radians.
+    pub rotation: f64,
+    /// The error metric of this model against the source.
+    pub error: f64,
+}
+
+/// A GGX or Beckmann fit: by least squares in the metric's space (the model used, with a
+/// Fresnel table averaged for its own D and G), and beside it the paper's estimate (α by first
+/// absolute slope moments, with the extraction's Fresnel) and its error.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ParamRecord {
+    /// α along the rotated x axis, by least squares.
+    pub alpha_x: f64,
+    /// α along the rotated y axis, by least squares.
+    pub alpha_y: f64,
+    /// Rotation of the α axes, radians.
+    pub rotation: f64,
+    /// The error metric of the least-squares model with its own Fresnel table (and ρd); a
+    /// physical Fresnel's error is in `fresnel_fits`.
+    pub error: f64,
+    /// How `alpha_x`, `alpha_y` and `rotation` were found (`"least_squares"`).
+    pub method: String,
+    /// The paper's estimate by slope moments, with its error: with a diffuse lobe on a quarter
+    /// of the grid's rows, as the physical curves' errors (within 0.6 % of the full grid's on
+    /// the 100 MERL proxies, median 0.04 %).
+    pub moments: Params,
+    /// F(θd) for this model's own D and G: averaged (the paper), or with a diffuse lobe solved
+    /// together with `diffuse` and kept in [0, 1].
+    pub fresnel: FresnelTable,
+    /// The Lambertian albedo ρd (f = ρd/π) fitted with this model; zero without a diffuse lobe.
+    #[serde(default)]
+    pub diffuse: Rgb,
+    /// Conductor, dielectric and Schlick curves fitted to `fresnel`, and which one the renderer
+    /// uses (absent: the table; fits without a diffuse lobe have none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fresnel_fits: Option<FresnelFits>,
+}
+
+/// The extracted (tabulated) model of a fit.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TabulatedRecord {
+    /// Error metric of the tabulated model; absent when it was not asked for.
+    pub error: Option<f64>,
+    /// The stretch applied to the tables (identity as extracted; edited in the viewer).
+    pub stretch: Stretch,
+    /// The extracted D and G1 tables.
+    pub tables: NdfTables,
+    /// The Lambertian albedo ρd (f = ρd/π) of the tabulated model; zero without a diffuse lobe.
+    #[serde(default)]
+    pub diffuse: Rgb,
+    /// Where the tables come from: `power_iteration` (the extraction, refined when the fit
+    /// refines), or `ggx` / `beckmann` when that fit's NDF, tabulated and refined, fitted
+    /// better than every extraction.
+    #[serde(default = "power_iteration")]
+    pub origin: String,
+}
+
+fn power_iteration() -> String {
+    "power_iteration".into()
+}
+
+/// Wall-clock times of a fit's phases, milliseconds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    /// Reading the source (0 when the caller did not time it).
+    pub load: f64,
+    /// The first power iteration and its D / G1 tables.
+    pub extract: f64,
+    /// The grid samples and the tabulated model's F (and ρd): with a diffuse lobe, its
+    /// separation (more extractions), refinement and physical Fresnel fits included.
+    pub fresnel: f64,
+    /// The GGX / Beckmann fits with their errors (and physical Fresnel fits).
+    pub fit: f64,
+    /// The whole fit.
+    pub total: f64,
+}
+
+/// The fit JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FitRecord {
+    /// The source's name.
+    pub name: String,
+    /// Where the source came from, as the caller described it (a path, `nbrdf:NAME`, ...).
+    pub source: String,
+    /// What ran the extraction: `cpu`, the adapter's description, or a CPU fallback notice.
+    pub backend: String,
+    /// θ samples of the extraction.
+    pub resolution: usize,
+    /// φ samples of the extraction (1 when isotropic).
+    pub phi_resolution: usize,
+    /// Whether αx, αy and a rotation were fitted.
+    pub anisotropic: bool,
+    /// The quadrature of the power iteration.
+    pub quadrature: crate::numerics::quadrature::Quadrature,
+    /// Power iterations run.
+    pub iterations: usize,
+    /// Residual of the power iteration when it stopped.
+    pub residual: f64,
+    /// λ of the power iteration: F(0) of the backscattering slice, mean of RGB.
+    pub eigenvalue: f64,
+    /// The extracted model.
+    pub tabulated: TabulatedRecord,
+    /// The GGX fit, when asked for.
+    pub ggx: Option<ParamRecord>,
+    /// The Beckmann fit, when asked for.
+    pub beckmann: Option<ParamRecord>,
+    /// F(θd) of the tabulated model.
+    pub fresnel: FresnelTable,
+    /// Physical curves fitted to `fresnel` and the one the renderer uses (see
+    /// [`ParamRecord::fresnel_fits`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fresnel_fits: Option<FresnelFits>,
+    /// Whether the models carry a fitted diffuse lobe (`--no-diffuse` and anisotropic fits:
+    /// false, the paper's single lobe).
+    #[serde(default)]
+    pub diffuse_lobe: bool,
+    /// Extractions run to separate the diffuse lobe from the tabulated NDF (1 without one).
+    #[serde(default)]
+    pub separation_rounds: usize,
+    /// Rounds of the refinement of the tabulated NDF in the metric's space (0: none).
+    #[serde(default)]
+    pub refine_rounds: usize,
+    /// How long each phase took.
+    pub timings_ms: Timings,
+}
+
+/// Which model of a fit to use.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelChoice {
+    /// The extracted NDF and G1 tables.
+    Tabulated,
+    /// The GGX fit.
+    Ggx,
+    /// The Beckmann fit.
+    Beckmann,
+}
+
+impl ModelChoice {
+    /// `tabulated`, `ggx` or `beckmann`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "tabulated" => Some(ModelChoice::Tabulated),
+            "ggx" => Some(ModelChoice::Ggx),
+            "beckmann" => Some(ModelChoice::Beckmann),
+            _ => None,
+        }
+    }
+}
+
+/// A fit record with its models built.
+#[derive(Clone, Debug)]
+pub struct FittedMaterial {
+    /// What is saved as JSON.
+    pub record: FitRecord,
+    /// The tabulated model (with the record's stretch).
+    pub tabulated: MicrofacetBrdf,
+    /// The GGX model, when fitted.
+    pub ggx: Option<MicrofacetBrdf>,
+    /// The Beckmann model, when fitted.
+    pub beckmann: Option<MicrofacetBrdf>,
+}
+
+impl FittedMaterial {
+    /// Builds the models of a record, checking its tables and parameters.
+    pub fn from_record(record: FitRecord) -> Result<Self, String> {
+        record.fresnel.validate()?;
+        let st = record.tabulated.stretch;
+        check_alpha("tabulated.stretch", st.alpha_x, st.alpha_y, st.rotation)?;
+        let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)?;
+        check_albedo("tabulated.diffuse", record.tabulated.diffuse)?;
+        let tabulated = MicrofacetBrdf {
+            name: format!("{}-tabulated", record.name),
+            ndf: Ndf::Tabulated(Arc::new(ndf)),
+            fresnel: used_fresnel("fresnel_fits", &record.fresnel_fits, &record.fresnel)?,
+            diffuse: record.tabulated.diffuse,
+        };
+        let param =
+            |kind: NdfKind, p: &Option<ParamRecord>| -> Result<Option<MicrofacetBrdf>, String> {
+                let Some(p) = p else { return Ok(None) };
+                p.fresnel.validate()?;
+                check_alpha(
+                    &format!("{}.alpha", kind.name()),
+                    p.alpha_x,
+                    p.alpha_y,
+                    p.rotation,
+                )?;
+                check_albedo(&format!("{}.diffuse", kind.name()), p.diffuse)?;
+                Ok(Some(MicrofacetBrdf {
+                    name: format!("{}-{}", record.name, kind.name()),
+                    ndf: Ndf::Analytic(AnalyticNdf {
+                        kind,
+                        alpha_x: p.alpha_x,
+                        alpha_y: p.alpha_y,
+                        rotation: p.rotation,
+                    }),
+                    fresnel: used_fresnel(
+                        &format!("{}.fresnel_fits", kind.name()),
+                        &p.fresnel_fits,
+                        &p.fresnel,
+                    )?,
+                    diffuse: p.diffuse,
+                }))
+            };
+        let ggx = param(NdfKind::Ggx, &record.ggx)?;
+        let beckmann = param(NdfKind::Beckmann, &record.beckmann)?;
+        Ok(FittedMaterial {
+            record,
+            tabulated,
+            ggx,
+            beckmann,
+        })
+    }
+
+    /// Reads a fit JSON written by [`FittedMaterial::save`].
+    pub fn load(path: &Path) -> Result<Self, FitError> {
+        Self::parse(
+            path,
+            &crate::io::input::read_to_string(path, crate::io::input::Cap::FIT_JSON)?,
+        )
+    }
+
+    /// A fit from the text of its JSON; `path` names it in errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Self, FitError> {
+        let bad = |problem: String| FitError::Material {
+            path: path.to_owned(),
+            problem,
+        };
+        let record: FitRecord = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+        Self::from_record(record).map_err(bad)
+    }
+
+    /// Writes the record as pretty JSON, through a temporary file renamed into place.
+    pub fn save(&self, path: &Path) -> Result<(), FitError> {
+        let text =
+            serde_json::to_string_pretty(&self.record).expect("a fit record always serialises");
+        let tmp = path.with_extension("json.partial");
+        std::fs::write(&tmp, text)
+            .and_then(|_| std::fs::rename(&tmp, path))
+            .map_err(|e| {
+                let _ = std::fs::remove_file(&tmp);
+                FitError::io(path, e)
+            })
+    }
+
+    /// One of the fitted models, if it was fitted.
+    pub fn model(&self, choice: ModelChoice) -> Option<&MicrofacetBrdf> {
+        match choice {
+            ModelChoice::Tabulated => Some(&self.tabulated),
+            ModelChoice::Ggx => self.ggx.as_ref(),
+            ModelChoice::Beckmann => self.beckmann.as_ref(),
+        }
+    }
+
+    /// The tabulated model with its NDF stretched: `P(x~/αx, y~/αy) sec⁴θ / (αx αy)`.
+    pub fn stretched(&self, stretch: Stretch) -> MicrofacetBrdf {
+        let Ndf::Tabulated(t) = &self.tabulated.ndf else {
+            unreachable!("the tabulated model has a tabulated NDF")
+        };
+        MicrofacetBrdf {
+            ndf: Ndf::Tabulated(Arc::new(t.with_stretch(stretch))),
+            ..self.tabulated.clone()
+        }
+    }
+}
+
+/// α in [`ALPHA_RANGE`](crate::model::analytic::ALPHA_RANGE) and a finite rotation, or an error naming
+/// the field and the values.
+fn check_alpha(field: &str, alpha_x: f64, alpha_y: f64, rotation: f64) -> Result<(), String> {
+    let range = crate::model::analytic::ALPHA_RANGE;
+    if range.contains(&alpha_x) && range.contains(&alpha_y) && rotation.is_finite() {
+        return Ok(());
+    }
+    Err(format!(
+        "{field}: α = ({alpha_x}, {alpha_y}), rotation {rotation} (α must lie in [{:e}, {}], the rotation be finite)",
+        range.start(),
+        range.end()
+    ))
+}
+
+/// The Fresnel a model renders with: its table, or the fit that `fits.used` names.
+fn used_fresnel(
+    field: &str,
+    fits: &Option<FresnelFits>,
+    table: &FresnelTable,
+) -> Result<Fresnel, String> {
+    match fits {
+        None => Ok(Fresnel::Table(table.clone())),
+        Some(f) => {
+            f.validate(field)?;
+            Ok(f.fresnel(f.used, table))
+        }
+    }
+}
+
+/// An albedo in [0, 1] per channel, or an error naming the field and the values.
+fn check_albedo(field: &str, albedo: Rgb) -> Result<(), String> {
+    if albedo.iter().all(|a| (0.0..=1.0).contains(a)) {
+        return Ok(());
+    }
+    Err(format!(
+        "{field}: ρd = {albedo:?} (each channel must lie in [0, 1])"
+    ))
+}
+
+/// A fitted material is a BRDF source: its tabulated model.
+impl Brdf for FittedMaterial {
+    fn name(&self) -> &str {
+        &self.record.name
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        self.tabulated.eval(wi, wo)
+    }
+
+    fn is_isotropic(&self) -> bool {
+        self.tabulated.is_isotropic()
+    }
+}

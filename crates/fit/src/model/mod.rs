@@ -1,0 +1,15 @@
+//! The models: the [`brdf::Brdf`] trait every source and fit implements, the shading-frame
+//! geometry, microfacet NDFs (GGX, Beckmann, tabulated with its stretch and visible-normal
+//! sampling), Fresnel tables and curves, analytic specifications and the fit record
+//! ([`material::FittedMaterial`]) that the renderer reads. Nothing here fits anything.
+
+pub mod albedo;
+pub mod analytic;
+pub mod brdf;
+pub mod fresnel;
+pub mod geometry;
+pub mod material;
+pub mod microfacet;
+pub mod tabulated;
+pub(crate) mod visible_normals;
+pub mod visible_tables;
