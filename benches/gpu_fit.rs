@@ -10,8 +10,9 @@ use facet_fit::fitting::params::fit_moments;
 use facet_fit::fitting::{Backend, FitConfig, fit_material_on};
 use facet_fit::gpu::GpuFitter;
 use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::NdfKind;
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::Gpu;
 use std::time::{Duration, Instant};
 

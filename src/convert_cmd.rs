@@ -95,7 +95,7 @@ pub fn run(args: &ConvertArgs) -> Result<ExitCode> {
                 out.display(),
                 args.input,
                 table.missing_count(),
-                facet_fit::sources::merl::SAMPLES,
+                facet_fit::model::merl_grid::SAMPLES,
                 load_ms + t.elapsed().as_secs_f64() * 1e3
             );
         }

@@ -8,7 +8,8 @@ mod common;
 use common::scratch;
 use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::material::FittedMaterial;
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -213,7 +214,7 @@ fn values_that_would_break_the_extraction_are_refused_up_front() {
     for d in [90i32, 90, 180] {
         bytes.extend(d.to_le_bytes());
     }
-    for _ in 0..3 * facet_fit::sources::merl::SAMPLES {
+    for _ in 0..3 * facet_fit::model::merl_grid::SAMPLES {
         bytes.extend(1e308f64.to_le_bytes());
     }
     let path = dir.join("huge-values.binary");
@@ -225,7 +226,7 @@ fn values_that_would_break_the_extraction_are_refused_up_front() {
     );
     // A source whose f_r cos θi passes MAX_X on the MERL grid is refused with the value.
     let mut t = MerlTable::sample(&parse_analytic("ggx?alpha=0.3").unwrap());
-    (0..facet_fit::sources::merl::SAMPLES).for_each(|s| t.scale_sample(s, [1e13; 3]));
+    (0..facet_fit::model::merl_grid::SAMPLES).for_each(|s| t.scale_sample(s, [1e13; 3]));
     let err = facet_fit::fitting::fit_material(
         &MerlBrdf::from_table("bright", t).unwrap(),
         "t",
@@ -570,7 +571,7 @@ fn a_mapped_merl_file_is_refused_as_a_read_one() {
     };
     let standard = |value: f64| {
         let mut b = header([90, 90, 180]);
-        for _ in 0..3 * facet_fit::sources::merl::SAMPLES {
+        for _ in 0..3 * facet_fit::model::merl_grid::SAMPLES {
             b.extend(value.to_le_bytes());
         }
         b

@@ -116,7 +116,7 @@ fn sampling_matches_its_pdf() {
 fn grid_fast_path_matches_direct_evaluation() {
     let src = facet_fit::sources::merl::MerlBrdf::from_table(
         "noisy-gold",
-        facet_fit::sources::merl::MerlTable::sample(
+        facet_fit::model::merl_grid::MerlTable::sample(
             &parse_analytic("ggx?alpha=0.25&conductor=gold&kd=0.05").unwrap(),
         ),
     )

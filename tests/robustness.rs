@@ -7,7 +7,8 @@ use facet_fit::error::FitError;
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::geometry::from_half_diff;
-use facet_fit::sources::merl::{MerlBrdf, MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles};
+use facet_fit::model::merl_grid::{MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles};
+use facet_fit::sources::merl::MerlBrdf;
 use std::path::Path;
 
 fn ggx_alpha(src: &MerlBrdf) -> (f64, f64) {
@@ -119,7 +120,7 @@ fn merl_write_read_round_trip_is_exact() {
 fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
     let dir = scratch("merl_mapped");
     let mut table = spec_table("ggx?alpha=0.1&f0=0.04&kd=0.2");
-    table.mark_missing(facet_fit::sources::merl::index(30, 40, 50));
+    table.mark_missing(facet_fit::model::merl_grid::index(30, 40, 50));
     let path = dir.join("plastic.binary");
     table.write(&path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
@@ -132,7 +133,7 @@ fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
     for s in [
         0,
         1234,
-        facet_fit::sources::merl::index(30, 40, 50),
+        facet_fit::model::merl_grid::index(30, 40, 50),
         SAMPLES - 1,
     ] {
         assert_eq!(
@@ -156,7 +157,7 @@ fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
         fit(&MerlBrdf::map(&path).unwrap()),
         fit(&MerlBrdf::open(&path).unwrap())
     );
-    let s = facet_fit::sources::merl::index(10, 20, 30);
+    let s = facet_fit::model::merl_grid::index(10, 20, 30);
     mapped.scale_sample(s, [2.0; 3]);
     let v = read.value_at(s).unwrap();
     assert_eq!(mapped.value_at(s).unwrap(), v.map(|v| v * 2.0));

@@ -9,7 +9,8 @@
 //! The table is changed in place and restored after each run.
 #![no_main]
 
-use facet_fit::sources::merl::{MAX_STORED, MerlBrdf, MerlTable, SAMPLES, SCALE};
+use facet_fit::sources::merl::MerlBrdf;
+use facet_fit::model::merl_grid::{MAX_STORED, MerlTable, SAMPLES, SCALE};
 use facet_fuzz::{assert_brdf_sane, assert_names, run};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;

@@ -2,7 +2,8 @@
 #![allow(dead_code)]
 
 use facet_fit::model::analytic::parse_analytic;
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::PathBuf;
 

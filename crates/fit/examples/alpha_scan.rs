@@ -7,8 +7,9 @@
 
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::metric::grid::{GridSamples, fresnel_diffuse_and_error};
+use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 
 /// Reweighted steps of each scanned α's F / ρd solve.

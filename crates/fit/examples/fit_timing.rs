@@ -9,7 +9,8 @@
 use facet_fit::Brdf;
 use facet_fit::fitting::{FitConfig, Models, fit_material};
 use facet_fit::model::analytic::parse_analytic;
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

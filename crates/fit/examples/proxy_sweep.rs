@@ -7,7 +7,8 @@
 //! `cargo run --release -p facet-fit --example proxy_sweep [-- NAME_FILTER]`
 
 use facet_fit::fitting::{FitConfig, Models, fit_material};
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::time::Instant;
 

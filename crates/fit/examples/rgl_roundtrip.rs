@@ -8,7 +8,8 @@
 
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::metric::grid::{GridSamples, error_metric};
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, rgl_tensor, sampling_ndfs};
 use std::time::Instant;

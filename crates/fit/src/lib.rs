@@ -9,7 +9,8 @@
 //! ```
 //! use facet_fit::fitting::{fit_material, FitConfig};
 //! use facet_fit::model::analytic::parse_analytic;
-//! use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+//! use facet_fit::sources::merl::MerlBrdf;
+//! use facet_fit::model::merl_grid::MerlTable;
 //!
 //! // A GGX conductor written as a MERL table, then fitted as if it were a measurement.
 //! let model = parse_analytic("ggx?alpha=0.3&conductor=gold").unwrap();
@@ -63,8 +64,9 @@ pub mod sources;
 
 pub use error::FitError;
 pub use fitting::{FitConfig, fit_material};
-pub use model::brdf::{Brdf, Rgb};
+pub use model::brdf::Brdf;
 pub use model::material::FittedMaterial;
+pub use model::rgb::Rgb;
 
 /// The crate README's Rust examples, compiled and run as doc-tests (the workspace README's
 /// fitting example is the same text; `tests/readme.rs` at the workspace root checks that).

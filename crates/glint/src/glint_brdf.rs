@@ -8,8 +8,8 @@
 use crate::dpf::cone_solid_angle;
 use crate::flakes::{FlakeField, Footprint, direction_coords};
 use crate::lit::{LitKey, blend_cells};
-use facet_fit::model::brdf::Rgb;
 use facet_fit::model::microfacet::{MicrofacetBrdf, correlation, g2};
+use facet_fit::model::rgb::Rgb;
 use glam::{DVec2, DVec3};
 
 /// How glints are counted.

@@ -12,8 +12,9 @@
 
 use facet_fit::Brdf;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::{AnalyticNdf, NdfKind, correlation, g2};
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{

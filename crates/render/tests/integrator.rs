@@ -2,8 +2,9 @@
 //! filtered switch, only-what-is-needed resources, determinism. GPU tests (lavapipe in CI).
 
 use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::MicrofacetBrdf;
-use facet_fit::sources::merl::{MerlBrdf, MerlTable};
+use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{

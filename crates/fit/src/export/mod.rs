@@ -24,10 +24,10 @@
 
 use crate::error::FitError;
 use crate::fitting::fresnel_fit::{FitQuality, FresnelChoice, FresnelFits};
-use crate::model::brdf::Rgb;
 use crate::model::fresnel::dielectric;
 use crate::model::material::{FitRecord, FittedMaterial, ParamRecord};
 use crate::model::microfacet::NdfKind;
+use crate::model::rgb::Rgb;
 use serde::Serialize;
 use serde_json::json;
 use std::path::Path;

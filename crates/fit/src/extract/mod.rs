@@ -10,8 +10,9 @@
 //! from the node values), which also gives G1 = cos θ / ∫ <o,h>+ D dω on a fine table.
 
 use crate::error::FitError;
-use crate::model::brdf::{Brdf, mean};
+use crate::model::brdf::Brdf;
 use crate::model::geometry::{acos_poly, spherical};
+use crate::model::rgb::mean;
 use crate::model::tabulated::{
     NdfTables, Stretch, TabulatedNdf, phi_node, theta_node, u_node_theta,
 };
@@ -142,7 +143,7 @@ fn backscatter_slice(src: &dyn Brdf, dirs: &[(f64, f64)]) -> Result<Vec<f64>, Fi
         return Err(fail(format!("the backscattering slice holds {v}")));
     }
     // Missing directions take the value of their nearest valid neighbour in the list.
-    let filled = crate::sources::merl::fill_missing(
+    let filled = crate::numerics::interp::fill_missing(
         &values.iter().map(|v| v.map(|x| [x; 3])).collect::<Vec<_>>(),
     )
     .ok_or_else(|| fail("no valid backscattering sample".into()))?;

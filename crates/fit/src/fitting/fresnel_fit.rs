@@ -9,8 +9,8 @@
 //! table and its error in Facet's metric, and names the one the renderer uses (`used`).
 
 use crate::fitting::params::brent;
-use crate::model::brdf::Rgb;
 use crate::model::fresnel::{Fresnel, FresnelTable, conductor, dielectric};
+use crate::model::rgb::Rgb;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 

@@ -15,19 +15,19 @@ use crate::fitting::params::{
 use crate::fitting::refine::{Refinement, model_of, tabulate};
 #[cfg(feature = "gpu")]
 use crate::gpu::{GpuFitter, gpu_error};
-#[cfg(feature = "gpu")]
-use crate::metric::grid::IsoTables;
 use crate::metric::grid::{
     CoarseGrid, GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error,
     microfacet_error, microfacet_errors,
 };
+#[cfg(feature = "gpu")]
+use crate::metric::iso_tables::IsoTables;
 use crate::model::brdf::Brdf;
-use crate::model::brdf::Rgb;
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::material::{
     FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings,
 };
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use crate::model::rgb::Rgb;
 use crate::model::tabulated::TabulatedNdf;
 use std::sync::Arc;
 use std::time::Instant;
@@ -233,7 +233,7 @@ fn fit_with(
         });
     }
     if let Some(s) = set.out_of_range() {
-        let (i, j, max) = (s.i, s.j, crate::metric::grid::MAX_X);
+        let (i, j, max) = (s.i, s.j, crate::metric::iso_tables::MAX_X);
         return Err(FitError::Extraction {
             name: src.name().into(),
             problem: format!(
@@ -253,7 +253,7 @@ fn fit_with(
         }
         _ => None,
     };
-    let average = |model: &MicrofacetBrdf| -> Result<Vec<crate::model::brdf::Rgb>, FitError> {
+    let average = |model: &MicrofacetBrdf| -> Result<Vec<crate::model::rgb::Rgb>, FitError> {
         #[cfg(feature = "gpu")]
         if let (Some((g, samples)), Some(tables)) = (&uploaded, IsoTables::new(model)) {
             return g

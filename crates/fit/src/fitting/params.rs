@@ -2,9 +2,10 @@
 //! paper) and by least squares in the space of the error metric.
 
 use crate::metric::grid::{
-    GridSamples, IsoTables, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error,
-    microfacet_error, tables_error,
+    GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error, microfacet_error,
+    tables_error,
 };
+use crate::metric::iso_tables::IsoTables;
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::model::tabulated::TabulatedNdf;

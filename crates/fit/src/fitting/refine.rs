@@ -19,12 +19,12 @@
 //! start's.
 
 use crate::extract::azimuthal_ab;
-use crate::metric::grid::IsoTables;
 use crate::metric::iso_grid::{IsoSamples, MEDIAN_BUCKETS, RowIdeals, RowSums};
-use crate::model::brdf::Rgb;
+use crate::metric::iso_tables::IsoTables;
+use crate::model::merl_grid::{THETA_H_RES, bin_angles};
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf};
+use crate::model::rgb::Rgb;
 use crate::model::tabulated::{NdfTables, Stretch, TabulatedNdf, theta_node, u_node_theta};
-use crate::sources::merl::{THETA_H_RES, bin_angles};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};

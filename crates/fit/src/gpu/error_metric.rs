@@ -3,7 +3,7 @@
 
 use super::GpuSamples;
 use super::grid::grid_constants;
-use crate::metric::grid::IsoTables;
+use crate::metric::iso_tables::IsoTables;
 use facet_gpu::{Gpu, GpuError, buffer, shader};
 
 /// The error metric over the MERL grid on the GPU (`shaders/fit/error.wgsl`).

@@ -3,8 +3,9 @@
 
 use super::GpuSamples;
 use super::grid::grid_constants;
-use crate::metric::grid::{GridSamples, IsoTables, fresnel_from_sums};
-use crate::model::brdf::Rgb;
+use crate::metric::grid::GridSamples;
+use crate::metric::iso_tables::{IsoTables, fresnel_from_sums};
+use crate::model::rgb::Rgb;
 use facet_gpu::{Gpu, GpuError, shader};
 
 /// The Fresnel average over the MERL grid on the GPU (`shaders/fit/fresnel.wgsl`).

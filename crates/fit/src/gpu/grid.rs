@@ -2,10 +2,11 @@
 //! (`merl_geometry.rs`, `iso_grid.rs`): its geometry uploaded once per fitter, a source's
 //! ln(1 + x) and validity flags once per source, read in place by the passes over the grid.
 
-use crate::metric::grid::{GridSamples, IsoTables};
+use crate::metric::grid::GridSamples;
 use crate::metric::iso_grid::PADDED;
+use crate::metric::iso_tables::IsoTables;
 use crate::metric::merl_geometry::{ROW, ROWS, merl_geometry};
-use crate::sources::merl::THETA_D_RES;
+use crate::model::merl_grid::THETA_D_RES;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch};
 
 /// The overrides of `grid.inc.wgsl`, for the pipelines that include it.

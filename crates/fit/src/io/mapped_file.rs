@@ -6,7 +6,7 @@
 //! the five timing files that is 7 ms for mapping and validating against 30–70 ms for reading
 //! and validating. The price: the mapping shows the file as it is, so a file truncated in place
 //! while mapped makes a later read of the lost part fault (SIGBUS). Writers that replace a file
-//! by renaming a new one into place (as [`crate::sources::merl::MerlTable::write`] does) are safe; the
+//! by renaming a new one into place (as [`crate::model::merl_grid::MerlTable::write`] does) are safe; the
 //! viewer and other long-lived users read the file into memory instead.
 
 use std::fs::File;

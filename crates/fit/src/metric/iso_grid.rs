@@ -13,18 +13,17 @@
 //! f32 lanes per row and in f64 across rows. The logs dominate: the metric's loops run chunk
 //! by chunk with the lanes in registers ([`row_error`], [`l1_channel`]).
 
-use crate::fitting::diffuse::LinearSums;
-use crate::metric::grid::{
-    IsoTables, LAMBDA_TABLE, MAX_X, exp_m1, fresnel_from_sums, ln_1p, ln_1p_fused,
-    ln_positive_fused,
-};
+use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
+use crate::metric::lambda_table::LAMBDA_TABLE;
 use crate::metric::merl_geometry::{
     COARSE_MU_ROW, COARSE_ROW, COARSE_STRIDE, MU_ROW, MerlGeometry, ROW, ROWS, merl_geometry,
     row_geometry,
 };
+use crate::metric::sums::LinearSums;
 use crate::model::brdf::Brdf;
-use crate::model::brdf::Rgb;
-use crate::sources::merl::{THETA_D_RES, THETA_H_RES};
+use crate::model::merl_grid::{THETA_D_RES, THETA_H_RES};
+use crate::model::rgb::Rgb;
+use crate::numerics::fast_log::{exp_m1, ln_1p, ln_1p_fused, ln_positive_fused};
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use std::sync::Arc;
@@ -1200,8 +1199,9 @@ fn build_rows_baseline(
         }
         // x = f_r cos θi, 0 where invalid
         let x = |c: usize, k: usize| {
-            let x = (f64::from_le_bytes(v[c][k]) * crate::sources::merl::SCALE[c] * mu_i[k] as f64)
-                as f32;
+            let x = (f64::from_le_bytes(v[c][k])
+                * crate::model::merl_grid::SCALE[c]
+                * mu_i[k] as f64) as f32;
             if valid[k] { x } else { 0.0 }
         };
         // x of each channel, then ln(1 + x) over it in place.

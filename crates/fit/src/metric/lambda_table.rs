@@ -1,5 +1,5 @@
 //! Λ cos θ tables uniform in cos θ: the G of an isotropic model on the fast path
-//! ([`crate::metric::grid::IsoTables`]).
+//! ([`crate::metric::iso_tables::IsoTables`]).
 //!
 //! A fit builds one table for every model its searches try, some fifty per analytic family,
 //! so their cost counts. Evaluated entry by entry through the general Λ, a table of 4096
@@ -8,7 +8,7 @@
 //! Here the cosines' sines and angles, the same for every table, are computed once per
 //! process, GGX's closed form runs in a loop the compiler vectorises, and Beckmann reads a
 //! universal function from a table of its own (below), built on first use: 14.5, 29 and
-//! 50–75 µs per [`crate::metric::grid::IsoTables`], which also evaluates D and F per bin. The fits'
+//! 50–75 µs per [`crate::metric::iso_tables::IsoTables`], which also evaluates D and F per bin. The fits'
 //! results are unchanged to the last digit on the five files of `examples/fit_timing.rs`.
 //!
 //! Beckmann: Λ = (erf a − 1) / 2 + e^(−a²) / (2 a √π), a = cot θ / α, so that

@@ -10,8 +10,8 @@
 //! over each half row), takes 14 M instructions, 57 M one bin at a time.
 
 use crate::model::geometry::acos_poly;
+use crate::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES, bin_angles};
 use crate::model::microfacet::correlation;
-use crate::sources::merl::{PHI_D_RES, THETA_D_RES, THETA_H_RES, bin_angles};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -188,7 +188,7 @@ fn build() -> MerlGeometry {
 mod tests {
     use super::*;
     use crate::model::geometry::{azimuth_between, from_half_diff};
-    use crate::sources::merl::index;
+    use crate::model::merl_grid::index;
 
     /// The build, vectorised where the CPU allows, gives every bin the bits of the formula
     /// evaluated one bin at a time: μ_k = a + b cos φd, and λ of the angle between the

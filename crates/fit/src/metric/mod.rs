@@ -4,5 +4,7 @@
 
 pub mod grid;
 pub(crate) mod iso_grid;
+pub mod iso_tables;
 pub(crate) mod lambda_table;
 pub(crate) mod merl_geometry;
+pub(crate) mod sums;

@@ -6,8 +6,9 @@
 //! n × n grid. (The diffuse term, if any, is added in closed form: ρd.) This is what the
 //! renderer's white-furnace tests compare against.
 
-use crate::model::brdf::{Brdf, Rgb};
+use crate::model::brdf::Brdf;
 use crate::model::microfacet::MicrofacetBrdf;
+use crate::model::rgb::Rgb;
 use glam::DVec3;
 
 /// E(ωo) per channel with an n × n midpoint grid over the sampling square.

@@ -1,11 +1,9 @@
 //! The one interface every BRDF source and every fitted model implements.
 
-use crate::sources::merl::MerlTable;
+use crate::model::merl_grid::MerlTable;
+use crate::model::rgb::Rgb;
 use glam::DVec3;
 use std::borrow::Cow;
-
-/// Linear Rec.709 RGB.
-pub type Rgb = [f64; 3];
 
 /// A BRDF: measured, neural, analytic or fitted.
 ///
@@ -38,7 +36,10 @@ pub trait Brdf: Sync {
     }
 }
 
-/// Mean of the three channels.
-pub fn mean(c: Rgb) -> f64 {
-    (c[0] + c[1] + c[2]) / 3.0
+impl MerlTable {
+    /// Samples any BRDF at the bin lower edges; below the horizon and where the source has no
+    /// value the sample is marked missing (−1).
+    pub fn sample<B: Brdf + ?Sized>(brdf: &B) -> Self {
+        MerlTable::from_fn(|wi, wo| brdf.eval(wi, wo))
+    }
 }

@@ -1,7 +1,7 @@
 //! Fresnel reflectance: Schlick, exact conductor and dielectric, and tables F(θd) extracted
 //! from measurements.
 
-use crate::model::brdf::Rgb;
+use crate::model::rgb::Rgb;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
 

@@ -3,9 +3,10 @@
 
 use crate::error::FitError;
 use crate::fitting::fresnel_fit::FresnelFits;
-use crate::model::brdf::{Brdf, Rgb};
+use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+use crate::model::rgb::Rgb;
 use crate::model::tabulated::{NdfTables, Stretch, TabulatedNdf};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

@@ -2,9 +2,10 @@
 //! Λ, the tabulated NDF of an extraction, the shadowing-masking model, and the microfacet BRDF
 //! `f = F(wi·h) D(h) G2(wi, wo) / (4 cos θi cos θo) + ρd/π`.
 
-use crate::model::brdf::{Brdf, Rgb};
+use crate::model::brdf::Brdf;
 use crate::model::fresnel::Fresnel;
 use crate::model::geometry::azimuth_between;
+use crate::model::rgb::Rgb;
 use crate::model::tabulated::TabulatedNdf;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

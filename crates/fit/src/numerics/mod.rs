@@ -1,5 +1,7 @@
-//! Numerical tools with no knowledge of BRDFs: quadrature rules and the χ² goodness-of-fit
-//! test.
+//! Numerical tools with no knowledge of BRDFs: quadrature rules, the χ² goodness-of-fit test,
+//! gap filling in tables, the fast logarithms of the metric and the 1-D and simplex optimisers.
 
 pub mod chi2;
+pub mod fast_log;
+pub(crate) mod interp;
 pub mod quadrature;

@@ -1,5 +1,5 @@
-//! MERL isotropic BRDF files (Matusik et al. 2003): reader, writer, nearest and interpolated
-//! lookups.
+//! MERL isotropic BRDF files (Matusik et al. 2003): reader and writer, and the measurement as a
+//! BRDF source. The grid and its lookups are [`crate::model::merl_grid`]'s.
 //!
 //! File layout: three little-endian `i32` dimensions (90, 90, 180) followed by 3·n `f64`
 //! values, all red then all green then all blue, sample index
@@ -9,114 +9,18 @@
 
 use crate::error::FitError;
 use crate::io::mapped_file::MappedFile;
-use crate::model::brdf::{Brdf, Rgb};
-use crate::model::geometry::{HalfDiff, from_half_diff, to_half_diff};
+use crate::model::brdf::Brdf;
+use crate::model::merl_grid::{
+    HEADER_BYTES, MAX_STORED, MerlTable, PHI_D_RES, SAMPLES, Stored, THETA_D_RES, THETA_H_RES,
+    bin_angles, stored,
+};
+use crate::model::rgb::Rgb;
+use crate::numerics::interp::fill_missing;
 use glam::DVec3;
 use rayon::prelude::*;
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::FRAC_PI_2;
 use std::io::Write;
 use std::path::Path;
-
-/// θh bins of a MERL file.
-pub const THETA_H_RES: usize = 90;
-/// θd bins of a MERL file.
-pub const THETA_D_RES: usize = 90;
-/// φd bins of a MERL file (over [0, π): reciprocity gives the rest).
-pub const PHI_D_RES: usize = 180;
-/// Samples per channel.
-pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
-/// f_r = stored value × `SCALE[channel]`.
-pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
-const HEADER_BYTES: u64 = 12;
-/// The largest stored value read as a measurement (f_r ≈ 7·10⁸ sr⁻¹, past any mirror-like
-/// MERL material): larger ones would overflow the extraction's sums.
-pub const MAX_STORED: f64 = 1e12;
-
-/// Flat index of bin (θh, θd, φd).
-pub const fn index(i: usize, j: usize, k: usize) -> usize {
-    k + PHI_D_RES * (j + THETA_D_RES * i)
-}
-
-/// Angles of the sample in bin (i, j, k): its lower edge.
-pub fn bin_angles(i: usize, j: usize, k: usize) -> HalfDiff {
-    let u = i as f64 / THETA_H_RES as f64;
-    HalfDiff {
-        theta_h: u * u * FRAC_PI_2,
-        phi_h: 0.0,
-        theta_d: j as f64 / THETA_D_RES as f64 * FRAC_PI_2,
-        phi_d: k as f64 / PHI_D_RES as f64 * PI,
-    }
-}
-
-/// Continuous bin coordinates (sample centres at integers) of a Rusinkiewicz pair.
-fn bin_coords(c: HalfDiff) -> [f64; 3] {
-    [
-        (c.theta_h.max(0.0) / FRAC_PI_2).sqrt() * THETA_H_RES as f64,
-        c.theta_d.max(0.0) / FRAC_PI_2 * THETA_D_RES as f64,
-        c.phi_d.rem_euclid(PI) / PI * PHI_D_RES as f64, // reciprocity: φd and φd + π are one bin
-    ]
-}
-
-/// The raw samples of a MERL file, exactly as stored.
-pub struct MerlTable {
-    raw: Stored,
-}
-
-/// A table's 3 · SAMPLES values, channel-major as in the file, each as its eight little-endian
-/// bytes (the file's own encoding, which a mapped file's unaligned values keep).
-enum Stored {
-    Owned(Vec<[u8; 8]>),
-    /// A standard MERL file mapped whole: the values follow its 12-byte header.
-    Mapped(MappedFile),
-}
-
-impl Stored {
-    fn values(&self) -> &[[u8; 8]] {
-        match self {
-            Stored::Owned(v) => v,
-            Stored::Mapped(m) => bytemuck::cast_slice(&m.bytes()[HEADER_BYTES as usize..]),
-        }
-    }
-}
-
-impl Clone for MerlTable {
-    fn clone(&self) -> Self {
-        MerlTable {
-            raw: Stored::Owned(self.raw.values().to_vec()),
-        }
-    }
-}
-
-impl PartialEq for MerlTable {
-    /// The values compared as numbers (−0 = 0), however each table holds them.
-    fn eq(&self, other: &Self) -> bool {
-        let (a, b) = (self.raw.values(), other.raw.values());
-        a.iter()
-            .zip(b)
-            .all(|(a, b)| f64::from_le_bytes(*a) == f64::from_le_bytes(*b))
-    }
-}
-
-impl std::fmt::Debug for MerlTable {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let held = match self.raw {
-            Stored::Owned(_) => "in memory",
-            Stored::Mapped(_) => "mapped",
-        };
-        write!(
-            f,
-            "MerlTable({} samples, {} missing, {held})",
-            SAMPLES,
-            self.missing_count()
-        )
-    }
-}
-
-/// The stored value at flat position `at` (channel-major).
-#[inline(always)]
-fn stored(raw: &[[u8; 8]], at: usize) -> f64 {
-    f64::from_le_bytes(raw[at])
-}
 
 impl MerlTable {
     /// Reads and validates a MERL `.binary` file into memory.
@@ -288,146 +192,6 @@ impl MerlTable {
             FitError::io(path, e)
         })
     }
-
-    /// Samples any BRDF at the bin lower edges; below the horizon and where the source has no
-    /// value the sample is marked missing (−1).
-    pub fn sample<B: Brdf + ?Sized>(brdf: &B) -> Self {
-        let mut raw = vec![(-1.0f64).to_le_bytes(); 3 * SAMPLES];
-        let values: Vec<Option<Rgb>> = (0..SAMPLES)
-            .into_par_iter()
-            .map(|s| {
-                let (i, j, k) = (
-                    s / (PHI_D_RES * THETA_D_RES),
-                    s / PHI_D_RES % THETA_D_RES,
-                    s % PHI_D_RES,
-                );
-                let (wi, wo) = from_half_diff(bin_angles(i, j, k));
-                if wi.z <= 0.0 || wo.z <= 0.0 {
-                    return None;
-                }
-                brdf.eval(wi, wo)
-            })
-            .collect();
-        for (s, v) in values.into_iter().enumerate() {
-            if let Some(v) = v {
-                for c in 0..3 {
-                    raw[c * SAMPLES + s] = (v[c] / SCALE[c]).to_le_bytes();
-                }
-            }
-        }
-        MerlTable {
-            raw: Stored::Owned(raw),
-        }
-    }
-
-    /// The stored values of channel `c` (0 red, 1 green, 2 blue) in flat bin order, as
-    /// little-endian bytes: f_r is a value times `SCALE[c]`, negative where missing.
-    pub(crate) fn channel(&self, c: usize) -> &[[u8; 8]] {
-        &self.raw.values()[c * SAMPLES..(c + 1) * SAMPLES]
-    }
-
-    /// The values to change, copied into memory first if the table is a mapped file (which is
-    /// never written).
-    fn values_mut(&mut self) -> &mut [[u8; 8]] {
-        if let Stored::Mapped(m) = &self.raw {
-            let owned = bytemuck::cast_slice(&m.bytes()[HEADER_BYTES as usize..]).to_vec();
-            self.raw = Stored::Owned(owned);
-        }
-        match &mut self.raw {
-            Stored::Owned(v) => v,
-            Stored::Mapped(_) => unreachable!("copied just above"),
-        }
-    }
-
-    /// f_r of bin (i, j, k), or `None` if the sample is missing.
-    #[inline]
-    pub fn value(&self, i: usize, j: usize, k: usize) -> Option<Rgb> {
-        self.value_at(index(i, j, k))
-    }
-
-    /// f_r of flat sample `s`, or `None` if the sample is missing.
-    #[inline]
-    pub fn value_at(&self, s: usize) -> Option<Rgb> {
-        let raw = self.raw.values();
-        let r = [
-            stored(raw, s),
-            stored(raw, SAMPLES + s),
-            stored(raw, 2 * SAMPLES + s),
-        ];
-        if r.iter().any(|&v| v < 0.0) {
-            return None;
-        }
-        Some([r[0] * SCALE[0], r[1] * SCALE[1], r[2] * SCALE[2]])
-    }
-
-    /// Marks flat sample `s` as missing.
-    pub fn mark_missing(&mut self, s: usize) {
-        let raw = self.values_mut();
-        for c in 0..3 {
-            raw[c * SAMPLES + s] = (-1.0f64).to_le_bytes();
-        }
-    }
-
-    /// Scales sample `s` by a per-channel factor (for noise experiments).
-    pub fn scale_sample(&mut self, s: usize, factor: Rgb) {
-        let raw = self.values_mut();
-        for (c, f) in factor.iter().enumerate() {
-            let v = stored(raw, c * SAMPLES + s);
-            if v >= 0.0 {
-                raw[c * SAMPLES + s] = (v * f).to_le_bytes();
-            }
-        }
-    }
-
-    /// The number of samples that hold no valid value.
-    pub fn missing_count(&self) -> usize {
-        (0..SAMPLES).filter(|&s| self.value_at(s).is_none()).count()
-    }
-
-    /// MERL's own lookup: the bin containing the angles (sqrt mapping on θh, φd folded by
-    /// reciprocity), indices clamped to the table.
-    pub fn lookup_nearest(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        let x = bin_coords(to_half_diff(wi, wo));
-        let clamp = |v: f64, n: usize| (v as usize).min(n - 1);
-        self.value(
-            clamp(x[0], THETA_H_RES),
-            clamp(x[1], THETA_D_RES),
-            clamp(x[2], PHI_D_RES),
-        )
-    }
-
-    /// Trilinear interpolation between the samples around (wi, wo), in the sqrt-θh, θd, φd
-    /// bin coordinates; φd wraps with period π; missing corners are left out and the weights of
-    /// the others renormalised.
-    pub fn lookup_interpolated(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        let x = bin_coords(to_half_diff(wi, wo));
-        let axis = |v: f64, n: usize| {
-            let v = v.clamp(0.0, (n - 1) as f64);
-            let i0 = (v as usize).min(n - 2);
-            (i0, i0 + 1, v - i0 as f64)
-        };
-        let (h0, h1, th) = axis(x[0], THETA_H_RES);
-        let (d0, d1, td) = axis(x[1], THETA_D_RES);
-        let p0 = (x[2] as usize).min(PHI_D_RES - 1);
-        let (p1, tp) = ((p0 + 1) % PHI_D_RES, x[2] - p0 as f64);
-        let mut sum = [0.0; 3];
-        let mut wsum = 0.0;
-        for (i, wi) in [(h0, 1.0 - th), (h1, th)] {
-            for (j, wj) in [(d0, 1.0 - td), (d1, td)] {
-                for (k, wk) in [(p0, 1.0 - tp), (p1, tp)] {
-                    let w = wi * wj * wk;
-                    if w <= 0.0 {
-                        continue;
-                    }
-                    if let Some(v) = self.value(i, j, k) {
-                        (0..3).for_each(|c| sum[c] += w * v[c]);
-                        wsum += w;
-                    }
-                }
-            }
-        }
-        (wsum > 0.0).then(|| sum.map(|s| s / wsum))
-    }
 }
 
 /// A MERL measurement as a BRDF source.
@@ -488,29 +252,6 @@ impl MerlBrdf {
     pub fn table(&self) -> &MerlTable {
         &self.table
     }
-}
-
-/// Fills `None` entries by linear interpolation between the nearest valid neighbours (constant
-/// beyond the ends). `None` if nothing is valid.
-pub(crate) fn fill_missing(v: &[Option<Rgb>]) -> Option<Vec<Rgb>> {
-    let valid: Vec<usize> = (0..v.len()).filter(|&i| v[i].is_some()).collect();
-    let (&first, &last) = (valid.first()?, valid.last()?);
-    Some(
-        (0..v.len())
-            .map(|i| match v[i] {
-                Some(x) => x,
-                None if i < first => v[first].unwrap(),
-                None if i > last => v[last].unwrap(),
-                None => {
-                    let hi = valid.partition_point(|&x| x < i);
-                    let (a, b) = (valid[hi - 1], valid[hi]);
-                    let t = (i - a) as f64 / (b - a) as f64;
-                    let (va, vb) = (v[a].unwrap(), v[b].unwrap());
-                    std::array::from_fn(|c| va[c] + t * (vb[c] - va[c]))
-                }
-            })
-            .collect(),
-    )
 }
 
 impl Brdf for MerlBrdf {

@@ -3,8 +3,9 @@
 //! x = (h, d) of the Rusinkiewicz parameterisation with φh = 0.
 
 use crate::error::FitError;
-use crate::model::brdf::{Brdf, Rgb};
+use crate::model::brdf::Brdf;
 use crate::model::geometry::{spherical, to_half_diff};
+use crate::model::rgb::Rgb;
 use glam::DVec3;
 use serde::Deserialize;
 use std::collections::BTreeMap;

@@ -36,8 +36,9 @@ pub mod tensor_file;
 pub mod warp2d;
 
 use crate::error::FitError;
-use crate::model::brdf::{Brdf, Rgb};
+use crate::model::brdf::Brdf;
 use crate::model::microfacet::Ndf;
+use crate::model::rgb::Rgb;
 use crate::sources::rgl::cie::SpectrumToRgb;
 use crate::sources::rgl::tensor_file::{TensorFile, TensorWriter};
 use crate::sources::rgl::warp2d::Warp2D;
