@@ -24,9 +24,7 @@
 use crate::error::FitError;
 use crate::extract::Extraction;
 use crate::metric::grid::{GridSamples, fresnel_diffuse_and_error};
-use crate::metric::sums::LinearSums;
 use crate::model::brdf::Brdf;
-use crate::model::merl_grid::THETA_D_RES;
 use crate::model::microfacet::{MicrofacetBrdf, Ndf};
 use crate::model::rgb::{Rgb, mean};
 use glam::DVec3;
@@ -208,6 +206,8 @@ pub(crate) fn tabulated_model(ex: &Extraction) -> MicrofacetBrdf {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::metric::sums::LinearSums;
+    use crate::model::merl_grid::THETA_D_RES;
 
     /// The separation's search finds minima at either end in two or three evaluations, and
     /// an interior one to its tolerance, from starts on either side of it.
