@@ -2,11 +2,12 @@
 
 use anyhow::{Context, Result, bail};
 use clap::Args;
+use facet_fit::export::rgl::{BsdfResolution, write_rgl};
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::io::input::same_file;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::open_source_mapped;
-use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, write_rgl};
+use facet_fit::sources::rgl::RglBsdf;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;

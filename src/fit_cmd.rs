@@ -3,10 +3,10 @@
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::extract::Stopping;
-use facet_fit::fitting::fresnel_fit::FresnelChoice;
 use facet_fit::fitting::{Backend, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
 use facet_fit::io::input::same_file;
+use facet_fit::model::fresnel_curves::FresnelChoice;
 use facet_fit::model::material::FittedMaterial;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::numerics::quadrature::Quadrature;

@@ -4,9 +4,9 @@
 mod common;
 
 use common::merl_from_spec;
-use facet_fit::fitting::fresnel_fit::FresnelChoice;
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::model::fresnel::Fresnel;
+use facet_fit::model::fresnel_curves::FresnelChoice;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 
 #[test]

@@ -22,12 +22,13 @@
 mod common;
 
 use facet_fit::Brdf;
+use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
 use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::model::merl_grid::{MAX_STORED, MerlTable, SAMPLES, SCALE};
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
-use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, rgl_tensor};
+use facet_fit::sources::rgl::RglBsdf;
 use facet_render::scene::data_uri::encode_base64;
 use facet_render::scene::{EnvironmentMap, LoadOptions, Scene};
 use glam::{DVec3, Vec2, Vec3};

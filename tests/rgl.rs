@@ -5,9 +5,10 @@ mod common;
 
 use common::{merl_from_spec, scratch, spectral_from_rgb};
 use facet_fit::Brdf;
+use facet_fit::export::rgl::{BsdfResolution, write_rgl};
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::metric::grid::{GridSamples, error_metric};
-use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, write_rgl};
+use facet_fit::sources::rgl::RglBsdf;
 use std::process::Command;
 
 /// A GGX plastic written as a MERL table, written as a `.bsdf` and read back: within 0.01 of

@@ -6,12 +6,13 @@
 //!
 //! `cargo run --release -p facet-fit --example rgl_roundtrip [-- NAME_FILTER [THETA_I SAMPLE VNDF]]`
 
+use facet_fit::export::rgl::{BsdfResolution, rgl_tensor, sampling_ndfs};
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::metric::grid::{GridSamples, error_metric};
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
-use facet_fit::sources::rgl::{BsdfResolution, RglBsdf, rgl_tensor, sampling_ndfs};
+use facet_fit::sources::rgl::RglBsdf;
 use std::time::Instant;
 
 fn quantile(v: &[f64], q: f64) -> f64 {

@@ -22,9 +22,11 @@
 //! contains the dielectric one (k = 0), so its error is never much above the dielectric's, and
 //! a colourless table fits both alike.
 
+pub mod rgl;
+
 use crate::error::FitError;
-use crate::fitting::fresnel_fit::{FitQuality, FresnelChoice, FresnelFits};
 use crate::model::fresnel::dielectric;
+use crate::model::fresnel_curves::{FitQuality, FresnelChoice, FresnelFits};
 use crate::model::material::{FitRecord, FittedMaterial, ParamRecord};
 use crate::model::microfacet::NdfKind;
 use crate::model::rgb::Rgb;

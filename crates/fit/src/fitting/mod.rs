@@ -8,7 +8,6 @@ pub(crate) mod refine;
 use crate::error::FitError;
 use crate::extract::{CpuSolver, ExtractConfig, Solver, extract_with};
 use crate::fitting::diffuse::{separate, tabulated_model};
-use crate::fitting::fresnel_fit::{FresnelChoice, FresnelFits};
 use crate::fitting::params::{
     candidates_of, fit_least_squares, fit_moments, least_squares_candidates, refine_by_bracket,
 };
@@ -23,6 +22,7 @@ use crate::metric::grid::{
 use crate::metric::iso_tables::IsoTables;
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
+use crate::model::fresnel_curves::{FresnelChoice, FresnelFits};
 use crate::model::material::{
     FitRecord, FittedMaterial, ParamRecord, Params, TabulatedRecord, Timings,
 };

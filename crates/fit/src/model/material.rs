@@ -2,9 +2,9 @@
 //! the record written as `<name>.json`. Each model is itself a [`Brdf`].
 
 use crate::error::FitError;
-use crate::fitting::fresnel_fit::FresnelFits;
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
+use crate::model::fresnel_curves::FresnelFits;
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::model::rgb::Rgb;
 use crate::model::tabulated::{NdfTables, Stretch, TabulatedNdf};

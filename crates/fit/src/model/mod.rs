@@ -7,6 +7,7 @@ pub mod albedo;
 pub mod analytic;
 pub mod brdf;
 pub mod fresnel;
+pub mod fresnel_curves;
 pub mod geometry;
 pub mod material;
 pub mod merl_grid;

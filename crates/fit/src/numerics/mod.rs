@@ -4,4 +4,5 @@
 pub mod chi2;
 pub mod fast_log;
 pub(crate) mod interp;
+pub(crate) mod optim;
 pub mod quadrature;
