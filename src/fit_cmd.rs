@@ -375,8 +375,8 @@ fn fit_one(
 ) -> Result<FittedMaterial> {
     let src = src?;
     let mut fit = fit_material_on(src.as_ref(), input, cfg, backend)?;
-    if fit.record.backend.starts_with("cpu (fallback") {
-        eprintln!("notice: {input}: {}", fit.record.backend);
+    if let Some(gpu_error) = &fit.record.fallback {
+        eprintln!("notice: {input}: fitted on the CPU after a GPU failure: {gpu_error}");
     }
     // The diffuse lobe is solved on the isotropic grid: a source that is not isotropic (an
     // anisotropic analytic or RGL material fitted without --aniso) gets the single lobe.

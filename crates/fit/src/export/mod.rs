@@ -828,6 +828,7 @@ mod tests {
             name: "test material".into(),
             source: "analytic:test".into(),
             backend: "cpu".into(),
+            fallback: None,
             resolution: 16,
             phi_resolution: 1,
             anisotropic: p.alpha_x != p.alpha_y,

@@ -10,7 +10,7 @@
 use crate::metric::iso_grid::{CoarseSamples, IsoSamples};
 use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
-use crate::model::fresnel::Fresnel;
+use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::geometry::{HalfDiff, from_half_diff};
 use crate::model::merl_grid::{PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles};
 use crate::model::microfacet::MicrofacetBrdf;
@@ -265,10 +265,72 @@ pub fn error_metric(model: &dyn Brdf, set: &GridSamples) -> f64 {
 
 /// [`error_metric`] of a microfacet model, through its tables when it is isotropic.
 pub fn microfacet_error(model: &MicrofacetBrdf, set: &GridSamples) -> f64 {
-    let Some(tables) = IsoTables::new(model).filter(|_| set.rotations.len() == 1) else {
+    error_with(model, IsoTables::new(model).as_ref(), set)
+}
+
+/// [`microfacet_error`] with the model's tables given.
+fn error_with(model: &MicrofacetBrdf, tables: Option<&IsoTables>, set: &GridSamples) -> f64 {
+    let Some(tables) = tables.filter(|_| set.rotations.len() == 1) else {
         return error_metric(model, set);
     };
     tables.log_error_sum(set) / (3 * set.len().max(1)) as f64
+}
+
+/// A microfacet model and, when it is isotropic, its tables: reduced once, then read by every
+/// pass a fit asks of it (the functions of this module reduce the model they are given on
+/// each call).
+#[derive(Clone)]
+pub struct GridModel {
+    /// The model.
+    pub model: MicrofacetBrdf,
+    /// Its tables; `None` for an anisotropic model, which the passes evaluate directly.
+    pub tables: Option<IsoTables>,
+}
+
+impl GridModel {
+    /// Reduces `model` to its tables.
+    pub fn new(model: MicrofacetBrdf) -> Self {
+        let tables = IsoTables::new(&model);
+        GridModel { model, tables }
+    }
+
+    /// The model with F per θd bin (a table on the MERL bins) and the diffuse albedo ρd: D and
+    /// Λ are kept, F and ρd/π tabulated as [`IsoTables::new`] tabulates them.
+    pub fn with_fresnel(&self, f: &[Rgb], diffuse: Rgb) -> Self {
+        let model = MicrofacetBrdf {
+            fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.to_vec())),
+            diffuse,
+            ..self.model.clone()
+        };
+        let tables = self.tables.as_ref().map(|t| t.with_model_fresnel(&model));
+        GridModel { model, tables }
+    }
+
+    /// [`microfacet_error`].
+    pub fn error(&self, set: &GridSamples) -> f64 {
+        error_with(&self.model, self.tables.as_ref(), set)
+    }
+
+    /// [`fresnel_average`].
+    pub fn fresnel_average(&self, set: &GridSamples) -> Vec<Rgb> {
+        average_with(&self.model, self.tables.as_ref(), set)
+    }
+
+    /// [`fresnel_and_error`].
+    pub fn fresnel_and_error(&self, set: &GridSamples) -> (Vec<Rgb>, f64) {
+        fresnel_and_error_with(&self.model, self.tables.as_ref(), set)
+    }
+
+    /// [`fresnel_diffuse_and_error`].
+    pub fn fresnel_diffuse_and_error(
+        &self,
+        set: &GridSamples,
+        irls: usize,
+    ) -> Option<(Vec<Rgb>, Rgb, f64)> {
+        let (iso, tables) = (set.iso.as_ref()?, self.tables.as_ref()?);
+        let (f, q, e) = iso.fresnel_diffuse_and_error_sum(tables, irls);
+        Some((f, q.map(|q| q * PI), e / (3 * set.len().max(1)) as f64))
+    }
 }
 
 /// The errors of `model` with each of `fresnels` in place of its own Fresnel: on an isotropic
@@ -304,15 +366,22 @@ pub fn microfacet_errors(
 /// that model's error ([`microfacet_error`]): the two passes of a least-squares step, sharing
 /// G2 on an isotropic set.
 pub fn fresnel_and_error(model: &MicrofacetBrdf, set: &GridSamples) -> (Vec<Rgb>, f64) {
-    if let (Some(iso), Some(tables)) = (&set.iso, IsoTables::new(model)) {
-        let (f, e) = iso.fresnel_and_error_sum(&tables);
+    fresnel_and_error_with(model, IsoTables::new(model).as_ref(), set)
+}
+
+/// [`fresnel_and_error`] with the model's tables given.
+fn fresnel_and_error_with(
+    model: &MicrofacetBrdf,
+    tables: Option<&IsoTables>,
+    set: &GridSamples,
+) -> (Vec<Rgb>, f64) {
+    if let (Some(iso), Some(tables)) = (&set.iso, tables) {
+        let (f, e) = iso.fresnel_and_error_sum(tables);
         return (f, e / (3 * set.len().max(1)) as f64);
     }
-    let f = fresnel_average(model, set);
+    let f = average_with(model, tables, set);
     let with = MicrofacetBrdf {
-        fresnel: crate::model::fresnel::Fresnel::Table(
-            crate::model::fresnel::FresnelTable::on_merl_bins(f.clone()),
-        ),
+        fresnel: Fresnel::Table(FresnelTable::on_merl_bins(f.clone())),
         ..model.clone()
     };
     let e = microfacet_error(&with, set);
@@ -345,12 +414,16 @@ impl CoarseGrid {
     /// ([`fresnel_diffuse_and_error`] without a reweighted step), without it the Fresnel
     /// average ([`fresnel_and_error`]). `None` for a model that is not isotropic.
     pub fn error(&self, model: &MicrofacetBrdf, diffuse: bool) -> Option<f64> {
-        let tables = IsoTables::new(model)?;
+        Some(self.tables_error(&IsoTables::new(model)?, diffuse))
+    }
+
+    /// [`CoarseGrid::error`] of a model reduced to its tables.
+    pub fn tables_error(&self, tables: &IsoTables, diffuse: bool) -> f64 {
         let e = match diffuse {
-            true => self.0.fresnel_diffuse_and_error_sum(&tables, 0).2,
-            false => self.0.fresnel_and_error_sum(&tables).1,
+            true => self.0.fresnel_diffuse_and_error_sum(tables, 0).2,
+            false => self.0.fresnel_and_error_sum(tables).1,
         };
-        Some(e / (3 * self.0.count.max(1)) as f64)
+        e / (3 * self.0.count.max(1)) as f64
     }
 
     /// F per θd bin, ρd and the mean error on these rows of `model` with `irls` reweighted
@@ -361,9 +434,17 @@ impl CoarseGrid {
         model: &MicrofacetBrdf,
         irls: usize,
     ) -> Option<(Vec<Rgb>, Rgb, f64)> {
-        let tables = IsoTables::new(model)?;
-        let (f, q, e) = self.0.fresnel_diffuse_and_error_sum(&tables, irls);
-        Some((f, q.map(|q| q * PI), e / (3 * self.0.count.max(1)) as f64))
+        Some(self.tables_fresnel_diffuse_and_error(&IsoTables::new(model)?, irls))
+    }
+
+    /// [`CoarseGrid::fresnel_diffuse_and_error`] of a model reduced to its tables.
+    pub fn tables_fresnel_diffuse_and_error(
+        &self,
+        tables: &IsoTables,
+        irls: usize,
+    ) -> (Vec<Rgb>, Rgb, f64) {
+        let (f, q, e) = self.0.fresnel_diffuse_and_error_sum(tables, irls);
+        (f, q.map(|q| q * PI), e / (3 * self.0.count.max(1)) as f64)
     }
 
     /// The rows themselves.
@@ -389,7 +470,12 @@ fn log_diff(x: Rgb, s: &GridSample) -> f64 {
 /// is the mean of f / f_ideal weighted by x_ideal, which keeps noisy tails (tiny f_ideal) from
 /// dominating. Bins without samples are filled by interpolation.
 pub fn fresnel_average(model: &MicrofacetBrdf, set: &GridSamples) -> Vec<Rgb> {
-    match IsoTables::new(model).filter(|_| set.rotations.len() == 1) {
+    average_with(model, IsoTables::new(model).as_ref(), set)
+}
+
+/// [`fresnel_average`] with the model's tables given.
+fn average_with(model: &MicrofacetBrdf, tables: Option<&IsoTables>, set: &GridSamples) -> Vec<Rgb> {
+    match tables.filter(|_| set.rotations.len() == 1) {
         Some(t) => t.fresnel_average(set),
         None => average_per_theta_d(set, |s| {
             let (wi, wo) = set.directions(s);

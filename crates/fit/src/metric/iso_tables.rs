@@ -45,12 +45,10 @@ impl IsoTables {
             )) as f32
         });
         let lambda_cos = lambda_cos_table(&model.ndf);
-        let fresnel =
-            std::array::from_fn(|j| model.fresnel.eval(bin_angles(0, j, 0).theta_d.cos()));
         Some(IsoTables {
             d32,
             lambda_cos,
-            fresnel,
+            fresnel: fresnel_bins(model),
             diffuse: model.diffuse.map(|k| k / PI),
         })
     }
@@ -65,6 +63,17 @@ impl IsoTables {
     #[cfg(feature = "gpu")]
     pub(crate) fn lambda_cos_table(&self) -> &[f32] {
         &self.lambda_cos[..]
+    }
+
+    /// These tables with the Fresnel and diffuse albedo of `model`, whose D and Λ are these
+    /// tables' (the same F and ρd/π as [`IsoTables::new`] of `model`, without its D and Λ).
+    pub fn with_model_fresnel(&self, model: &MicrofacetBrdf) -> Self {
+        IsoTables {
+            d32: self.d32,
+            lambda_cos: self.lambda_cos.clone(),
+            fresnel: fresnel_bins(model),
+            diffuse: model.diffuse.map(|k| k / PI),
+        }
     }
 
     /// The same model with another Fresnel table.
@@ -87,6 +96,11 @@ impl IsoTables {
         );
         self.d32[i] as f64 * g / (4.0 * wo.z)
     }
+}
+
+/// F of `model` at each θd bin.
+fn fresnel_bins(model: &MicrofacetBrdf) -> [Rgb; THETA_D_RES] {
+    std::array::from_fn(|j| model.fresnel.eval(bin_angles(0, j, 0).theta_d.cos()))
 }
 
 /// F per θd bin from the sums (Σ x_data per channel, Σ x_ideal); empty bins interpolated.

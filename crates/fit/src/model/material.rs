@@ -106,6 +106,9 @@ pub struct FitRecord {
     pub source: String,
     /// What ran the extraction: `cpu`, the adapter's description, or a CPU fallback notice.
     pub backend: String,
+    /// The GPU's error when a GPU fit fell back to the CPU (`backend` then says so in words).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fallback: Option<String>,
     /// θ samples of the extraction.
     pub resolution: usize,
     /// φ samples of the extraction (1 when isotropic).
@@ -190,10 +193,29 @@ impl FittedMaterial {
         let st = record.tabulated.stretch;
         check_alpha("tabulated.stretch", st.alpha_x, st.alpha_y, st.rotation)?;
         let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)?;
+        Self::with_ndf(record, Arc::new(ndf))
+    }
+
+    /// [`FittedMaterial::from_record`] for a record whose tabulated NDF is built already (a
+    /// fit's own): its sampler is not built a second time. `ndf` must be the record's
+    /// tables with the record's stretch.
+    pub fn from_parts(record: FitRecord, ndf: Arc<TabulatedNdf>) -> Result<Self, String> {
+        debug_assert!(
+            ndf.tables() == &record.tabulated.tables && ndf.stretch == record.tabulated.stretch,
+            "from_parts: the NDF is not the record's"
+        );
+        record.fresnel.validate()?;
+        let st = record.tabulated.stretch;
+        check_alpha("tabulated.stretch", st.alpha_x, st.alpha_y, st.rotation)?;
+        Self::with_ndf(record, ndf)
+    }
+
+    /// The models of a record whose Fresnel table and stretch are checked, with its NDF.
+    fn with_ndf(record: FitRecord, ndf: Arc<TabulatedNdf>) -> Result<Self, String> {
         check_albedo("tabulated.diffuse", record.tabulated.diffuse)?;
         let tabulated = MicrofacetBrdf {
             name: format!("{}-tabulated", record.name),
-            ndf: Ndf::Tabulated(Arc::new(ndf)),
+            ndf: Ndf::Tabulated(ndf),
             fresnel: used_fresnel("fresnel_fits", &record.fresnel_fits, &record.fresnel)?,
             diffuse: record.tabulated.diffuse,
         };
