@@ -6,8 +6,8 @@ use facet_fit::export::rgl::{BsdfResolution, write_rgl};
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::io::input::same_file;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
-use facet_fit::sources::open_source_mapped;
 use facet_fit::sources::rgl::RglBsdf;
+use facet_fit::sources::{InputSpec, Residence};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -81,7 +81,11 @@ pub fn run(args: &ConvertArgs) -> Result<ExitCode> {
     };
     let t = Instant::now();
     let mut library: Option<NbrdfLibrary> = None;
-    let src = open_source_mapped(&args.input, args.nbrdf.as_deref(), &mut library)?;
+    let src = InputSpec::parse(&args.input).open(
+        args.nbrdf.as_deref(),
+        &mut library,
+        Residence::Mapped,
+    )?;
     let load_ms = t.elapsed().as_secs_f64() * 1e3;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         crate::output::folder(dir, "OUT's folder")?;

@@ -4,8 +4,10 @@ use crate::fit_cmd::BackendArg;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use facet_fit::extract::{ExtractConfig, extract_isotropic};
-use facet_fit::model::microfacet::{MicrofacetBrdf, Ndf};
-use facet_fit::sources::open_source_mapped;
+use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::microfacet::Ndf;
+use facet_fit::sources::nbrdf::NbrdfLibrary;
+use facet_fit::sources::{InputSpec, Residence};
 use facet_glint::dpf::{DpfConfig, DpfPyramid, LEVELS_DEG, dpf, query_directions};
 use facet_gpu::Gpu;
 use std::path::{Path, PathBuf};
@@ -51,24 +53,17 @@ pub struct DpfArgs {
 }
 
 fn ndf_of(spec: &str, nbrdf: &Option<PathBuf>) -> Result<Ndf> {
-    let mut library = None;
-    let path = facet_fit::sources::nbrdf::NbrdfLibrary::override_path(nbrdf.as_deref());
-    if let Some(rest) = spec.strip_prefix("analytic:") {
-        return Ok(facet_fit::model::analytic::parse_analytic(rest)?.ndf);
+    let input = InputSpec::parse(spec);
+    match &input {
+        InputSpec::Analytic(rest) => Ok(facet_fit::model::analytic::parse_analytic(rest)?.ndf),
+        InputSpec::Fit(path) => Ok(FittedMaterial::load(path)?.tabulated.ndf),
+        _ => {
+            let path = NbrdfLibrary::override_path(nbrdf.as_deref());
+            let src = input.open(path.as_deref(), &mut None, Residence::Mapped)?;
+            let ex = extract_isotropic(src.as_ref(), &ExtractConfig::isotropic())?;
+            Ok(Ndf::Tabulated(Arc::new(ex.ndf)))
+        }
     }
-    if spec.ends_with(".json") {
-        let fit = facet_fit::model::material::FittedMaterial::load(Path::new(spec))?;
-        return Ok(fit.tabulated.ndf.clone());
-    }
-    let src = open_source_mapped(spec, path.as_deref(), &mut library)?;
-    let ex = extract_isotropic(src.as_ref(), &ExtractConfig::isotropic())?;
-    let model = MicrofacetBrdf {
-        name: spec.into(),
-        ndf: Ndf::Tabulated(Arc::new(ex.ndf)),
-        fresnel: facet_fit::model::fresnel::Fresnel::Schlick { f0: [1.0; 3] },
-        diffuse: [0.0; 3],
-    };
-    Ok(model.ndf)
 }
 
 /// Builds the listed levels on the GPU (`auto`: when there is one, else on the CPU).

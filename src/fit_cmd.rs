@@ -12,7 +12,7 @@ use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::numerics::quadrature::Quadrature;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
-use facet_fit::sources::open_source_mapped;
+use facet_fit::sources::{InputSpec, Residence};
 use facet_gpu::Gpu;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
@@ -100,9 +100,13 @@ fn open_gpu_during<T>(
 /// A source opened, and the milliseconds it took.
 type Opened = (Result<Box<dyn facet_fit::Brdf>, facet_fit::FitError>, f64);
 
-fn open_timed(input: &str, nbrdf: Option<&Path>, library: &mut Option<NbrdfLibrary>) -> Opened {
+fn open_timed(
+    input: &InputSpec,
+    nbrdf: Option<&Path>,
+    library: &mut Option<NbrdfLibrary>,
+) -> Opened {
     let t = Instant::now();
-    let src = open_source_mapped(input, nbrdf, library);
+    let src = input.open(nbrdf, library, Residence::Mapped);
     (src, t.elapsed().as_secs_f64() * 1e3)
 }
 
@@ -259,8 +263,9 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let cfg = args.config()?;
     let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
     let mut library = None;
+    let specs: Vec<InputSpec> = args.inputs.iter().map(|i| InputSpec::parse(i)).collect();
     let (gpu, mut first) = open_gpu_during(args.backend, cfg.anisotropic, || {
-        let first = args.inputs.first()?;
+        let first = specs.first()?;
         Some(open_timed(first, nbrdf.as_deref(), &mut library))
     });
     let gpu = gpu?;
@@ -269,11 +274,9 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     crate::output::folder(&args.out, "--out")?;
     let mut outputs = Outputs {
         dir: &args.out,
-        read: args
-            .inputs
+        read: specs
             .iter()
-            .filter(|i| !i.starts_with("nbrdf:") && !i.starts_with("analytic:"))
-            .map(PathBuf::from)
+            .filter_map(|s| s.path().map(Path::to_path_buf))
             .chain(nbrdf.clone())
             .collect(),
         names: HashSet::new(),
@@ -289,13 +292,13 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     let mut rows = Vec::new();
     let mut failures = 0;
     let started = Instant::now();
-    for input in &args.inputs {
+    for (input, spec) in args.inputs.iter().zip(&specs) {
         if let Some(bar) = &bar {
             bar.set_message(input.clone());
         }
         let opened = first
             .take()
-            .unwrap_or_else(|| open_timed(input, nbrdf.as_deref(), &mut library));
+            .unwrap_or_else(|| open_timed(spec, nbrdf.as_deref(), &mut library));
         match fit_one(input, opened, &cfg, backend, &mut outputs) {
             Ok(fit) => rows.push(fit),
             Err(e) => {

@@ -30,7 +30,7 @@
 //! | [`io`] | input files read safely (regular, bounded, mapped), outputs written atomically |
 //! | [`numerics`] | quadrature rules, the χ² test |
 //! | [`model`] | the [`Brdf`] trait, geometry, microfacet NDFs (GGX, Beckmann, tabulated), Fresnel, analytic specs, the fit record [`FittedMaterial`] |
-//! | [`sources`] | measurements: MERL files, the neural proxies, RGL `.bsdf` files; [`sources::open_source`] |
+//! | [`sources`] | measurements: MERL files, the neural proxies, RGL `.bsdf` files; [`sources::InputSpec`] names one |
 //! | [`extract`] | the paper's algorithm: the kernel and the power iteration |
 //! | [`metric`] | passes over the MERL grid: the error metric, the Fresnel average, the linear solves |
 //! | `gpu` | the extraction and the grid passes as WGSL compute passes (feature `gpu`) |

@@ -147,8 +147,9 @@ impl ViewerApp {
             self.open_scene(Path::new(&spec));
             return;
         }
-        if ext.as_deref() == Some("json") {
-            match FittedMaterial::load(Path::new(&spec)) {
+        let input = facet_fit::sources::InputSpec::parse(&spec);
+        if let facet_fit::sources::InputSpec::Fit(path) = &input {
+            match FittedMaterial::load(path) {
                 Ok(fit) => {
                     self.set_material(EditedMaterial::new(fit, spec.clone()));
                     self.status = format!("opened {spec}");
@@ -157,9 +158,8 @@ impl ViewerApp {
             }
             return;
         }
-        if !spec.starts_with("nbrdf:")
-            && !spec.starts_with("analytic:")
-            && let Err(e) = std::fs::metadata(&spec)
+        if let Some(path) = input.path()
+            && let Err(e) = std::fs::metadata(path)
         {
             self.error = Some(format!("cannot open {spec}: {e}"));
             return;
@@ -172,7 +172,12 @@ impl ViewerApp {
         std::thread::spawn(move || {
             let r = (|| {
                 let mut lib = None;
-                let src = facet_fit::sources::open_source(&spec, nbrdf.as_deref(), &mut lib)
+                let src = input
+                    .open(
+                        nbrdf.as_deref(),
+                        &mut lib,
+                        facet_fit::sources::Residence::Read,
+                    )
                     .map_err(|e| e.to_string())?;
                 *st.lock().unwrap() = "extracting the NDF and fitting".into();
                 fit_material(&*src, &spec, &FitConfig::isotropic()).map_err(|e| e.to_string())

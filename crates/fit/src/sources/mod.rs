@@ -1,4 +1,5 @@
-//! Resolving an input of `facet fit` to a BRDF source.
+//! The measured sources — MERL files, the neural proxies, RGL `.bsdf` files — and an input
+//! named on a command line resolved to one ([`InputSpec`]).
 
 pub mod merl;
 pub mod nbrdf;
@@ -11,54 +12,86 @@ use crate::model::material::FittedMaterial;
 use crate::sources::merl::MerlBrdf;
 use crate::sources::nbrdf::NbrdfLibrary;
 use crate::sources::rgl::RglBsdf;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-/// An input: `nbrdf:NAME`, `analytic:SPEC`, a fit `.json` (its tabulated model), an RGL
-/// `.bsdf` or a MERL file (any other name, read into memory).
-/// `nbrdf` is the network file used for `nbrdf:` inputs (`None`: the embedded MERL-100
-/// proxies), opened on first use.
-pub fn open_source(
-    input: &str,
-    nbrdf: Option<&Path>,
-    library: &mut Option<NbrdfLibrary>,
-) -> Result<Box<dyn Brdf>, FitError> {
-    open(input, nbrdf, library, false)
+/// An input as a user names it (`facet fit INPUT`, `facet convert INPUT`, the viewer's open
+/// box), parsed once into what it names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum InputSpec {
+    /// `nbrdf:NAME`: one of the neural proxies.
+    Nbrdf(String),
+    /// `analytic:SPEC`: an analytic model ([`parse_analytic`]).
+    Analytic(String),
+    /// A fit `.json`: its tabulated model.
+    Fit(PathBuf),
+    /// An RGL `.bsdf`.
+    Rgl(PathBuf),
+    /// A MERL `.binary` file (any other name).
+    Merl(PathBuf),
 }
 
-/// [`open_source`] for a short-lived process: a MERL file is mapped ([`MerlBrdf::map`]), not
-/// read, and must not be truncated in place while the source lives.
-pub fn open_source_mapped(
-    input: &str,
-    nbrdf: Option<&Path>,
-    library: &mut Option<NbrdfLibrary>,
-) -> Result<Box<dyn Brdf>, FitError> {
-    open(input, nbrdf, library, true)
+/// How a MERL file is held.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Residence {
+    /// Read into memory.
+    Read,
+    /// Mapped ([`MerlBrdf::map`]): the fast way for a short-lived process; the file must not
+    /// be truncated in place while the source lives.
+    Mapped,
 }
 
-fn open(
-    input: &str,
-    nbrdf: Option<&Path>,
-    library: &mut Option<NbrdfLibrary>,
-    map: bool,
-) -> Result<Box<dyn Brdf>, FitError> {
-    if let Some(name) = input.strip_prefix("nbrdf:") {
-        if library.is_none() {
-            *library = Some(NbrdfLibrary::open_or_embedded(nbrdf)?);
+impl InputSpec {
+    /// What `input` names: by its `nbrdf:` or `analytic:` prefix, else by its extension (any
+    /// case).
+    pub fn parse(input: &str) -> Self {
+        if let Some(name) = input.strip_prefix("nbrdf:") {
+            return InputSpec::Nbrdf(name.to_owned());
         }
-        return Ok(Box::new(library.as_ref().unwrap().get(name)?));
+        if let Some(spec) = input.strip_prefix("analytic:") {
+            return InputSpec::Analytic(spec.to_owned());
+        }
+        let path = PathBuf::from(input);
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        match ext.as_deref() {
+            Some("json") => InputSpec::Fit(path),
+            Some("bsdf") => InputSpec::Rgl(path),
+            _ => InputSpec::Merl(path),
+        }
     }
-    if let Some(spec) = input.strip_prefix("analytic:") {
-        return Ok(Box::new(parse_analytic(spec)?));
+
+    /// The file the input reads, if it names one (not the neural proxies' file, which
+    /// `nbrdf:` inputs share).
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            InputSpec::Nbrdf(_) | InputSpec::Analytic(_) => None,
+            InputSpec::Fit(p) | InputSpec::Rgl(p) | InputSpec::Merl(p) => Some(p),
+        }
     }
-    let path = Path::new(input);
-    if path.extension().is_some_and(|e| e == "json") {
-        return Ok(Box::new(FittedMaterial::load(path)?));
+
+    /// The source. `nbrdf` is the network file of `nbrdf:` inputs (`None`: the embedded
+    /// MERL-100 proxies), opened into `library` on first use.
+    pub fn open(
+        &self,
+        nbrdf: Option<&Path>,
+        library: &mut Option<NbrdfLibrary>,
+        merl: Residence,
+    ) -> Result<Box<dyn Brdf>, FitError> {
+        Ok(match self {
+            InputSpec::Nbrdf(name) => {
+                if library.is_none() {
+                    *library = Some(NbrdfLibrary::open_or_embedded(nbrdf)?);
+                }
+                Box::new(library.as_ref().unwrap().get(name)?)
+            }
+            InputSpec::Analytic(spec) => Box::new(parse_analytic(spec)?),
+            InputSpec::Fit(path) => Box::new(FittedMaterial::load(path)?),
+            InputSpec::Rgl(path) => Box::new(RglBsdf::open(path)?),
+            InputSpec::Merl(path) => Box::new(match merl {
+                Residence::Read => MerlBrdf::open(path)?,
+                Residence::Mapped => MerlBrdf::map(path)?,
+            }),
+        })
     }
-    if path.extension().is_some_and(|e| e == "bsdf") {
-        return Ok(Box::new(RglBsdf::open(path)?));
-    }
-    Ok(Box::new(match map {
-        true => MerlBrdf::map(path)?,
-        false => MerlBrdf::open(path)?,
-    }))
 }
