@@ -124,19 +124,13 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode> {
         crate::output::folder(dir, "--out")?;
     }
     // Through a temporary file renamed into place, as `facet fit` writes its JSON.
-    let mut tmp = out.clone().into_os_string();
-    tmp.push(".partial");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, &exported.text)
-        .and_then(|_| std::fs::rename(&tmp, &out))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            anyhow::anyhow!(
-                "{}: cannot write: {}",
-                out.display(),
-                facet_fit::io::input::io_problem(&e)
-            )
-        })?;
+    facet_fit::io::output::write_bytes_atomically(&out, &exported.text).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot write: {}",
+            out.display(),
+            facet_fit::io::input::io_problem(&e)
+        )
+    })?;
     println!("{}", exported.report.summary());
     println!("wrote {}", out.display());
     Ok(ExitCode::SUCCESS)

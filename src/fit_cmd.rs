@@ -420,9 +420,7 @@ fn write_tables(fit: &FittedMaterial, path: &Path) -> Result<()> {
             f[2]
         );
     }
-    let tmp = path.with_extension("csv.partial");
-    std::fs::write(&tmp, s)
-        .and_then(|_| std::fs::rename(&tmp, path))
+    facet_fit::io::output::write_bytes_atomically(path, s)
         .with_context(|| format!("writing {}", path.display()))
 }
 

@@ -128,8 +128,9 @@ fn encode_srgb(v: f32) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
-/// Writes through a temporary file beside `path` and renames it, so a failed write never leaves
-/// a truncated file where a good one was.
+/// Writes through a temporary file beside `path` and renames it
+/// ([`facet_fit::io::output::write_atomically`]), so a failed write never leaves a truncated
+/// file where a good one was; creates the folder first.
 fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
@@ -138,21 +139,12 @@ fn write_atomically(
         path: path.to_owned(),
         message,
     };
+    if path.file_name().is_none() {
+        return Err(err("not a file name".into()));
+    }
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
     }
-    let name = path
-        .file_name()
-        .ok_or_else(|| err("not a file name".into()))?
-        .to_string_lossy();
-    let ext = path.extension().map(|e| e.to_string_lossy().to_string());
-    let tmp = path.with_file_name(format!(
-        ".{name}.tmp{}",
-        ext.map_or(String::new(), |e| format!(".{e}"))
-    ));
-    write(&tmp).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        err(e)
-    })?;
-    std::fs::rename(&tmp, path).map_err(|e| err(e.to_string()))
+    facet_fit::io::output::write_atomically(path, |tmp| write(tmp).map_err(std::io::Error::other))
+        .map_err(|e| err(e.to_string()))
 }

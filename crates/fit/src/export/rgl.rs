@@ -7,10 +7,11 @@ use crate::error::FitError;
 use crate::model::brdf::Brdf;
 use crate::model::microfacet::Ndf;
 use crate::model::rgb::Rgb;
+use crate::model::rgb::luminance;
 use crate::sources::rgl::RglBsdf;
 use crate::sources::rgl::tensor_file::TensorWriter;
 use crate::sources::rgl::warp2d::Warp2D;
-use crate::sources::rgl::{luminance, phi2u, theta2u, u2phi, u2theta};
+use crate::sources::rgl::{phi2u, theta2u, u2phi, u2theta};
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::path::Path;
 
@@ -273,13 +274,7 @@ pub fn write_rgl(
         }
     }
     let (bytes, written) = best.expect("at least one sample space");
-    let tmp = path.with_extension("bsdf.partial");
-    std::fs::write(&tmp, &bytes)
-        .and_then(|_| std::fs::rename(&tmp, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            FitError::io(path, e)
-        })?;
+    crate::io::output::write_bytes_atomically(path, &bytes).map_err(|e| FitError::io(path, e))?;
     Ok(written)
 }
 

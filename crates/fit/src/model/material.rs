@@ -278,13 +278,7 @@ impl FittedMaterial {
     pub fn save(&self, path: &Path) -> Result<(), FitError> {
         let text =
             serde_json::to_string_pretty(&self.record).expect("a fit record always serialises");
-        let tmp = path.with_extension("json.partial");
-        std::fs::write(&tmp, text)
-            .and_then(|_| std::fs::rename(&tmp, path))
-            .map_err(|e| {
-                let _ = std::fs::remove_file(&tmp);
-                FitError::io(path, e)
-            })
+        crate::io::output::write_bytes_atomically(path, text).map_err(|e| FitError::io(path, e))
     }
 
     /// One of the fitted models, if it was fitted.

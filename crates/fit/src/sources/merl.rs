@@ -177,20 +177,15 @@ impl MerlTable {
     /// Writes the table as a MERL file. The file is written beside its destination and renamed
     /// into place, so a failed write never leaves a half-written file.
     pub fn write(&self, path: &Path) -> Result<(), FitError> {
-        let tmp = path.with_extension("binary.partial");
-        let result = (|| {
-            let mut file = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        crate::io::output::write_atomically(path, |tmp| {
+            let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
             for d in [THETA_H_RES, THETA_D_RES, PHI_D_RES] {
                 file.write_all(&(d as i32).to_le_bytes())?;
             }
             file.write_all(bytemuck::cast_slice(self.raw.values()))?;
-            file.into_inner().map_err(|e| e.into_error())?.sync_all()?;
-            std::fs::rename(&tmp, path)
-        })();
-        result.map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            FitError::io(path, e)
+            file.into_inner().map_err(|e| e.into_error())?.sync_all()
         })
+        .map_err(|e| FitError::io(path, e))
     }
 }
 

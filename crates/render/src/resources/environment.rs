@@ -1,12 +1,12 @@
 //! The environment on the GPU: its kind and colour in the frame uniform, a map's texels and
 //! sampling CDFs in the tables, and its entry among the lights.
 
-use super::lights::{LightSet, Probe, lum};
+use super::lights::{LightSet, Probe};
 use super::tables::Tables;
 use crate::error::RenderError;
 use crate::gpu_types::{GpuLight, LightKind};
 use crate::limits::{DeviceLimits, Planned};
-use crate::scene::environment::uv_to_direction;
+use crate::scene::environment::{luminance, uv_to_direction};
 use crate::scene::{Environment, EnvironmentMap};
 use crate::tags::EnvKind;
 use glam::Vec2;
@@ -38,7 +38,7 @@ fn map_irradiance(map: &EnvironmentMap, probes: &[Probe]) -> f32 {
             let mut l = 0.0;
             for y in y0..y1 {
                 for x in x0..x1 {
-                    l += lum(map.texels[y * w + x]);
+                    l += luminance(map.texels[y * w + x]);
                 }
             }
             l /= ((y1 - y0) * (x1 - x0)).max(1) as f32;
@@ -95,7 +95,7 @@ pub fn place(
             // (cosine or visible normals) at finding a uniform sky: it gets only the robust
             // selection's uniform share. (MIS compensation, Karlík et al. 2019: what light
             // sampling adds is the part of L above its mean, nothing for a constant.)
-            lights.push(light, flux(lum(*c)), 0.0);
+            lights.push(light, flux(luminance(*c)), 0.0);
         }
         Some(Environment::Map(map)) => {
             rec.kind = EnvKind::Map;
@@ -112,8 +112,8 @@ pub fn place(
             let marginal = tables.push(&source, map.marginal_cdf.iter().copied());
             let conditional = tables.push(&source, map.conditional_cdf.iter().copied());
             rec.offsets = (texels, marginal, conditional);
-            let mean =
-                map.texels.iter().map(|t| lum(*t)).sum::<f32>() / map.texels.len().max(1) as f32;
+            let mean = map.texels.iter().map(|t| luminance(*t)).sum::<f32>()
+                / map.texels.len().max(1) as f32;
             let contribution = map_irradiance(map, &lights.probes);
             lights.push(light, flux(mean), contribution);
         }

@@ -20,10 +20,7 @@ use crate::scene::{Light, Scene};
 use glam::Vec3;
 use std::f32::consts::PI;
 
-/// Luminance of linear Rec. 709 RGB.
-pub fn lum(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
+use crate::scene::environment::luminance;
 
 /// How next-event estimation picks a light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -132,7 +129,7 @@ impl LightSet {
                 Light::Point {
                     position,
                     intensity,
-                } => lum(intensity) * mean_over(position, &|l, d2, n| n.dot(l).max(0.0) / d2),
+                } => luminance(intensity) * mean_over(position, &|l, d2, n| n.dot(l).max(0.0) / d2),
                 Light::Spot {
                     position,
                     direction,
@@ -147,7 +144,7 @@ impl LightSet {
                         let t = ((-l).dot(direction) - co) / (ci - co).max(1e-4);
                         t.clamp(0.0, 1.0).powi(2)
                     };
-                    lum(intensity)
+                    luminance(intensity)
                         * mean_over(position, &|l, d2, n| falloff(l) * n.dot(l).max(0.0) / d2)
                 }
                 Light::Directional {
@@ -155,7 +152,7 @@ impl LightSet {
                     irradiance,
                 } => {
                     let l = -direction.normalize_or_zero();
-                    lum(irradiance) * probes.iter().map(|q| q.n.dot(l).max(0.0)).sum::<f32>()
+                    luminance(irradiance) * probes.iter().map(|q| q.n.dot(l).max(0.0)).sum::<f32>()
                         / probes.len().max(1) as f32
                 }
             };
@@ -170,7 +167,7 @@ impl LightSet {
                         intensity: intensity.extend(0.0).to_array(),
                         ..Default::default()
                     },
-                    4.0 * PI * lum(intensity),
+                    4.0 * PI * luminance(intensity),
                 ),
                 Light::Spot {
                     position,
@@ -188,7 +185,7 @@ impl LightSet {
                         intensity: intensity.extend(0.0).to_array(),
                         ..Default::default()
                     },
-                    2.0 * PI * (1.0 - outer_cone.cos()) * lum(intensity),
+                    2.0 * PI * (1.0 - outer_cone.cos()) * luminance(intensity),
                 ),
                 Light::Directional {
                     direction,
@@ -200,7 +197,7 @@ impl LightSet {
                         intensity: irradiance.extend(0.0).to_array(),
                         ..Default::default()
                     },
-                    PI * radius * radius * lum(irradiance),
+                    PI * radius * radius * luminance(irradiance),
                 ),
             };
             set.push(g, p, contribution);
@@ -208,7 +205,7 @@ impl LightSet {
         for (ti, tri) in scene.indices.iter().enumerate() {
             let m = &materials[scene.triangle_material[ti] as usize];
             let le = Vec3::from_slice(&m.emissive[..3]);
-            if lum(le) <= 0.0 {
+            if luminance(le) <= 0.0 {
                 continue;
             }
             let [a, b, c] = tri.map(|i| scene.positions[i as usize]);
@@ -217,7 +214,7 @@ impl LightSet {
             let normal = cross.normalize_or_zero();
             let centre = (a + b + c) / 3.0;
             // One-sided: Le A cos θl cos θ / d² toward the probes in front.
-            let contribution = lum(le)
+            let contribution = luminance(le)
                 * area
                 * mean_over(centre, &|l, d2, n| {
                     normal.dot(-l).max(0.0) * n.dot(l).max(0.0) / d2
@@ -233,7 +230,7 @@ impl LightSet {
             };
             // Flux of a Lambertian emitter: π A Le.
             set.lights.push(light);
-            set.power.push(PI * area * lum(le));
+            set.power.push(PI * area * luminance(le));
             set.contribution.push(contribution);
         }
         if set.triangle_light.is_empty() {

@@ -85,9 +85,11 @@ fn check_env_size(width: u64, height: u64) -> Result<(), String> {
     Ok(())
 }
 
-/// Rec. 709 luminance: 0.2126 R + 0.7152 G + 0.0722 B.
+/// Rec. 709 luminance ([`facet_fit::model::rgb::LUMINANCE`]) in f32.
 pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    c.dot(Vec3::from(
+        facet_fit::model::rgb::LUMINANCE.map(|w| w as f32),
+    ))
 }
 
 /// An equirectangular radiance map with its sampling distribution.

@@ -91,11 +91,6 @@ fn mulsign_neg(a: f64, b: f64) -> f64 {
     if b >= 0.0 { -a } else { a }
 }
 
-/// Rec.709 luminance.
-pub(crate) fn luminance(c: Rgb) -> f64 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
-}
-
 impl RglBsdf {
     /// Reads a `.bsdf` file.
     pub fn open(path: &Path) -> Result<Self, FitError> {
