@@ -515,3 +515,27 @@ fn average_per_theta_d(set: &GridSamples, ideal: impl Fn(&GridSample) -> f64 + S
         );
     fresnel_from_sums(&acc)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
+
+    /// A model's tables with a new F and ρd are the tables of the model with them: D and Λ
+    /// depend on the NDF alone, so keeping them is exact.
+    #[test]
+    fn a_grid_model_with_new_fresnel_has_the_tables_of_that_model() {
+        let ndf = Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Ggx, 0.3));
+        let m = GridModel::new(MicrofacetBrdf::ideal("m", ndf));
+        let f: Vec<Rgb> = (0..THETA_D_RES)
+            .map(|j| [0.5, 0.6, 0.01 * j as f64])
+            .collect();
+        let with = m.with_fresnel(&f, [0.1, 0.2, 0.3]);
+        let direct = IsoTables::new(&with.model).unwrap();
+        let kept = with.tables.as_ref().unwrap();
+        assert_eq!(kept.d32, direct.d32);
+        assert_eq!(kept.lambda_cos[..], direct.lambda_cos[..]);
+        assert_eq!(kept.fresnel, direct.fresnel);
+        assert_eq!(kept.diffuse, direct.diffuse);
+    }
+}

@@ -95,3 +95,51 @@ impl InputSpec {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_input_is_named_by_its_prefix_or_its_extension() {
+        let path = |s: &str| PathBuf::from(s);
+        assert_eq!(
+            InputSpec::parse("nbrdf:gold-paint"),
+            InputSpec::Nbrdf("gold-paint".into())
+        );
+        assert_eq!(
+            InputSpec::parse("analytic:ggx?alpha=0.2"),
+            InputSpec::Analytic("ggx?alpha=0.2".into())
+        );
+        assert_eq!(
+            InputSpec::parse("a/fit.json"),
+            InputSpec::Fit(path("a/fit.json"))
+        );
+        assert_eq!(
+            InputSpec::parse("FIT.JSON"),
+            InputSpec::Fit(path("FIT.JSON"))
+        );
+        assert_eq!(
+            InputSpec::parse("paint.bsdf"),
+            InputSpec::Rgl(path("paint.bsdf"))
+        );
+        assert_eq!(
+            InputSpec::parse("gold.binary"),
+            InputSpec::Merl(path("gold.binary"))
+        );
+        assert_eq!(
+            InputSpec::parse("no-extension"),
+            InputSpec::Merl(path("no-extension"))
+        );
+        // A prefix is a prefix only at the start; the files a run reads are the named ones.
+        assert_eq!(
+            InputSpec::parse("x/nbrdf:a"),
+            InputSpec::Merl(path("x/nbrdf:a"))
+        );
+        assert_eq!(InputSpec::parse("nbrdf:x").path(), None);
+        assert_eq!(
+            InputSpec::parse("m.binary").path(),
+            Some(Path::new("m.binary"))
+        );
+    }
+}
