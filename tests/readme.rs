@@ -85,5 +85,9 @@ fn readme_rust_blocks_are_tested_code() {
         }
         checked += blocks.len();
     }
-    assert!(checked >= 2, "{checked} rust blocks in {} files", files.len());
+    assert!(
+        checked >= 2,
+        "{checked} rust blocks in {} files",
+        files.len()
+    );
 }
