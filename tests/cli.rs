@@ -369,7 +369,8 @@ fn read_exr(path: &Path) -> (usize, usize, Vec<[f32; 3]>) {
     )
 }
 
-/// The README's tone map, written out here: 255 · sRGB(1 − exp(−2^e L)), before rounding.
+/// The tone map of docs/rendering.md (Output), written out here: 255 · sRGB(1 − exp(−2^e L)),
+/// before rounding.
 fn tone_map(l: f32, exposure: f64) -> f64 {
     let v = 1.0 - (-(exposure.exp2()) * (l.max(0.0) as f64)).exp();
     let s = if v <= 0.003_130_8 {

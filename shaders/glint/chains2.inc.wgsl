@@ -1,6 +1,6 @@
 // Include-only. The lit-count walk's width (glint/lit.inc.wgsl) where each query reads one
 // direction cell (select_cell): 2 queries. Half the stack entry of chains8.inc.wgsl's walk, the
-// same counts; on lavapipe the demo's glint stage takes 0.74× the time (README, Performance).
+// same counts; on lavapipe the demo's glint stage takes 0.74× the time (docs/log/glints.md).
 
 const CHAINS: u32 = 2u;
 

@@ -28,7 +28,7 @@ impl InputError {
     }
 }
 
-/// The largest file of each kind Facet reads; documented in the README.
+/// The largest file of each kind Facet reads; documented in docs/fitting.md.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Cap {
     /// What the file is, for the message ("fit JSON", "glTF buffer").

@@ -5,11 +5,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 /// How the N polar nodes of the extraction are placed.
 ///
-/// Measured on MERL files made from GGX and Beckmann (`tests/quadrature.rs`, table in the
-/// README): both rules in u = sqrt(θ/(π/2)) recover α 10–50× better than the paper's uniform θ
-/// nodes at N ≤ 64, because they put nodes where specular NDFs are peaked (small θ). Gauss–
-/// Legendre is best at N = 16; from N = 32 both sit on a ~0.3 % floor set by the MERL bins. It is
-/// the default.
+/// Measured on MERL files made from GGX and Beckmann (`tests/quadrature.rs`, table in
+/// docs/fitting.md): both rules in u = sqrt(θ/(π/2)) recover α 10–50× better than the paper's
+/// uniform θ nodes at N ≤ 64, because they put nodes where specular NDFs are peaked (small θ).
+/// Gauss–Legendre is best at N = 16; from N = 32 both sit on a ~0.3 % floor set by the MERL bins.
+/// It is the default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Quadrature {
