@@ -192,7 +192,7 @@ impl<'a, const N: usize, const M: usize, const P: usize> Refinement<'a, N, M, P>
     }
 }
 
-/// The weighted median of a [`crate::metric::iso::BinMedians`] histogram in ln s over
+/// The weighted median of a [`IsoSamples::bin_medians`] histogram in ln s over
 /// [−span, span], linear within its bucket; 0 for an empty bin.
 fn weighted_median(h: &[f64; MEDIAN_BUCKETS + 2], span: f64) -> f64 {
     let half = 0.5 * h.iter().sum::<f64>();
