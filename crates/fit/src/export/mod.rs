@@ -21,17 +21,21 @@
 //! The error comparison alone decides nothing: the conductor curve (η and k per channel)
 //! contains the dielectric one (k = 0), so its error is never much above the dielectric's, and
 //! a colourless table fits both alike.
+//!
+//! Each target's writer is in its own module: [`mitsuba`], `pbrt` and [`gltf`]; [`rgl`] writes
+//! a fit's model as an RGL `.bsdf` file.
 
+pub mod gltf;
+pub mod mitsuba;
+mod pbrt;
 pub mod rgl;
 
 use crate::error::FitError;
-use crate::model::fresnel::dielectric;
 use crate::model::fresnel_curves::{FitQuality, FresnelChoice, FresnelFits};
 use crate::model::material::{FitRecord, FittedMaterial, ParamRecord};
 use crate::model::microfacet::NdfKind;
 use crate::model::rgb::Rgb;
 use serde::Serialize;
-use serde_json::json;
 use std::path::Path;
 
 /// The mean Schlick F0 from which [`KindRequest::Auto`] exports a conductor.
@@ -250,6 +254,32 @@ struct Curve {
     quality: FitQuality,
 }
 
+impl Curve {
+    /// The curve the target's BSDF evaluates for `kind`.
+    fn of(target: Target, kind: Kind, fits: &FresnelFits) -> Self {
+        // The curve each target's BSDF evaluates: glTF's is always Schlick (a conductor's F0 is
+        // its base colour; a dielectric's F0 comes from `ior` and `KHR_materials_specular`).
+        let choice = match (target, kind) {
+            (Target::Gltf, _) => FresnelChoice::Schlick,
+            (_, Kind::Conductor) => FresnelChoice::Conductor,
+            (_, Kind::Plastic) => FresnelChoice::Dielectric,
+        };
+        let quality = match choice {
+            FresnelChoice::Conductor => fits.conductor,
+            FresnelChoice::Dielectric => fits.dielectric,
+            _ => fits.schlick,
+        };
+        Curve {
+            name: match choice {
+                FresnelChoice::Conductor => "conductor",
+                FresnelChoice::Dielectric => "dielectric",
+                _ => "schlick",
+            },
+            quality,
+        }
+    }
+}
+
 /// Writes the analytic model of `fit` for `options.target`; `path` names the fit in the
 /// statement and in errors (a fit without the asked model is an error naming it).
 pub fn export(
@@ -265,6 +295,44 @@ pub fn export(
     let target = options.target;
     let mut notes = Vec::new();
     let (fit_kind, p) = choose(r, options, &mut notes).map_err(bad)?;
+    let (fits, recorded) = fresnel_fits(r, p, &mut notes);
+    let kind = choose_kind(options.kind, p, &fits, recorded);
+    let curve = Curve::of(target, kind, &fits);
+    note_approximations(&mut notes, target, kind, p, &fits, recorded);
+    let mut report = Report {
+        target: target.name(),
+        source_fit: path.display().to_string(),
+        material: r.name.clone(),
+        fit_model: fit_kind.name(),
+        distribution: if target.has_beckmann() {
+            fit_kind.name()
+        } else {
+            "ggx"
+        },
+        kind,
+        alpha_x: p.alpha_x,
+        alpha_y: p.alpha_y,
+        rotation_deg: p.rotation.to_degrees(),
+        diffuse: p.diffuse,
+        fresnel: curve.name,
+        fresnel_error: known_error(recorded, curve.quality),
+        fresnel_rms: curve.quality.rms,
+        table_error: p.error,
+        fresnel_fits_recorded: recorded,
+        notes,
+    };
+    let id = crate::io::input::safe_file_stem(&r.name);
+    let text = match target {
+        Target::Mitsuba => mitsuba::write(&id, p, &fits, &mut report),
+        Target::Pbrt => pbrt::write(&id, p, &fits, &mut report),
+        Target::Gltf => gltf::write(&r.name, p, &fits, &mut report),
+    };
+    Ok(Exported { text, report })
+}
+
+/// The Fresnel fits recorded with `p`, or (said in `notes`) fitted here to its F table, and
+/// whether they were recorded.
+fn fresnel_fits(r: &FitRecord, p: &ParamRecord, notes: &mut Vec<String>) -> (FresnelFits, bool) {
     let (fits, recorded) = match &p.fresnel_fits {
         Some(f) => (f.clone(), true),
         None => (FresnelFits::of(&p.fresnel, |_| [f64::NAN; 3]), false),
@@ -276,41 +344,53 @@ pub fn export(
             "a single-lobe fit (facet fit's no-diffuse or aniso options): no Fresnel fits were recorded, they were fitted here to the model's F table, which also holds the light of any diffuse term (ρd = 0); their error in Facet's metric is unknown".into()
         });
     }
-    let mean_f0 = fits.schlick_f0.iter().sum::<f64>() / 3.0;
-    let known = |q: FitQuality| recorded.then_some(q.error).filter(|e| e.is_finite());
+    (fits, recorded)
+}
+
+/// A curve's error in Facet's metric where the fit recorded it (and it is finite).
+fn known_error(recorded: bool, q: FitQuality) -> Option<f64> {
+    recorded.then_some(q.error).filter(|e| e.is_finite())
+}
+
+/// The Schlick fit's F0, averaged over the channels.
+fn mean_f0(fits: &FresnelFits) -> f64 {
+    fits.schlick_f0.iter().sum::<f64>() / 3.0
+}
+
+/// Whether the conductor curve fits clearly better than the dielectric one
+/// ([`CONDUCTOR_MARGIN`]): by their recorded errors where both are known, else by their RMS
+/// distances to the table.
+fn conductor_fits_better(fits: &FresnelFits, recorded: bool) -> bool {
     let (c, d) = (fits.conductor, fits.dielectric);
-    let conductor_fits_better = match (known(c), known(d)) {
+    match (known_error(recorded, c), known_error(recorded, d)) {
         (Some(c), Some(d)) => c < CONDUCTOR_MARGIN * d,
         _ => c.rms < CONDUCTOR_MARGIN * d.rms,
-    };
+    }
+}
+
+/// The kind asked for, or [`KindRequest::Auto`]'s choice (the module's doc gives the rule).
+fn choose_kind(request: KindRequest, p: &ParamRecord, fits: &FresnelFits, recorded: bool) -> Kind {
     let no_diffuse = p.diffuse.iter().all(|&a| a <= CONDUCTOR_MAX_ALBEDO);
-    let kind = match options.kind {
+    match request {
         KindRequest::Conductor => Kind::Conductor,
         KindRequest::Plastic => Kind::Plastic,
-        KindRequest::Auto if mean_f0 >= CONDUCTOR_MIN_F0 => Kind::Conductor,
-        KindRequest::Auto if no_diffuse && conductor_fits_better => Kind::Conductor,
+        KindRequest::Auto if mean_f0(fits) >= CONDUCTOR_MIN_F0 => Kind::Conductor,
+        KindRequest::Auto if no_diffuse && conductor_fits_better(fits, recorded) => Kind::Conductor,
         KindRequest::Auto => Kind::Plastic,
-    };
-    let quality = |c: FresnelChoice| match c {
-        FresnelChoice::Conductor => fits.conductor,
-        FresnelChoice::Dielectric => fits.dielectric,
-        _ => fits.schlick,
-    };
-    // The curve each target's BSDF evaluates: glTF's is always Schlick (a conductor's F0 is
-    // its base colour; a dielectric's F0 comes from `ior` and `KHR_materials_specular`).
-    let choice = match (target, kind) {
-        (Target::Gltf, _) => FresnelChoice::Schlick,
-        (_, Kind::Conductor) => FresnelChoice::Conductor,
-        (_, Kind::Plastic) => FresnelChoice::Dielectric,
-    };
-    let curve = Curve {
-        name: match choice {
-            FresnelChoice::Conductor => "conductor",
-            FresnelChoice::Dielectric => "dielectric",
-            _ => "schlick",
-        },
-        quality: quality(choice),
-    };
+    }
+}
+
+/// What every writer of `target` leaves out, added to `notes`: ρd under a conductor, the
+/// conductor's coloured Fresnel under a plastic, a dielectric η whose F0 is not the table's,
+/// rotated α axes, and the target's Smith G.
+fn note_approximations(
+    notes: &mut Vec<String>,
+    target: Target,
+    kind: Kind,
+    p: &ParamRecord,
+    fits: &FresnelFits,
+    recorded: bool,
+) {
     let (ax, ay, rot) = (p.alpha_x, p.alpha_y, p.rotation);
     let max_kd = p.diffuse.iter().cloned().fold(0.0, f64::max);
     if kind == Kind::Conductor && max_kd > 0.0 {
@@ -319,17 +399,18 @@ pub fn export(
             p.diffuse
         ));
     }
-    if kind == Kind::Plastic && conductor_fits_better {
+    let c = fits.conductor;
+    if kind == Kind::Plastic && conductor_fits_better(fits, recorded) {
         notes.push(format!(
             "a dielectric's Fresnel is one colourless curve: the conductor fit (η {:?}, k {:?}) is closer (error {}, RMS {:.2e}); exported with the conductor kind it is kept, without ρd",
             fits.conductor_eta,
             fits.conductor_k,
-            fmt_error(known(c)),
+            fmt_error(known_error(recorded, c)),
             c.rms
         ));
     }
     if kind == Kind::Plastic && target != Target::Gltf {
-        let (f0_eta, f0) = (dielectric_f0(fits.dielectric_eta), mean_f0);
+        let (f0_eta, f0) = (dielectric_f0(fits.dielectric_eta), mean_f0(fits));
         if (f0_eta / f0 - 1.0).abs() > 0.05 {
             notes.push(format!(
                 "the dielectric fit's η {} has F0 {f0_eta:.4}, the table's (Schlick fit's) F0 is {f0:.4}: one exact dielectric curve cannot follow this table at both normal and grazing incidence; η {:.4} would match F0 (its error in Facet's metric is not recorded)",
@@ -357,35 +438,6 @@ pub fn export(
         }
     };
     notes.push(g_note.into());
-    let mut report = Report {
-        target: target.name(),
-        source_fit: path.display().to_string(),
-        material: r.name.clone(),
-        fit_model: fit_kind.name(),
-        distribution: if target.has_beckmann() {
-            fit_kind.name()
-        } else {
-            "ggx"
-        },
-        kind,
-        alpha_x: ax,
-        alpha_y: ay,
-        rotation_deg: rot.to_degrees(),
-        diffuse: p.diffuse,
-        fresnel: curve.name,
-        fresnel_error: known(curve.quality),
-        fresnel_rms: curve.quality.rms,
-        table_error: p.error,
-        fresnel_fits_recorded: recorded,
-        notes,
-    };
-    let id = crate::io::input::safe_file_stem(&r.name);
-    let text = match target {
-        Target::Mitsuba => mitsuba(&id, p, &fits, &mut report),
-        Target::Pbrt => pbrt(&id, p, &fits, &mut report),
-        Target::Gltf => gltf(&r.name, p, &fits, &mut report),
-    };
-    Ok(Exported { text, report })
 }
 
 fn fmt_error(e: Option<f64>) -> String {
@@ -481,25 +533,6 @@ pub fn schlick_ior(f0: f64) -> f64 {
     (1.0 + r) / (1.0 - r)
 }
 
-/// The hemispherical (cosine-weighted) reflectance of a smooth dielectric of index η seen from
-/// outside, 2 ∫ F(μ) μ dμ (midpoint rule, 1024 steps).
-fn hemispherical_reflectance(eta: f64) -> f64 {
-    const N: usize = 1024;
-    (0..N)
-        .map(|i| {
-            let mu = (i as f64 + 0.5) / N as f64;
-            2.0 * dielectric(mu, eta) * mu / N as f64
-        })
-        .sum()
-}
-
-/// The ratio of Mitsuba's `roughplastic` diffuse term at normal incidence to ρd/π, for a smooth
-/// interface: t(0)² / (η² (1 − R_int)) with 1 − R_int = (1 − R_ext)/η², i.e. t(0)² / (1 − R_ext).
-pub fn plastic_diffuse_ratio(eta: f64) -> f64 {
-    let t0 = 1.0 - dielectric_f0(eta);
-    t0 * t0 / (1.0 - hemispherical_reflectance(eta))
-}
-
 /// A number list: `a, b, c` (Mitsuba) or `a b c` (pbrt), in the shortest form that reads back
 /// to the same f64.
 fn list(v: &[f64], sep: &str) -> String {
@@ -509,271 +542,10 @@ fn list(v: &[f64], sep: &str) -> String {
         .join(sep)
 }
 
-/// Text safe inside an XML comment: no `--`, no stray control characters.
-fn xml_comment(s: &str) -> String {
-    let mut out: String = s
-        .chars()
-        .map(|c| if c.is_control() { ' ' } else { c })
-        .collect();
-    while out.contains("--") {
-        out = out.replace("--", "- -");
-    }
-    if out.ends_with('-') {
-        out.push(' ');
-    }
-    out
-}
-
-/// Text safe inside an XML attribute value.
-fn xml_attr(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
-/// The least `int_ior` written for Mitsuba (which refuses an interface of index 1).
-const MITSUBA_MIN_IOR: f64 = 1.0001;
-
-fn mitsuba(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
-    let dist = report.distribution;
-    let mut body = vec![format!(
-        r#"    <string name="distribution" value="{dist}"/>"#
-    )];
-    let kind = report.kind;
-    let (ax, ay) = (p.alpha_x, p.alpha_y);
-    let bsdf = match kind {
-        Kind::Conductor => {
-            if ax == ay {
-                body.push(format!(r#"    <float name="alpha" value="{ax}"/>"#));
-            } else {
-                body.push(format!(r#"    <float name="alpha_u" value="{ax}"/>"#));
-                body.push(format!(r#"    <float name="alpha_v" value="{ay}"/>"#));
-            }
-            body.push(format!(
-                r#"    <rgb name="eta" value="{}"/>"#,
-                list(&fits.conductor_eta, ", ")
-            ));
-            body.push(format!(
-                r#"    <rgb name="k" value="{}"/>"#,
-                list(&fits.conductor_k, ", ")
-            ));
-            "roughconductor"
-        }
-        Kind::Plastic => {
-            let alpha = if ax == ay {
-                ax
-            } else {
-                let a = (ax * ay).sqrt();
-                report.notes.push(format!(
-                    "Mitsuba's roughplastic is isotropic: α = √(αx αy) = {a} (the same peak D(0) = 1/(π αx αy)) in place of αx {ax}, αy {ay}"
-                ));
-                a
-            };
-            // Mitsuba refuses int_ior = ext_ior; the dielectric fit's η lies in [1, 4].
-            let eta = fits.dielectric_eta.max(MITSUBA_MIN_IOR);
-            if eta != fits.dielectric_eta {
-                report.notes.push(format!(
-                    "roughplastic needs int_ior ≠ ext_ior: the dielectric fit's η {} is written as {eta}",
-                    fits.dielectric_eta
-                ));
-            }
-            report.notes.push(format!(
-                "roughplastic's diffuse term is ρ t(θi) t(θo) / (π η² (1 − R_int)) (internal scattering under the interface, nonlinear = false), not ρd/π: with ρ = ρd it is about {:.3} × ρd/π at normal incidence (smooth-interface estimate) and falls to 0 at grazing",
-                plastic_diffuse_ratio(eta)
-            ));
-            body.push(format!(r#"    <float name="alpha" value="{alpha}"/>"#));
-            body.push(format!(r#"    <float name="int_ior" value="{eta}"/>"#));
-            body.push(r#"    <float name="ext_ior" value="1"/>"#.into());
-            body.push(format!(
-                r#"    <rgb name="diffuse_reflectance" value="{}"/>"#,
-                list(&p.diffuse, ", ")
-            ));
-            body.push(r#"    <boolean name="nonlinear" value="false"/>"#.into());
-            "roughplastic"
-        }
-    };
-    let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
-    for line in report.lines() {
-        s += &format!("  {}\n", xml_comment(&line));
-    }
-    s += "-->\n";
-    s += &format!(
-        "<bsdf type=\"{bsdf}\" id=\"{}\" version=\"3.0.0\">\n",
-        xml_attr(id)
-    );
-    for b in body {
-        s += &b;
-        s.push('\n');
-    }
-    s += "</bsdf>\n";
-    s
-}
-
-fn pbrt(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
-    let (ax, ay) = (p.alpha_x, p.alpha_y);
-    let mut params = Vec::new();
-    let kind = report.kind;
-    let ty = match kind {
-        Kind::Conductor => {
-            params.push(format!(
-                "\"rgb eta\" [ {} ]",
-                list(&fits.conductor_eta, " ")
-            ));
-            params.push(format!("\"rgb k\" [ {} ]", list(&fits.conductor_k, " ")));
-            "conductor"
-        }
-        Kind::Plastic => {
-            params.push(format!("\"rgb reflectance\" [ {} ]", list(&p.diffuse, " ")));
-            params.push(format!("\"float eta\" [ {} ]", fits.dielectric_eta));
-            report.notes.push(
-                "coateddiffuse is a layered BSDF evaluated stochastically (a Lambertian base of reflectance ρd under a rough dielectric interface of η, thickness 0.01, no medium): its diffuse light passes the interface twice and scatters between the layers, so it is not ρd/π".into(),
-            );
-            "coateddiffuse"
-        }
-    };
-    params.push(format!("\"float uroughness\" [ {ax} ]"));
-    params.push(format!("\"float vroughness\" [ {ay} ]"));
-    params.push("\"bool remaproughness\" [ false ]".into());
-    let mut s = String::new();
-    for line in report.lines() {
-        s += &format!("# {}\n", line.replace(['\n', '\r'], " "));
-    }
-    // A name in a pbrt string cannot hold a double quote; `id` is a safe file stem.
-    s += &format!("MakeNamedMaterial \"{id}\"\n    \"string type\" [ \"{ty}\" ]\n");
-    for p in params {
-        s += &format!("    {p}\n");
-    }
-    s
-}
-
-fn gltf(name: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut Report) -> String {
-    let (ax, ay) = (p.alpha_x, p.alpha_y);
-    let (amin, amax) = (ax.min(ay), ax.max(ay));
-    let roughness = alpha_to_roughness(amin);
-    if amin > 1.0 {
-        report.notes.push(format!(
-            "glTF's roughness is at most 1 (α = 1): α {amin} is clamped"
-        ));
-    }
-    let mut extensions = serde_json::Map::new();
-    if amax != amin {
-        let (strength, rotation) = anisotropy(ax, ay, p.rotation);
-        if amax > 1.0 {
-            report.notes.push(format!(
-                "KHR_materials_anisotropy's strength is at most 1 (α = 1 along the stretched axis): α {amax} is clamped"
-            ));
-        }
-        extensions.insert(
-            "KHR_materials_anisotropy".into(),
-            json!({ "anisotropyStrength": strength, "anisotropyRotation": rotation }),
-        );
-        report.notes.push(
-            "KHR_materials_anisotropy needs TANGENT vectors on the mesh: its rotation is from the tangent, like the fit's".into(),
-        );
-    }
-    let kind = report.kind;
-    let (base, metallic) = match kind {
-        Kind::Conductor => {
-            report.notes.push(format!(
-                "glTF's metal Fresnel is Schlick's with F0 = baseColorFactor and F(90°) = 1: the Schlick fit stands in for the conductor's η {:?}, k {:?} (the conductor fit's error {})",
-                fits.conductor_eta,
-                fits.conductor_k,
-                fmt_error(report.fresnel_fits_recorded.then_some(fits.conductor.error))
-            ));
-            (fits.schlick_f0.map(|f| f.clamp(0.0, 1.0)), 1.0)
-        }
-        Kind::Plastic => {
-            // glTF's dielectric Fresnel is Schlick's with F0 = ((ior − 1)/(ior + 1))² ×
-            // specularColorFactor: ior from the Schlick fit's mean F0, the colour (if any) as
-            // the factor, is the Schlick fit exactly.
-            let f0 = fits.schlick_f0.iter().sum::<f64>() / 3.0;
-            let eta = schlick_ior(f0);
-            extensions.insert("KHR_materials_ior".into(), json!({ "ior": eta }));
-            let color = fits.schlick_f0.map(|s| if f0 > 0.0 { s / f0 } else { 1.0 });
-            if color.iter().any(|c| (c - 1.0).abs() > 1e-3) {
-                extensions.insert(
-                    "KHR_materials_specular".into(),
-                    json!({ "specularColorFactor": color }),
-                );
-            }
-            if (eta / fits.dielectric_eta - 1.0).abs() > 1e-3 {
-                report.notes.push(format!(
-                    "ior {eta} is the Schlick fit's (glTF's Fresnel is Schlick's), not the dielectric fit's η {} (error {})",
-                    fits.dielectric_eta,
-                    fmt_error(report.fresnel_fits_recorded.then_some(fits.dielectric.error))
-                ));
-            }
-            report.notes.push(
-                "glTF's dielectric diffuse is ρd/π weighted by 1 − F (Schlick) of the specular layer, not ρd/π beside it".into(),
-            );
-            (p.diffuse, 0.0)
-        }
-    };
-    let mut used: Vec<&String> = extensions.keys().collect();
-    used.sort();
-    let mut material = json!({
-        "name": name,
-        "pbrMetallicRoughness": {
-            "baseColorFactor": [base[0], base[1], base[2], 1.0],
-            "metallicFactor": metallic,
-            "roughnessFactor": roughness,
-        },
-        "extras": { "facet_export": report, "statement": report.lines() },
-    });
-    if !extensions.is_empty() {
-        material["extensions"] = serde_json::Value::Object(extensions.clone());
-    }
-    let mut doc = json!({
-        "asset": {
-            "version": "2.0",
-            "generator": "facet export",
-            "extras": { "summary": report.summary() },
-        },
-        "materials": [material],
-    });
-    if !used.is_empty() {
-        doc["extensionsUsed"] = json!(used);
-    }
-    let mut s = serde_json::to_string_pretty(&doc).expect("a JSON value always serialises");
-    s.push('\n');
-    s
-}
-
-/// glTF's roughness of α (α = roughness²), at most 1.
-pub fn alpha_to_roughness(alpha: f64) -> f64 {
-    alpha.sqrt().min(1.0)
-}
-
-/// `KHR_materials_anisotropy` of (αx, αy, rotation): glTF keeps α = roughness² across the
-/// stretched direction and raises it along it, α_t = mix(α, 1, strength²), so with the
-/// material's roughness √min(αx, αy), strength = √((α_max − α_min)/(1 − α_min)) (at most 1) and
-/// the rotation is the fit's, plus 90° when αy is the larger.
-pub fn anisotropy(alpha_x: f64, alpha_y: f64, rotation: f64) -> (f64, f64) {
-    let (amin, amax) = (alpha_x.min(alpha_y).min(1.0), alpha_x.max(alpha_y).min(1.0));
-    let strength = if amin < 1.0 {
-        ((amax - amin) / (1.0 - amin)).sqrt().min(1.0)
-    } else {
-        0.0
-    };
-    let rotation = if alpha_y > alpha_x {
-        rotation + std::f64::consts::FRAC_PI_2
-    } else {
-        rotation
-    };
-    (strength, rotation)
-}
-
-/// (αx along the anisotropy direction, α across it) of glTF's roughness and strength: the
-/// inverse of [`anisotropy`] with [`alpha_to_roughness`].
-pub fn gltf_alphas(roughness: f64, strength: f64) -> (f64, f64) {
-    let a = roughness * roughness;
-    (a + (1.0 - a) * strength * strength, a)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::export::gltf::gltf_alphas;
     use crate::model::fresnel::{Fresnel, FresnelTable};
     use crate::model::material::{Params, TabulatedRecord};
 
@@ -787,7 +559,14 @@ mod tests {
 
     /// A parameter record of α, a Fresnel curve and ρd, with fits recorded (errors made up,
     /// distinct so that a test can tell them apart) or not.
-    fn param(ax: f64, ay: f64, rot: f64, f: &Fresnel, kd: Rgb, recorded: bool) -> ParamRecord {
+    pub(super) fn param(
+        ax: f64,
+        ay: f64,
+        rot: f64,
+        f: &Fresnel,
+        kd: Rgb,
+        recorded: bool,
+    ) -> ParamRecord {
         let table = table_of(f);
         let fits = recorded.then(|| {
             let mut fits = FresnelFits::of(&table, |_| [0.0; 3]);
@@ -854,11 +633,18 @@ mod tests {
         }
     }
 
-    fn material(ggx: Option<ParamRecord>, beckmann: Option<ParamRecord>) -> FittedMaterial {
+    pub(super) fn material(
+        ggx: Option<ParamRecord>,
+        beckmann: Option<ParamRecord>,
+    ) -> FittedMaterial {
         FittedMaterial::from_record(record(ggx, beckmann)).unwrap()
     }
 
-    fn run(m: &FittedMaterial, target: Target, model: ModelRequest) -> Result<Exported, FitError> {
+    pub(super) fn run(
+        m: &FittedMaterial,
+        target: Target,
+        model: ModelRequest,
+    ) -> Result<Exported, FitError> {
         export(
             m,
             Path::new("fits/test.json"),
@@ -868,33 +654,6 @@ mod tests {
                 kind: KindRequest::Auto,
             },
         )
-    }
-
-    /// glTF's roughness is √α exactly, and the anisotropy mapping inverted gives αx, αy back.
-    #[test]
-    fn roughness_and_anisotropy_invert() {
-        for a in [1e-4, 0.01, 0.2, 0.5, 1.0] {
-            // √α correctly rounded (IEEE sqrt), so roughness² is α to the last bit or two.
-            assert_eq!(alpha_to_roughness(a), a.sqrt());
-            assert!((alpha_to_roughness(a).powi(2) / a - 1.0).abs() < 4.0 * f64::EPSILON);
-        }
-        for (ax, ay, rot) in [(0.3, 0.1, 0.4), (0.05, 0.6, -1.0), (0.2, 0.2001, 0.0)] {
-            let (s, r) = anisotropy(ax, ay, rot);
-            let (along, across) = gltf_alphas(alpha_to_roughness(f64::min(ax, ay)), s);
-            assert!(
-                (along - f64::max(ax, ay)).abs() < 1e-12,
-                "{ax} {ay}: {along}"
-            );
-            assert!((across - f64::min(ax, ay)).abs() < 1e-12);
-            // The stretched direction is the fit's x axis, or its y axis (90° on) when αy is
-            // the larger.
-            let want = if ay > ax {
-                rot + std::f64::consts::FRAC_PI_2
-            } else {
-                rot
-            };
-            assert_eq!(r, want);
-        }
     }
 
     /// A GGX gold fit exports the fit's conductor η and k exactly, α as is, the conductor's
@@ -1090,38 +849,6 @@ mod tests {
         assert!(x.text.contains(&format!("{}", fits.conductor_eta[0])));
     }
 
-    /// A coloured Schlick F0 on a plastic: glTF's ior × specularColorFactor gives it back.
-    #[test]
-    fn coloured_f0_goes_to_khr_materials_specular() {
-        let f0 = [0.02, 0.04, 0.06];
-        let m = material(
-            Some(param(
-                0.2,
-                0.2,
-                0.0,
-                &Fresnel::Schlick { f0 },
-                [0.2; 3],
-                true,
-            )),
-            None,
-        );
-        let g = run(&m, Target::Gltf, ModelRequest::Ggx).unwrap();
-        let v: serde_json::Value = serde_json::from_str(&g.text).unwrap();
-        let ext = &v["materials"][0]["extensions"];
-        let ior = ext["KHR_materials_ior"]["ior"].as_f64().unwrap();
-        let color = &ext["KHR_materials_specular"]["specularColorFactor"];
-        for c in 0..3 {
-            let got = dielectric_f0(ior) * color[c].as_f64().unwrap();
-            assert!((got - f0[c]).abs() < 1e-9, "{c}: {got}");
-        }
-        assert!(
-            v["extensionsUsed"]
-                .as_array()
-                .unwrap()
-                .contains(&"KHR_materials_specular".into())
-        );
-    }
-
     /// The automatic kind: F0 ≥ 0.2 is a conductor whatever ρd; below, a conductor only with
     /// no diffuse lobe and a conductor curve clearly better than the dielectric.
     #[test]
@@ -1155,14 +882,5 @@ mod tests {
         };
         assert_eq!(kind(&paint, [0.0; 3], false).kind, Kind::Conductor);
         assert_eq!(kind(&paint, [0.05; 3], false).kind, Kind::Plastic);
-    }
-
-    /// A plastic's diffuse in Mitsuba at η = 1.5 is within a few percent of ρd/π at normal
-    /// incidence; the estimate is exactly 1 at η = 1 (no interface).
-    #[test]
-    fn plastic_diffuse_ratio_is_near_one() {
-        assert!((plastic_diffuse_ratio(1.0) - 1.0).abs() < 1e-12);
-        let r = plastic_diffuse_ratio(1.5);
-        assert!(r > 1.0 && r < 1.05, "{r}");
     }
 }

@@ -19,7 +19,7 @@
 //! start's.
 
 use crate::extract::azimuthal_ab;
-use crate::metric::iso_grid::{IsoSamples, MEDIAN_BUCKETS, RowIdeals, RowSums};
+use crate::metric::iso::{IsoSamples, MEDIAN_BUCKETS, RowIdeals, RowSums};
 use crate::metric::iso_tables::IsoTables;
 use crate::model::merl_grid::{THETA_H_RES, bin_angles};
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf};
@@ -192,7 +192,7 @@ impl<'a, const N: usize, const M: usize, const P: usize> Refinement<'a, N, M, P>
     }
 }
 
-/// The weighted median of a [`crate::metric::iso_grid::BinMedians`] histogram in ln s over
+/// The weighted median of a [`IsoSamples::bin_medians`] histogram in ln s over
 /// [−span, span], linear within its bucket; 0 for an empty bin.
 fn weighted_median(h: &[f64; MEDIAN_BUCKETS + 2], span: f64) -> f64 {
     let half = 0.5 * h.iter().sum::<f64>();

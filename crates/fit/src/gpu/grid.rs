@@ -1,9 +1,9 @@
 //! The isotropic MERL grid on the GPU (`shaders/fit/grid.inc.wgsl`) as the CPU passes hold it
-//! (`merl_geometry.rs`, `iso_grid.rs`): its geometry uploaded once per fitter, a source's
+//! (`merl_geometry.rs`, `iso/`): its geometry uploaded once per fitter, a source's
 //! ln(1 + x) and validity flags once per source, read in place by the passes over the grid.
 
 use crate::metric::grid::GridSamples;
-use crate::metric::iso_grid::PADDED;
+use crate::metric::iso::PADDED;
 use crate::metric::iso_tables::IsoTables;
 use crate::metric::merl_geometry::{ROW, ROWS, merl_geometry};
 use crate::model::merl_grid::THETA_D_RES;

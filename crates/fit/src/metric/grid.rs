@@ -2,12 +2,12 @@
 //!
 //! The Fresnel average and the error metric both run over every valid sample of a source on
 //! the MERL grid (bin lower edges, both directions above the horizon, the sample present).
-//! Isotropic sources are held in a compact row form (`iso_grid.rs`), and isotropic
+//! Isotropic sources are held in a compact row form (`iso/`), and isotropic
 //! microfacet models take a fast path there: D depends only on the θh bin, F only on the θd
 //! bin and Λ only on cos θ, so each is a small table; `tests/models.rs` checks it against the
 //! direct evaluation.
 
-use crate::metric::iso_grid::{CoarseSamples, IsoSamples};
+use crate::metric::iso::{CoarseSamples, IsoSamples};
 use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};

@@ -3,7 +3,7 @@
 //! solves for F and a diffuse albedo, on the CPU (the GPU twins are in [`crate::gpu`]).
 
 pub mod grid;
-pub(crate) mod iso_grid;
+pub(crate) mod iso;
 pub mod iso_tables;
 pub(crate) mod lambda_table;
 pub(crate) mod merl_geometry;

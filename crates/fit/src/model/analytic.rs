@@ -41,9 +41,7 @@ pub fn parse_analytic(spec: &str) -> Result<MicrofacetBrdf, FitError> {
         "beckmann" => NdfKind::Beckmann,
         other => return Err(bad(format!("unknown model `{other}` (ggx or beckmann)"))),
     };
-    let mut alpha = (None, None);
-    let (mut rotation, mut fresnel, mut eta, mut k, mut diffuse) =
-        (0.0, None, None, None, [0.0; 3]);
+    let mut keys = Keys::default();
     let mut seen: Vec<&str> = Vec::new();
     for pair in query.split('&').filter(|p| !p.is_empty()) {
         let (key, value) = pair
@@ -57,6 +55,65 @@ pub fn parse_analytic(spec: &str) -> Result<MicrofacetBrdf, FitError> {
             }));
         }
         seen.push(key);
+        keys.read(key, value, &bad)?;
+    }
+    let Keys {
+        alpha,
+        rotation,
+        mut fresnel,
+        eta,
+        k,
+        diffuse,
+    } = keys;
+    if let (Some(eta), Some(k)) = (eta, k) {
+        fresnel = Some(Fresnel::Conductor { eta, k });
+    } else if eta.is_some() || k.is_some() {
+        return Err(bad("a conductor needs both eta and k".into()));
+    }
+    let (Some(alpha_x), Some(alpha_y)) = alpha else {
+        return Err(bad("give alpha, or alpha_x and alpha_y".into()));
+    };
+    let ndf = Ndf::Analytic(AnalyticNdf {
+        kind,
+        alpha_x,
+        alpha_y,
+        rotation,
+    });
+    let name = format!(
+        "analytic-{}",
+        spec.replace(
+            |c: char| !(c.is_ascii_alphanumeric() || c == '.' || c == '-'),
+            "_"
+        )
+    );
+    Ok(MicrofacetBrdf {
+        name,
+        ndf,
+        fresnel: fresnel.unwrap_or(Fresnel::Schlick { f0: [0.04; 3] }),
+        diffuse,
+    })
+}
+
+/// What a spec's keys set, as they are read: α along x and y, the rotation (radians), the
+/// Fresnel, a conductor's η and k (one Fresnel once both are read), and ρd.
+#[derive(Default)]
+struct Keys {
+    alpha: (Option<f64>, Option<f64>),
+    rotation: f64,
+    fresnel: Option<Fresnel>,
+    eta: Option<[f64; 3]>,
+    k: Option<[f64; 3]>,
+    diffuse: [f64; 3],
+}
+
+impl Keys {
+    /// Reads `key=value`, its value checked against the key's range; `bad` makes the error.
+    fn read(
+        &mut self,
+        key: &str,
+        value: &str,
+        bad: &impl Fn(String) -> FitError,
+    ) -> Result<(), FitError> {
         // `x` is one component of the value `v`; an error names the whole value.
         let num_of = |x: &str, v: &str, range: &std::ops::RangeInclusive<f64>, what: &str| {
             let x = x
@@ -95,65 +152,39 @@ pub fn parse_analytic(spec: &str) -> Result<MicrofacetBrdf, FitError> {
         match key {
             "alpha" => {
                 let a = num(value, ALPHA_RANGE, &alpha_range())?;
-                alpha = (Some(a), Some(a));
+                self.alpha = (Some(a), Some(a));
             }
-            "alpha_x" => alpha.0 = Some(num(value, ALPHA_RANGE, &alpha_range())?),
-            "alpha_y" => alpha.1 = Some(num(value, ALPHA_RANGE, &alpha_range())?),
+            "alpha_x" => self.alpha.0 = Some(num(value, ALPHA_RANGE, &alpha_range())?),
+            "alpha_y" => self.alpha.1 = Some(num(value, ALPHA_RANGE, &alpha_range())?),
             "rotation" => {
-                rotation =
+                self.rotation =
                     num(value, -360.0..=360.0, "rotation is in degrees, -360 to 360")?.to_radians()
             }
             "f0" => {
-                fresnel = Some(Fresnel::Schlick {
+                self.fresnel = Some(Fresnel::Schlick {
                     f0: rgb(value, 0.0..=1.0, "f0 must lie in [0, 1]")?,
                 })
             }
             "ior" => {
-                fresnel = Some(Fresnel::Dielectric {
+                self.fresnel = Some(Fresnel::Dielectric {
                     eta: num(value, positive, "ior must lie in [1e-6, 1e6]")?,
                 })
             }
-            "eta" => eta = Some(rgb(value, positive, "eta must lie in [1e-6, 1e6]")?),
-            "k" => k = Some(rgb(value, 0.0..=1e6, "k must lie in [0, 1e6]")?),
-            "conductor" if value == "gold" => fresnel = Some(Fresnel::GOLD),
+            "eta" => self.eta = Some(rgb(value, positive, "eta must lie in [1e-6, 1e6]")?),
+            "k" => self.k = Some(rgb(value, 0.0..=1e6, "k must lie in [0, 1e6]")?),
+            "conductor" if value == "gold" => self.fresnel = Some(Fresnel::GOLD),
             "conductor" => {
                 return Err(bad(format!(
                     "unknown conductor `{value}` (gold, or give eta and k)"
                 )));
             }
-            "kd" => diffuse = rgb(value, 0.0..=1.0, "kd must lie in [0, 1]")?,
+            "kd" => self.diffuse = rgb(value, 0.0..=1.0, "kd must lie in [0, 1]")?,
             other => {
                 return Err(bad(format!(
                     "unknown key `{other}` (alpha, alpha_x, alpha_y, rotation, f0, ior, eta, k, conductor, kd)"
                 )));
             }
         }
+        Ok(())
     }
-    if let (Some(eta), Some(k)) = (eta, k) {
-        fresnel = Some(Fresnel::Conductor { eta, k });
-    } else if eta.is_some() || k.is_some() {
-        return Err(bad("a conductor needs both eta and k".into()));
-    }
-    let (Some(alpha_x), Some(alpha_y)) = alpha else {
-        return Err(bad("give alpha, or alpha_x and alpha_y".into()));
-    };
-    let ndf = Ndf::Analytic(AnalyticNdf {
-        kind,
-        alpha_x,
-        alpha_y,
-        rotation,
-    });
-    let name = format!(
-        "analytic-{}",
-        spec.replace(
-            |c: char| !(c.is_ascii_alphanumeric() || c == '.' || c == '-'),
-            "_"
-        )
-    );
-    Ok(MicrofacetBrdf {
-        name,
-        ndf,
-        fresnel: fresnel.unwrap_or(Fresnel::Schlick { f0: [0.04; 3] }),
-        diffuse,
-    })
 }
