@@ -5,10 +5,10 @@
 // facet_glint::dpf::dpf_on_rings), or, on wide cones, polar coordinates (ρ, φ) about the mirror
 // direction clipped to the cone (facet_glint::lobe_rule; CPU twin facet_glint::dpf::dpf_on_lobe).
 
+#include "common/math.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
 
 const WG: u32 = 64u;
-const PI: f32 = 3.14159265358979;
 // Rust: facet_glint::lobe_rule::LOBE_EPS, TOUCH_MERGE and TAIL_START.
 override LOBE_EPS: f32;
 override TOUCH_MERGE: f32;
