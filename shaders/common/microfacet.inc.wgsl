@@ -1,8 +1,9 @@
 // Include-only. Analytic microfacet NDFs (Rust twin: facet_fit::microfacet::AnalyticNdf):
-// D, Smith Λ and sampling of GGX (kind 0) and Beckmann (kind 1), αx, αy and a rotation: of
-// D cos θh, and of the normals visible from ωo (facet_fit::visible_normals).
+// D, Smith Λ and sampling of GGX (NDF_KIND_GGX) and Beckmann (NDF_KIND_BECKMANN), αx, αy and a
+// rotation: of D cos θh, and of the normals visible from ωo (facet_fit::visible_normals).
 
 #include "common/math.inc.wgsl"
+#include "common/ndf_kind.inc.wgsl"
 
 struct AnalyticNdf {
     kind: u32,
@@ -18,7 +19,7 @@ fn ndf_d(n: AnalyticNdf, h: vec3<f32>) -> f32 {
     }
     let l = unrotate_z(h, n.rotation);
     let e = (l.x / n.alpha_x) * (l.x / n.alpha_x) + (l.y / n.alpha_y) * (l.y / n.alpha_y);
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         // GGX: 1 / (π αx αy (hx²/αx² + hy²/αy² + hz²)²)
         let q = e + l.z * l.z;
         return 1.0 / (PI * n.alpha_x * n.alpha_y * q * q);
@@ -42,7 +43,7 @@ fn ndf_lambda(n: AnalyticNdf, w: vec3<f32>) -> f32 {
     if (a2t2 <= 0.0) {
         return 0.0;
     }
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         return 0.5 * (sqrt(1.0 + a2t2) - 1.0);
     }
     let a = 1.0 / sqrt(a2t2);
@@ -56,7 +57,7 @@ fn ndf_lambda(n: AnalyticNdf, w: vec3<f32>) -> f32 {
 // tan θ = sqrt(−ln(1 − u))) stretched by (αx, αy) and rotated.
 fn ndf_sample(n: AnalyticNdf, u: vec2<f32>) -> vec3<f32> {
     var r = 0.0;
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         r = sqrt(u.x / max(1.0 - u.x, 1e-30));
     } else {
         r = sqrt(-log(max(1.0 - u.x, 1e-30)));
@@ -120,7 +121,7 @@ fn ndf_sample_visible(n: AnalyticNdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> 
     let o = unrotate_z(wo, n.rotation);
     let v = normalize(vec3<f32>(n.alpha_x * o.x, n.alpha_y * o.y, max(o.z, 1e-7)));
     var h: vec3<f32>;
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         let phi = 2.0 * PI * u.x;
         let z = (1.0 - u.y) * (1.0 + v.z) - v.z;
         let r = sqrt(max(1.0 - z * z, 0.0));

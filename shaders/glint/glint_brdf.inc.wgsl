@@ -20,7 +20,7 @@ struct EvalParams {
     level_t: f32,
     n_theta: u32,
     n_dphi: u32,
-    // 0 GGX, 1 Beckmann, 2 the renderer's tabulated NDF (alpha, rotation: its stretch).
+    // NDF_KIND_*: GGX, Beckmann, or the renderer's tabulated NDF (alpha, rotation: its stretch).
     ndf_kind: u32,
     alpha_x: f32,
     alpha_y: f32,
