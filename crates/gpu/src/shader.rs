@@ -106,8 +106,8 @@ pub fn validate(name: &str, source: &str) -> Result<naga::Module, GpuError> {
     let module =
         naga::front::wgsl::parse_str(source).map_err(|e| fail(e.emit_to_string(source)))?;
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), WEBGPU_CORE)
-    .validate(&module)
-    .map_err(|e| fail(e.emit_to_string(source)))?;
+        .validate(&module)
+        .map_err(|e| fail(e.emit_to_string(source)))?;
     Ok(module)
 }
 
@@ -337,7 +337,9 @@ mod tests {
         // 16 levels below the root are fine, 17 are not.
         assert_eq!(expand_files("f1.wgsl", &files).unwrap(), "end\n");
         let (_, message) = shader_error(expand_files("f0.wgsl", &files).unwrap_err());
-        assert!(message.ends_with("includes nest deeper than 16"), "{message}");
+        assert!(
+            message.ends_with("includes nest deeper than 16"),
+            "{message}"
+        );
     }
-
 }
