@@ -1,6 +1,9 @@
 // Include-only. Analytic microfacet NDFs (Rust twin: facet_fit::microfacet::AnalyticNdf):
-// D, Smith Λ and sampling of GGX (kind 0) and Beckmann (kind 1), αx, αy and a rotation: of
-// D cos θh, and of the normals visible from ωo (facet_fit::visible_normals).
+// D, Smith Λ and sampling of GGX (NDF_KIND_GGX) and Beckmann (NDF_KIND_BECKMANN), αx, αy and a
+// rotation: of D cos θh, and of the normals visible from ωo (facet_fit::visible_normals).
+
+#include "common/math.inc.wgsl"
+#include "common/ndf_kind.inc.wgsl"
 
 struct AnalyticNdf {
     kind: u32,
@@ -9,29 +12,21 @@ struct AnalyticNdf {
     rotation: f32,
 }
 
-const MF_PI: f32 = 3.14159265358979;
-
-fn ndf_to_local(n: AnalyticNdf, w: vec3<f32>) -> vec3<f32> {
-    let c = cos(n.rotation);
-    let s = sin(n.rotation);
-    return vec3<f32>(c * w.x + s * w.y, -s * w.x + c * w.y, w.z);
-}
-
 // D(h), ∫ D cos θ dω = 1.
 fn ndf_d(n: AnalyticNdf, h: vec3<f32>) -> f32 {
     if (h.z <= 0.0) {
         return 0.0;
     }
-    let l = ndf_to_local(n, h);
+    let l = unrotate_z(h, n.rotation);
     let e = (l.x / n.alpha_x) * (l.x / n.alpha_x) + (l.y / n.alpha_y) * (l.y / n.alpha_y);
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         // GGX: 1 / (π αx αy (hx²/αx² + hy²/αy² + hz²)²)
         let q = e + l.z * l.z;
-        return 1.0 / (MF_PI * n.alpha_x * n.alpha_y * q * q);
+        return 1.0 / (PI * n.alpha_x * n.alpha_y * q * q);
     }
     // Beckmann: exp(−(hx²/αx² + hy²/αy²)/hz²) / (π αx αy hz⁴)
     let z2 = l.z * l.z;
-    return exp(-e / z2) / (MF_PI * n.alpha_x * n.alpha_y * z2 * z2);
+    return exp(-e / z2) / (PI * n.alpha_x * n.alpha_y * z2 * z2);
 }
 
 // erf by Abramowitz–Stegun 7.1.26 (|error| < 1.5e-7; the CPU uses libm's erf).
@@ -43,35 +38,33 @@ fn erf_approx(x: f32) -> f32 {
 
 // Smith Λ(w).
 fn ndf_lambda(n: AnalyticNdf, w: vec3<f32>) -> f32 {
-    let l = ndf_to_local(n, w);
+    let l = unrotate_z(w, n.rotation);
     let a2t2 = ((l.x * n.alpha_x) * (l.x * n.alpha_x) + (l.y * n.alpha_y) * (l.y * n.alpha_y)) / (l.z * l.z);
     if (a2t2 <= 0.0) {
         return 0.0;
     }
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         return 0.5 * (sqrt(1.0 + a2t2) - 1.0);
     }
     let a = 1.0 / sqrt(a2t2);
     if (a > 6.0) {
         return 0.0;
     }
-    return 0.5 * (erf_approx(a) - 1.0) + exp(-a * a) / (2.0 * a * sqrt(MF_PI));
+    return 0.5 * (erf_approx(a) - 1.0) + exp(-a * a) / (2.0 * a * sqrt(PI));
 }
 
 // A normal with density D(h) cos θh: a unit slope (GGX tan θ = sqrt(u/(1 − u)), Beckmann
 // tan θ = sqrt(−ln(1 − u))) stretched by (αx, αy) and rotated.
 fn ndf_sample(n: AnalyticNdf, u: vec2<f32>) -> vec3<f32> {
     var r = 0.0;
-    if (n.kind == 0u) {
+    if (n.kind == NDF_KIND_GGX) {
         r = sqrt(u.x / max(1.0 - u.x, 1e-30));
     } else {
         r = sqrt(-log(max(1.0 - u.x, 1e-30)));
     }
-    let phi = 2.0 * MF_PI * u.y;
+    let phi = 2.0 * PI * u.y;
     let h = normalize(vec3<f32>(r * cos(phi) * n.alpha_x, r * sin(phi) * n.alpha_y, 1.0));
-    let c = cos(n.rotation);
-    let s = sin(n.rotation);
-    return vec3<f32>(c * h.x - s * h.y, s * h.x + c * h.y, h.z);
+    return rotate_z(h, n.rotation);
 }
 
 // Inverse error function: Giles (2010), single precision (facet_fit::visible_normals::erfinv_giles).
@@ -104,12 +97,6 @@ fn erfinv_f32(y: f32) -> f32 {
     return p * y;
 }
 
-fn ndf_rotate(n: AnalyticNdf, v: vec3<f32>) -> vec3<f32> {
-    let c = cos(n.rotation);
-    let s = sin(n.rotation);
-    return vec3<f32>(c * v.x - s * v.y, s * v.x + c * v.y, v.z);
-}
-
 // Visible slopes of the unit Beckmann NDF seen from cos θ in the x–z plane: Newton's method on
 // the CDF in the erf domain, x = erf(x̃) ∈ (−1, erf(cot θ)), CDF ∝ 1 + x + tan θ exp(−x̃²)/√π.
 fn beckmann_visible_slopes_11(cos_theta: f32, u_in: vec2<f32>) -> vec2<f32> {
@@ -118,10 +105,10 @@ fn beckmann_visible_slopes_11(cos_theta: f32, u_in: vec2<f32>) -> vec2<f32> {
     let max_x = erf_approx(cot_theta);
     let u = clamp(u_in, vec2<f32>(1e-6), vec2<f32>(1.0 - 1e-6));
     var x = max_x - (max_x + 1.0) * erf_approx(sqrt(-log(u.x)));
-    let target_cdf = u.x * (1.0 + max_x + tan_theta * exp(-cot_theta * cot_theta) / sqrt(MF_PI));
+    let target_cdf = u.x * (1.0 + max_x + tan_theta * exp(-cot_theta * cot_theta) / sqrt(PI));
     for (var i = 0u; i < 6u; i++) {
         let slope = erfinv_f32(x);
-        let value = 1.0 + x + tan_theta * exp(-slope * slope) / sqrt(MF_PI) - target_cdf;
+        let value = 1.0 + x + tan_theta * exp(-slope * slope) / sqrt(PI) - target_cdf;
         let derivative = 1.0 - slope * tan_theta;
         x = clamp(x - value / derivative, -1.0 + 1e-6, min(max_x, 1.0 - 1e-6));
     }
@@ -131,11 +118,11 @@ fn beckmann_visible_slopes_11(cos_theta: f32, u_in: vec2<f32>) -> vec2<f32> {
 // A normal from the distribution of normals visible from wo (wo.z > 0), density
 // ndf_pdf_visible: GGX by spherical caps (Dupuy & Benyoub 2023), Beckmann by visible slopes.
 fn ndf_sample_visible(n: AnalyticNdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
-    let o = ndf_to_local(n, wo);
+    let o = unrotate_z(wo, n.rotation);
     let v = normalize(vec3<f32>(n.alpha_x * o.x, n.alpha_y * o.y, max(o.z, 1e-7)));
     var h: vec3<f32>;
-    if (n.kind == 0u) {
-        let phi = 2.0 * MF_PI * u.x;
+    if (n.kind == NDF_KIND_GGX) {
+        let phi = 2.0 * PI * u.x;
         let z = (1.0 - u.y) * (1.0 + v.z) - v.z;
         let r = sqrt(max(1.0 - z * z, 0.0));
         let hs = vec3<f32>(r * cos(phi), r * sin(phi), z) + v;
@@ -152,7 +139,7 @@ fn ndf_sample_visible(n: AnalyticNdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> 
         let slope = vec2<f32>((cos_phi * s.x - sin_phi * s.y) * n.alpha_x, (sin_phi * s.x + cos_phi * s.y) * n.alpha_y);
         h = vec3<f32>(-slope.x, -slope.y, 1.0);
     }
-    return ndf_rotate(n, normalize(h));
+    return rotate_z(normalize(h), n.rotation);
 }
 
 // D_wo(h) = G1(wo) max(0, wo·h) D(h) / wo.z, G1 = 1 / (1 + Λ(wo)).

@@ -4,10 +4,10 @@
 // nodes (y = K v) or table queries (y = I(q), the clamped-cosine convolution behind D and G1).
 // Each workgroup stages a tile of nodes (direction and col_j v_j) in workgroup memory.
 
+#include "common/math.inc.wgsl"
 #include "fit/node.inc.wgsl"
 
 const WG: u32 = 64u;
-const PI: f32 = 3.14159265358979;
 
 @group(0) @binding(0) var<storage, read> nodes: array<Node>;
 @group(0) @binding(1) var<storage, read> queries: array<Node>;

@@ -1,5 +1,6 @@
 // Include-only. A quadrature node or query direction of the power iteration
-// (Rust: facet_fit::gpu::GpuNode; sizes checked against naga in tests/gpu_layout.rs).
+// (Rust: facet_fit::gpu::GpuNode, and GpuState below; layouts checked against naga in
+// tests/shaders.rs).
 struct Node {
     x: f32,
     y: f32,

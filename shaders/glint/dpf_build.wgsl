@@ -5,10 +5,11 @@
 // facet_glint::dpf::dpf_on_rings), or, on wide cones, polar coordinates (ρ, φ) about the mirror
 // direction clipped to the cone (facet_glint::lobe_rule; CPU twin facet_glint::dpf::dpf_on_lobe).
 
+#include "common/math.inc.wgsl"
+#include "common/ndf_kind.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
 
 const WG: u32 = 64u;
-const PI: f32 = 3.14159265358979;
 // Rust: facet_glint::lobe_rule::LOBE_EPS, TOUCH_MERGE and TAIL_START.
 override LOBE_EPS: f32;
 override TOUCH_MERGE: f32;
@@ -22,7 +23,7 @@ struct Params {
     n_theta: u32,
     n_dphi: u32,
     n_rings: u32,
-    // 0: GGX, 1: Beckmann, 2: table over (u = sqrt(θ/(π/2)), φ).
+    // NDF_KIND_*: GGX, Beckmann, or the table over (u = sqrt(θ/(π/2)), φ).
     ndf_kind: u32,
     alpha_x: f32,
     alpha_y: f32,
@@ -52,7 +53,7 @@ struct Ring {
 @group(0) @binding(0) var<uniform> params: Params;
 // The rings of the cone rule.
 @group(0) @binding(1) var<storage, read> rings: array<Ring>;
-// The NDF table when ndf_kind = 2 (index k · nphi + l).
+// The NDF table when ndf_kind is NDF_KIND_TABULATED (index k · nphi + l).
 @group(0) @binding(2) var<storage, read> ndf_table: array<f32>;
 @group(0) @binding(3) var<storage, read_write> out: array<f32>;
 // The rule about the lobe's Gauss–Legendre nodes on [0, 1], (x, weight): n_radial, n_angular,
@@ -63,7 +64,7 @@ fn ndf(h: vec3<f32>) -> f32 {
     if (h.z <= 0.0) {
         return 0.0;
     }
-    if (params.ndf_kind == 2u) {
+    if (params.ndf_kind == NDF_KIND_TABULATED) {
         let theta = acos(clamp(h.z, -1.0, 1.0));
         let x = sqrt(theta / (0.5 * PI)) * f32(params.table_nu - 1u);
         let k = min(u32(x), params.table_nu - 2u);

@@ -3,7 +3,7 @@
 // Needs `field: Field` and `split_table: array<u32>` (facet_glint::flakes::SplitTable) declared
 // by the includer, and glint/tea.inc.wgsl.
 
-const PI_F: f32 = 3.14159265358979;
+#include "common/math.inc.wgsl"
 
 // Set from Rust (facet_glint::flakes), written once there.
 override LEAF_FLAKES: u32;
@@ -102,7 +102,7 @@ fn node_hash(level: u32, ix: u32, iy: u32) -> vec2<u32> {
 
 // Footprint area π |det [a b]|.
 fn footprint_area(a: vec2<f32>, b: vec2<f32>) -> f32 {
-    return PI_F * abs(a.x * b.y - a.y * b.x);
+    return PI * abs(a.x * b.y - a.y * b.x);
 }
 
 // Flake k of a leaf whose hash is h: its id (facet_glint::flakes::FlakeField::leaf_flake).

@@ -8,6 +8,8 @@
 // (texture_3d<f32>), glint/tea.inc.wgsl, common/microfacet.inc.wgsl, glint/flakes.inc.wgsl and
 // glint/lit.inc.wgsl.
 
+#include "common/math.inc.wgsl"
+
 // Rust: facet_glint::gpu::GlintEvalParams.
 struct EvalParams {
     gamma: f32,
@@ -18,7 +20,7 @@ struct EvalParams {
     level_t: f32,
     n_theta: u32,
     n_dphi: u32,
-    // 0 GGX, 1 Beckmann, 2 the renderer's tabulated NDF (alpha, rotation: its stretch).
+    // NDF_KIND_*: GGX, Beckmann, or the renderer's tabulated NDF (alpha, rotation: its stretch).
     ndf_kind: u32,
     alpha_x: f32,
     alpha_y: f32,
@@ -30,8 +32,8 @@ struct EvalParams {
 fn level_lookup(tex: texture_3d<f32>, theta_o: f32, theta_i: f32, dphi: f32) -> f32 {
     let nt = params.n_theta;
     let np = params.n_dphi;
-    let st = 0.5 * PI_F / f32(nt);
-    let sp = PI_F / f32(np);
+    let st = 0.5 * PI / f32(nt);
+    let sp = PI / f32(np);
     let xo = clamp(theta_o / st - 0.5, 0.0, f32(nt - 1u));
     let xi = clamp(theta_i / st - 0.5, 0.0, f32(nt - 1u));
     let xp = clamp(dphi / sp - 0.5, 0.0, f32(np - 1u));
@@ -73,7 +75,7 @@ fn polar_precise(r: f32, z: f32) -> f32 {
     if (r <= z) {
         return atan_unit(r / z);
     }
-    return 0.5 * PI_F - atan_unit(z / r);
+    return 0.5 * PI - atan_unit(z / r);
 }
 
 // The half vector in cells: facet_glint::flakes::direction_coords.
@@ -90,9 +92,9 @@ fn glint_dpf(wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     let theta_o = acos(clamp(wo.z, -1.0, 1.0));
     let theta_i = acos(clamp(wi.z, -1.0, 1.0));
     var dphi = azimuth(wo) - azimuth(wi);
-    dphi = dphi - 2.0 * PI_F * floor(dphi / (2.0 * PI_F));
-    if (dphi > PI_F) {
-        dphi = 2.0 * PI_F - dphi;
+    dphi = dphi - 2.0 * PI * floor(dphi / (2.0 * PI));
+    if (dphi > PI) {
+        dphi = 2.0 * PI - dphi;
     }
     let d0 = level_lookup(level0, theta_o, theta_i, dphi) / params.sigma0;
     let d1 = level_lookup(level1, theta_o, theta_i, dphi) / params.sigma1;
@@ -136,18 +138,6 @@ fn glint_scale(wi: vec3<f32>, wo: vec3<f32>, count: f32, area: f32) -> f32 {
         return 0.0;
     }
     let h = normalize(wi + wo);
-    let g2 = g2_glint(glint_lambda(wi), glint_lambda(wo), wi, wo);
+    let g2 = g2_correlated(glint_lambda(wi), glint_lambda(wo), wi, wo);
     return g2 * dot(h, wo) * count / (field.density * area * params.sigma * wi.z * h.z) / wo.z;
-}
-
-// Correlated Smith G2: 1 / (1 + max(Λi, Λo) + λ(φ) min(Λi, Λo)), λ = 4.41φ/(4.41φ + 1).
-fn g2_glint(lam_i: f32, lam_o: f32, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
-    let li = length(wi.xy);
-    let lo = length(wo.xy);
-    var phi = 0.0;
-    if (li > 1e-6 && lo > 1e-6) {
-        phi = acos(clamp(dot(wi.xy, wo.xy) / (li * lo), -1.0, 1.0));
-    }
-    let corr = 4.41 * phi / (4.41 * phi + 1.0);
-    return 1.0 / (1.0 + max(lam_i, lam_o) + corr * min(lam_i, lam_o));
 }

@@ -53,7 +53,7 @@ fn glint_eval(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgr
     let h = normalize(wi + wo);
     let theta_d = acos(clamp(dot(wi, h), 0.0, 1.0));
     let n = arrayLength(&fresnel);
-    let x = clamp(theta_d / (0.5 * PI_F / f32(n)), 0.0, f32(n - 1u));
+    let x = clamp(theta_d / (0.5 * PI / f32(n)), 0.0, f32(n - 1u));
     let j = min(u32(x), n - 2u);
     let f = mix(fresnel[j].xyz, fresnel[j + 1u].xyz, x - f32(j));
     out[idx] = vec4<f32>(f * scale, 0.0);

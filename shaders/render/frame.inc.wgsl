@@ -44,7 +44,7 @@ struct Frame {
     // 1: also accumulate squared radiance into film_sq (per-pixel variance)
     moments: u32,
     pad1: u32,
-    // Constant environment radiance (env_kind 1); w: 1 / Σ weights of the map (env_kind 2).
+    // rgb the constant environment's radiance (ENV_CONSTANT); w unused (0).
     env_color: vec4<f32>,
     // xyz position, w tan(yfov / 2)
     cam_pos: vec4<f32>,

@@ -3,9 +3,9 @@
 // the environment map and its CDFs, the Fresnel tables and the tabulated NDFs at offsets.
 
 #include "render/tags.inc.wgsl"
+#include "common/math.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
 
-const PI: f32 = 3.14159265358979;
 const NONE: u32 = 0xffffffffu;
 
 // Rust: facet_render::gpu_types::GpuMaterial.

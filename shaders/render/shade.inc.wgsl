@@ -8,6 +8,8 @@
 //   bsdf_roughness(b) -> α of the lobe (for the cone),
 // all in the local shading frame (z the normal).
 
+#include "common/math.inc.wgsl"
+
 // Random numbers of a bounce: 0..2 light choice and point, 3..5 BSDF sample, 6 the class's own
 // (glints: the direction cell), 7 roulette.
 fn shade(slot: u32) {
@@ -74,18 +76,6 @@ fn shade(slot: u32) {
 }
 
 // ---- the microfacet pieces the stages share -----------------------------------------------
-
-// Correlated Smith G2 (design.md): 1 / (1 + max(Λi, Λo) + λ(φ) min(Λi, Λo)), λ = 4.41φ/(4.41φ + 1).
-fn g2_correlated(lam_i: f32, lam_o: f32, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
-    let li = length(wi.xy);
-    let lo = length(wo.xy);
-    var phi = 0.0;
-    if (li > 1e-6 && lo > 1e-6) {
-        phi = acos(clamp(dot(wi.xy, wo.xy) / (li * lo), -1.0, 1.0));
-    }
-    let corr = 4.41 * phi / (4.41 * phi + 1.0);
-    return 1.0 / (1.0 + max(lam_i, lam_o) + corr * min(lam_i, lam_o));
-}
 
 // Cosine-weighted hemisphere, pdf cos θ / π.
 fn sample_cosine(u: vec2<f32>) -> vec3<f32> {

@@ -9,6 +9,7 @@
 // the cosine lobe by albedo where the fit has a diffuse term (as shade_microfacet.wgsl).
 
 #include "render/frame.inc.wgsl"
+#include "common/ndf_kind.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
 #include "render/bvh.inc.wgsl"
 #include "render/scene.inc.wgsl"
@@ -24,9 +25,6 @@ override Q_SHADE: u32;
 @group(2) @binding(3) var level1: texture_3d<f32>;
 @group(2) @binding(4) var<storage, read> split_table: array<u32>;
 
-// EvalParams.ndf_kind of a tabulated NDF (facet_glint::gpu::GlintEvalParams).
-const NDF_TABULATED: u32 = 2u;
-
 #include "glint/flakes.inc.wgsl"
 // Each query reads one direction cell (bsdf_setup's cell_u): a walk of two chains.
 #include "glint/chains2.inc.wgsl"
@@ -36,7 +34,7 @@ const NDF_TABULATED: u32 = 2u;
 struct Bsdf {
     material: u32,
     ndf: AnalyticNdf,
-    // The fit's tabulated NDF, when params.ndf_kind is NDF_TABULATED.
+    // The fit's tabulated NDF, when params.ndf_kind is NDF_KIND_TABULATED.
     tab: TabNdf,
     center: vec2<f32>,
     a: vec2<f32>,
@@ -71,7 +69,7 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     var b: Bsdf;
     b.material = s.material;
     b.ndf = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
-    if (params.ndf_kind == NDF_TABULATED) {
+    if (params.ndf_kind == NDF_KIND_TABULATED) {
         b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
     }
     b.center = s.uv;
@@ -135,7 +133,7 @@ fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -
 var<private> glint_tab: TabNdf;
 
 fn glint_lambda(w: vec3<f32>) -> f32 {
-    if (params.ndf_kind == NDF_TABULATED) {
+    if (params.ndf_kind == NDF_KIND_TABULATED) {
         return tab_lambda(glint_tab, w);
     }
     return ndf_lambda(AnalyticNdf(params.ndf_kind, params.alpha_x, params.alpha_y, params.rotation), w);
@@ -148,7 +146,7 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     }
     let h = normalize(wi + wo);
     var spec: f32;
-    if (params.ndf_kind == NDF_TABULATED) {
+    if (params.ndf_kind == NDF_KIND_TABULATED) {
         spec = tab_pdf_visible(b.tab, wo, h) / (4.0 * abs(dot(wo, h)));
     } else {
         spec = lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
@@ -161,7 +159,7 @@ fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
         return sample_cosine(u.xy);
     }
     var h: vec3<f32>;
-    if (params.ndf_kind == NDF_TABULATED) {
+    if (params.ndf_kind == NDF_KIND_TABULATED) {
         h = tab_sample_visible(b.tab, wo, u.xy);
     } else {
         h = lobe_sample_h(b.ndf, wo, u.xy);
@@ -172,7 +170,7 @@ fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
 fn bsdf_roughness(b: Bsdf) -> f32 {
     // m.roughness: the fit's effective α (GGX) for a table, √(αx αy) for an analytic NDF.
     var r = sqrt(b.ndf.alpha_x * b.ndf.alpha_y);
-    if (params.ndf_kind == NDF_TABULATED) {
+    if (params.ndf_kind == NDF_KIND_TABULATED) {
         r = materials[b.material].roughness;
     }
     return mix(1.0, r, b.p_spec);

@@ -4,7 +4,9 @@
 // and the visible-normal slices of facet_fit::visible_tables (n_theta_v × n_phi_v slices of
 // rows × columns cells, each with its CDF and pdf). Block in `tables` at `tab_offset`:
 // [nu, nphi, ng, n_theta_v, n_phi_v, rows, columns, -] then d, g1, cdf, cell_pdf, vis_cdf,
-// vis_pdf. The includer declares `tables` and PI.
+// vis_pdf. The includer declares `tables`.
+
+#include "common/math.inc.wgsl"
 
 struct TabNdf {
     base: u32,
@@ -60,10 +62,20 @@ fn tab_bilinear(off: u32, n: u32, nphi: u32, x: f32, phi: f32) -> f32 {
     return mix(r0, r1, t);
 }
 
-fn tab_local(t: TabNdf, w: vec3<f32>) -> vec3<f32> {
-    let c = cos(t.rotation);
-    let s = sin(t.rotation);
-    return vec3<f32>(c * w.x + s * w.y, -s * w.x + c * w.y, w.z);
+// Where the base NDF is read for a normal h: h₀ ∝ (hx/αx, hy/αy, hz) in the rotated frame, its
+// row coordinate x on the u = sqrt(θ / (π/2)) nodes, and r = cos θ₀ / cos θh.
+struct TabBase {
+    h0: vec3<f32>,
+    x: f32,
+    r: f32,
+}
+
+fn tab_base(t: TabNdf, h: vec3<f32>) -> TabBase {
+    let l = unrotate_z(h, t.rotation);
+    let h0 = normalize(vec3<f32>(l.x / t.alpha_x, l.y / t.alpha_y, l.z));
+    let theta = polar_angle(h0);
+    let x = min(sqrt(theta / (0.5 * PI)), 1.0) * f32(t.nu - 1u);
+    return TabBase(h0, x, h0.z / l.z);
 }
 
 // D(h) = D₀(h₀) cos⁴θ₀ / (cos⁴θh αx αy), h₀ ∝ (hx/αx, hy/αy, hz).
@@ -71,12 +83,9 @@ fn tab_d(t: TabNdf, h: vec3<f32>) -> f32 {
     if (h.z <= 0.0) {
         return 0.0;
     }
-    let l = tab_local(t, h);
-    let h0 = normalize(vec3<f32>(l.x / t.alpha_x, l.y / t.alpha_y, l.z));
-    let theta = polar_angle(h0);
-    let x = min(sqrt(theta / (0.5 * PI)), 1.0) * f32(t.nu - 1u);
-    let r = h0.z / l.z;
-    return tab_bilinear(tab_d_off(t), t.nu, t.nphi, x, azimuth_of(h0)) * r * r * r * r / (t.alpha_x * t.alpha_y);
+    let b = tab_base(t, h);
+    let r = b.r;
+    return tab_bilinear(tab_d_off(t), t.nu, t.nphi, b.x, azimuth_of(b.h0)) * r * r * r * r / (t.alpha_x * t.alpha_y);
 }
 
 // Λ(w) = 1/G1₀(w₀) − 1, w₀ ∝ (αx wx, αy wy, wz).
@@ -84,7 +93,7 @@ fn tab_lambda(t: TabNdf, w: vec3<f32>) -> f32 {
     if (w.z <= 0.0) {
         return 3.0e38;
     }
-    let l = tab_local(t, w);
+    let l = unrotate_z(w, t.rotation);
     let w0 = normalize(vec3<f32>(l.x * t.alpha_x, l.y * t.alpha_y, l.z));
     let theta = polar_angle(w0);
     let g1 = tab_bilinear(tab_g1_off(t), t.ng, t.nphi, theta / (0.5 * PI) * f32(t.ng - 1u), azimuth_of(w0));
@@ -130,9 +139,7 @@ fn tab_sample(t: TabNdf, u: vec2<f32>) -> vec3<f32> {
     let phi = (f32(l) + u.y) * 2.0 * PI / f32(t.nphi);
     let h0 = vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), cos_t);
     let hl = normalize(vec3<f32>(h0.x * t.alpha_x, h0.y * t.alpha_y, h0.z));
-    let cr = cos(t.rotation);
-    let sr = sin(t.rotation);
-    return vec3<f32>(cr * hl.x - sr * hl.y, sr * hl.x + cr * hl.y, hl.z);
+    return rotate_z(hl, t.rotation);
 }
 
 // q₀(h₀) cos³θ₀ / (αx αy cos³θh).
@@ -140,13 +147,10 @@ fn tab_pdf(t: TabNdf, h: vec3<f32>) -> f32 {
     if (h.z <= 0.0) {
         return 0.0;
     }
-    let l = tab_local(t, h);
-    let h0 = normalize(vec3<f32>(l.x / t.alpha_x, l.y / t.alpha_y, l.z));
-    let theta = polar_angle(h0);
-    let x = min(sqrt(theta / (0.5 * PI)), 1.0) * f32(t.nu - 1u);
-    let k = min(u32(x), t.nu - 2u);
-    let lp = min(u32(azimuth_of(h0) / (2.0 * PI) * f32(t.nphi)), t.nphi - 1u);
-    let r = h0.z / l.z;
+    let b = tab_base(t, h);
+    let k = min(u32(b.x), t.nu - 2u);
+    let lp = min(u32(azimuth_of(b.h0) / (2.0 * PI) * f32(t.nphi)), t.nphi - 1u);
+    let r = b.r;
     return tables[tab_pdf_off(t) + k * t.nphi + lp] * r * r * r / (t.alpha_x * t.alpha_y);
 }
 
@@ -196,7 +200,7 @@ fn tab_row_cos(r: u32, rows: u32) -> vec2<f32> {
 
 // Base-space view of ωo: w₀ ∝ (αx wx, αy wy, wz) in the rotated frame.
 fn tab_base_view(t: TabNdf, wo: vec3<f32>) -> vec3<f32> {
-    let l = tab_local(t, wo);
+    let l = unrotate_z(wo, t.rotation);
     return normalize(vec3<f32>(l.x * t.alpha_x, l.y * t.alpha_y, max(l.z, 0.0)));
 }
 
@@ -219,9 +223,7 @@ fn tab_sample_visible(t: TabNdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
     let phi = q.phi_ref + (f32(c % t.columns) + b.y) * 2.0 * PI / f32(t.columns);
     let h0 = vec3<f32>(sin_t * cos(phi), sin_t * sin(phi), cos_t);
     let hl = normalize(vec3<f32>(h0.x * t.alpha_x, h0.y * t.alpha_y, h0.z));
-    let cr = cos(t.rotation);
-    let sr = sin(t.rotation);
-    return vec3<f32>(cr * hl.x - sr * hl.y, sr * hl.x + cr * hl.y, hl.z);
+    return rotate_z(hl, t.rotation);
 }
 
 // q_w₀(h₀) cos³θ₀ / (αx αy cos³θh), q_w₀ the slices' mixture of cell densities.
@@ -231,8 +233,8 @@ fn tab_pdf_visible(t: TabNdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
     }
     let v = tab_base_view(t, wo);
     let q = tab_slices(t, v);
-    let l = tab_local(t, h);
-    let h0 = normalize(vec3<f32>(l.x / t.alpha_x, l.y / t.alpha_y, l.z));
+    let base = tab_base(t, h);
+    let h0 = base.h0;
     let u = sqrt(polar_angle(h0) / (0.5 * PI));
     let r = min(u32(u * f32(t.rows)), t.rows - 1u);
     var dphi = azimuth_of(h0) - q.phi_ref;
@@ -244,6 +246,6 @@ fn tab_pdf_visible(t: TabNdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
     let p1 = (q.j + 1u) * t.n_phi_v;
     let lo = (1.0 - q.s) * tables[at + (p0 + q.p) * cells] + q.s * tables[at + (p0 + q.p1) * cells];
     let hi = (1.0 - q.s) * tables[at + (p1 + q.p) * cells] + q.s * tables[at + (p1 + q.p1) * cells];
-    let z = h0.z / l.z;
+    let z = base.r;
     return mix(lo, hi, q.t) * z * z * z / (t.alpha_x * t.alpha_y);
 }

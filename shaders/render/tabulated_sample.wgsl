@@ -2,7 +2,6 @@
 // facet_fit::tabulated::TabulatedNdf::{sample_visible, pdf_visible}), for the CPU comparison
 // in crates/render/tests/tabulated_sampling.rs; the shading stage uses the same functions.
 
-const PI: f32 = 3.14159265358979;
 const WG: u32 = 64u;
 
 // The tabulated block as facet_render::resources::materials::tabulated_block lays it out.

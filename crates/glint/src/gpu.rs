@@ -4,6 +4,7 @@
 use crate::cone_rule::{ConeRule, LevelRule, Ring, lobe_width};
 use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG};
 use crate::lobe_rule::{LOBE_EPS, TAIL_START, TOUCH_MERGE};
+use crate::tags::NdfTag;
 use bytemuck::{Pod, Zeroable};
 use facet_fit::model::geometry::spherical;
 use facet_fit::model::microfacet::Ndf;
@@ -17,7 +18,7 @@ pub struct DpfParams {
     pub n_theta: u32,
     pub n_dphi: u32,
     pub n_rings: u32,
-    /// 0 GGX, 1 Beckmann, 2 table.
+    /// An [`NdfTag`]: GGX, Beckmann or the table.
     pub ndf_kind: u32,
     pub alpha_x: f32,
     pub alpha_y: f32,
@@ -40,12 +41,8 @@ const NDF_TABLE_NU: usize = 1024;
 fn ndf_upload(ndf: &Ndf) -> (DpfParams, Vec<f32>) {
     match ndf {
         Ndf::Analytic(a) => {
-            let kind = match a.kind {
-                facet_fit::model::microfacet::NdfKind::Ggx => 0,
-                facet_fit::model::microfacet::NdfKind::Beckmann => 1,
-            };
             let p = DpfParams {
-                ndf_kind: kind,
+                ndf_kind: NdfTag::from(a.kind) as u32,
                 alpha_x: a.alpha_x as f32,
                 alpha_y: a.alpha_y as f32,
                 rotation: a.rotation as f32,
@@ -65,7 +62,7 @@ fn ndf_upload(ndf: &Ndf) -> (DpfParams, Vec<f32>) {
                 })
                 .collect();
             let p = DpfParams {
-                ndf_kind: 2,
+                ndf_kind: NdfTag::Tabulated as u32,
                 table_nu: NDF_TABLE_NU as u32,
                 table_nphi: nphi as u32,
                 alpha_x: 1.0,
@@ -390,7 +387,7 @@ pub struct GlintEvalParams {
     pub level_t: f32,
     pub n_theta: u32,
     pub n_dphi: u32,
-    /// 0 GGX, 1 Beckmann, 2 the renderer's tabulated NDF (α and rotation: its stretch).
+    /// An [`NdfTag`]; tabulated: the renderer's table (α and rotation: its stretch).
     pub ndf_kind: u32,
     pub alpha_x: f32,
     pub alpha_y: f32,
@@ -533,17 +530,9 @@ pub fn eval_params<'a>(
     };
     let ((l0, t0), (l1, t1)) = (level(k0)?, level(k1)?);
     // A tabulated NDF's parameters are its stretch (the table itself is the renderer's).
-    let (ndf_kind, alpha_x, alpha_y, rotation) = match ndf {
-        Ndf::Analytic(a) => (
-            match a.kind {
-                facet_fit::model::microfacet::NdfKind::Ggx => 0,
-                facet_fit::model::microfacet::NdfKind::Beckmann => 1,
-            },
-            a.alpha_x,
-            a.alpha_y,
-            a.rotation,
-        ),
-        Ndf::Tabulated(t) => (2, t.stretch.alpha_x, t.stretch.alpha_y, t.stretch.rotation),
+    let (alpha_x, alpha_y, rotation) = match ndf {
+        Ndf::Analytic(a) => (a.alpha_x, a.alpha_y, a.rotation),
+        Ndf::Tabulated(t) => (t.stretch.alpha_x, t.stretch.alpha_y, t.stretch.rotation),
     };
     let params = GlintEvalParams {
         gamma: cfg.gamma as f32,
@@ -553,7 +542,7 @@ pub fn eval_params<'a>(
         level_t: t as f32,
         n_theta: l0.config.n_theta as u32,
         n_dphi: l0.config.n_dphi as u32,
-        ndf_kind,
+        ndf_kind: NdfTag::of(ndf) as u32,
         alpha_x: alpha_x as f32,
         alpha_y: alpha_y as f32,
         rotation: rotation as f32,

@@ -8,7 +8,8 @@
 //! its consistent quadtree and counting over footprints. [`lit`]: lit counts per node, so a
 //! count costs O(footprint boundary), blended over the four nearest direction cells. [`glint_brdf`]: the glint BRDF with its
 //! filtered switch, sampling and pdf. [`gpu`]: the pyramid built on the GPU into 3D textures,
-//! glint counting, evaluation and sampling in WGSL.
+//! glint counting, evaluation and sampling in WGSL. [`tags`]: the NDF kind as the WGSL reads
+//! it.
 //!
 //! ```
 //! use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
@@ -29,4 +30,5 @@ pub mod glint_brdf;
 pub mod gpu;
 pub mod lit;
 pub mod lobe_rule;
+pub mod tags;
 pub mod tea;

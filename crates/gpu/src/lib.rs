@@ -1,7 +1,8 @@
 //! # facet-gpu: the wgpu layer of Facet
 //!
 //! Adapter and device selection ([`Gpu`]), WGSL loading from `shaders/` with includes and naga
-//! validation ([`shader`]), buffer upload and read-back ([`buffer`]), GPU timestamps
+//! validation ([`shader`]), closed sets written once for Rust and WGSL ([`tags!`],
+//! [`tags`](mod@tags)), buffer upload and read-back ([`buffer`]), GPU timestamps
 //! ([`timer::GpuTimer`]) and errors a caller can act on ([`GpuError`]), and for tests the GPU or a visible skip
 //! ([`gpu_for_tests`], [`skip`]). Nothing domain-specific.
 //!
@@ -21,6 +22,7 @@ mod error;
 mod runtime_dir;
 pub mod shader;
 pub mod skip;
+pub mod tags;
 pub mod timer;
 
 pub use context::{Gpu, GpuOptions, gpu_for_tests, gpu_for_tests_with};

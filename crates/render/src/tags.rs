@@ -3,44 +3,11 @@
 //! written once, here. [`wgsl`] renders them as WGSL constants; the committed
 //! `shaders/render/tags.inc.wgsl` is its output (`cargo test -p facet-render --test tags`
 //! fails when the two differ; `FACET_REGENERATE=1` rewrites the file) and no other WGSL file
-//! may define a constant with one of the prefixes.
+//! may define a constant with one of the prefixes. The `tags!` macro is facet-gpu's
+//! ([`facet_gpu::tags`](mod@facet_gpu::tags)).
 
-/// Declares a `#[repr(u32)]` enum whose variants are WGSL constants `PREFIX` + name.
-macro_rules! tags {
-    ($(#[$meta:meta])* $name:ident, $prefix:literal {
-        $($(#[doc = $doc:literal])* $variant:ident = $value:literal => $wgsl:literal,)+
-    }) => {
-        $(#[$meta])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-        #[repr(u32)]
-        pub enum $name {
-            $($(#[doc = $doc])* $variant = $value,)+
-        }
-
-        impl $name {
-            /// Every tag, in value order.
-            pub const ALL: &[$name] = &[$($name::$variant),+];
-            /// The prefix of the WGSL constants' names.
-            pub const WGSL_PREFIX: &str = $prefix;
-
-            /// The WGSL constant's name.
-            pub const fn wgsl_name(self) -> &'static str {
-                match self {
-                    $($name::$variant => concat!($prefix, $wgsl),)+
-                }
-            }
-
-            /// The first line of the variant's doc, for the WGSL comment.
-            pub const fn doc(self) -> &'static str {
-                match self {
-                    $($name::$variant => tags!(@first $($doc)*),)+
-                }
-            }
-        }
-    };
-    (@first) => { "" };
-    (@first $first:literal $($rest:literal)*) => { $first };
-}
+use facet_gpu::tags;
+pub use facet_gpu::tags::TagSet;
 
 tags!(
     /// Material kinds (`Material.kind`).
@@ -160,52 +127,25 @@ tags!(
     }
 );
 
-/// One tag enum: its Rust name, its WGSL prefix and its (WGSL name, value, doc) constants.
-pub struct TagSet {
-    /// The Rust enum's name.
-    pub rust: &'static str,
-    /// The WGSL constants' prefix.
-    pub prefix: &'static str,
-    /// (WGSL name, value, doc) of each tag.
-    pub tags: Vec<(&'static str, u32, &'static str)>,
-}
-
 /// Every tag set.
 pub fn all() -> Vec<TagSet> {
-    macro_rules! set {
-        ($t:ident) => {
-            TagSet {
-                rust: stringify!($t),
-                prefix: $t::WGSL_PREFIX,
-                tags: $t::ALL
-                    .iter()
-                    .map(|&v| (v.wgsl_name(), v as u32, v.doc()))
-                    .collect(),
-            }
-        };
-    }
     vec![
-        set!(MaterialKind),
-        set!(LightKind),
-        set!(EnvKind),
-        set!(Strategy),
-        set!(NdfSampling),
-        set!(Region),
-        set!(SlotState),
+        MaterialKind::tag_set(),
+        LightKind::tag_set(),
+        EnvKind::tag_set(),
+        Strategy::tag_set(),
+        NdfSampling::tag_set(),
+        Region::tag_set(),
+        SlotState::tag_set(),
     ]
 }
 
 /// The committed `shaders/render/tags.inc.wgsl`, generated.
 pub fn wgsl() -> String {
-    let mut s = String::from(
-        "// Include-only. Generated from facet_render::tags (crates/render/src/tags.rs): do not edit;\n\
-         // `FACET_REGENERATE=1 cargo test -p facet-render --test tags` rewrites it.\n",
-    );
-    for set in all() {
-        s += &format!("\n// facet_render::tags::{}\n", set.rust);
-        for (name, value, doc) in set.tags {
-            s += &format!("const {name}: u32 = {value}u; // {}\n", doc.trim());
-        }
-    }
-    s
+    tags::wgsl(
+        "facet_render::tags",
+        "crates/render/src/tags.rs",
+        "facet-render",
+        &all(),
+    )
 }

@@ -29,14 +29,7 @@ fn the_committed_wgsl_tags_are_the_generated_ones() {
 /// naga's view of the constants (the file as the GPU compiles it) against the Rust values.
 #[test]
 fn naga_reads_the_rust_values() {
-    let module = naga::front::wgsl::parse_str(&facet_render::tags::wgsl()).unwrap();
-    let mut found = std::collections::HashMap::new();
-    for (_, c) in module.constants.iter() {
-        if let naga::Expression::Literal(naga::Literal::U32(v)) = module.global_expressions[c.init]
-        {
-            found.insert(c.name.clone().unwrap(), v);
-        }
-    }
+    let found = facet_gpu::tags::u32_constants(&facet_render::tags::wgsl()).unwrap();
     let mut n = 0;
     for set in facet_render::tags::all() {
         for (name, value, _) in set.tags {
@@ -55,23 +48,7 @@ fn naga_reads_the_rust_values() {
 #[test]
 fn no_other_wgsl_file_defines_a_tag() {
     let prefixes: Vec<&str> = facet_render::tags::all().iter().map(|t| t.prefix).collect();
-    let mut offenders = Vec::new();
-    for name in facet_gpu::shader::all_files() {
-        if name == FILE {
-            continue;
-        }
-        let src = facet_gpu::shader::raw_source(name).unwrap();
-        for (i, line) in src.lines().enumerate() {
-            let l = line.trim_start();
-            for keyword in ["const ", "override "] {
-                if let Some(rest) = l.strip_prefix(keyword)
-                    && prefixes.iter().any(|p| rest.starts_with(p))
-                {
-                    offenders.push(format!("{name}:{}: {l}", i + 1));
-                }
-            }
-        }
-    }
+    let offenders = facet_gpu::tags::defined_elsewhere(FILE, &prefixes);
     assert!(
         offenders.is_empty(),
         "tags defined outside {FILE}:\n{}",

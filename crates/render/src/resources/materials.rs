@@ -7,8 +7,9 @@ use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
 use crate::scene::{FacetModel, GlintParams, Material};
 use facet_fit::model::material::ModelChoice;
-use facet_fit::model::microfacet::{Ndf, NdfKind};
+use facet_fit::model::microfacet::Ndf;
 use facet_fit::model::tabulated::TabulatedNdf;
+use facet_glint::tags::NdfTag;
 
 /// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
 pub const FRESNEL_NODES: usize = 91;
@@ -136,10 +137,7 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
     match &brdf.ndf {
         Ndf::Analytic(a) => {
             gpu.kind = MaterialKind::Analytic as u32;
-            gpu.ndf_kind = match a.kind {
-                NdfKind::Ggx => 0,
-                NdfKind::Beckmann => 1,
-            };
+            gpu.ndf_kind = NdfTag::from(a.kind) as u32;
             (gpu.alpha_x, gpu.alpha_y) = (a.alpha_x as f32, a.alpha_y as f32);
             gpu.rotation = a.rotation as f32;
             gpu.roughness = (a.alpha_x * a.alpha_y).sqrt() as f32;
