@@ -1,5 +1,5 @@
 // Include-only. The isotropic MERL grid in rows, as the CPU passes hold it
-// (`crates/fit/src/merl_geometry.rs`, `iso_grid.rs`): row r = θd bin + THETA_D · θh bin, of ROW
+// (`crates/fit/src/metric/merl_geometry.rs`, `metric/iso/`): row r = θd bin + THETA_D · θh bin, of ROW
 // φd bins. Its geometry is uploaded once per fitter: ROW + 1 cosines μ_k a row (bin k's
 // cos θo = μ_k, cos θi = μ_(ROW − k)) and λ(φ) of G2 per bin. A source adds its validity
 // flags (one bit a bin), and a model D per θh bin and Λ cos θ uniform in cos θ. Bindings 0–4
