@@ -219,10 +219,14 @@ fn fit_with(
 
     let t = Instant::now();
     let set = GridSamples::new(src);
-    if set.is_empty() {
+    if set.len() < crate::merl::MIN_VALID_SAMPLES {
         return Err(FitError::Extraction {
             name: src.name().into(),
-            problem: "no valid sample on the MERL grid".into(),
+            problem: format!(
+                "{} valid samples on the MERL grid; a fit needs at least {}",
+                set.len(),
+                crate::merl::MIN_VALID_SAMPLES
+            ),
         });
     }
     if let Some(s) = set.out_of_range() {
@@ -285,10 +289,10 @@ fn fit_with(
         Ok((f, [0.0; 3], e))
     };
     // The final steps' rows: with a diffuse lobe a quarter of the rows, the full grid without.
-    let final_steps = if diffuse {
-        set.diagonal(FINAL_STRIDE)
-    } else {
-        set.subsample(1)
+    // (A sparse source may hold no sample on the quarter: then the full grid.)
+    let final_steps = match diffuse.then(|| set.diagonal(FINAL_STRIDE)) {
+        Some(rows) if !rows.is_empty() => rows,
+        _ => set.subsample(1),
     };
     // A model with its F table and ρd solved.
     let solved = |m: &MicrofacetBrdf, f: &[Rgb], albedo: Rgb| MicrofacetBrdf {

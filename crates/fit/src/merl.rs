@@ -28,6 +28,12 @@ pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
 /// f_r = stored value × `SCALE[channel]`.
 pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 const HEADER_BYTES: u64 = 12;
+/// The fewest valid samples a source may hold to be fitted ([`MerlBrdf::from_table`] refuses a
+/// table with fewer, the fit any source with fewer on the grid). With a diffuse lobe the fit
+/// solves, per channel, F on each of the 90 θd bins and ρd, beside α: below these 92 unknowns
+/// every model can match the samples exactly, and the errors it reports say nothing. (Every
+/// pass runs on fewer: the extraction needs one backscattering sample.)
+pub const MIN_VALID_SAMPLES: usize = THETA_D_RES + 2;
 /// The largest stored value read as a measurement (f_r ≈ 7·10⁸ sr⁻¹, past any mirror-like
 /// MERL material): larger ones would overflow the extraction's sums.
 pub const MAX_STORED: f64 = 1e12;
@@ -457,7 +463,8 @@ impl MerlBrdf {
         })
     }
 
-    /// Wraps a table; fails if the table has no backscattering sample at all.
+    /// Wraps a table; fails if the table has no backscattering sample at all, or fewer than
+    /// [`MIN_VALID_SAMPLES`] valid samples.
     pub fn from_table(name: impl Into<String>, table: MerlTable) -> Result<Self, String> {
         let slice: Vec<Option<Rgb>> = (0..THETA_H_RES)
             .map(|i| {
@@ -470,7 +477,39 @@ impl MerlBrdf {
                 })
             })
             .collect();
-        let backscatter = fill_missing(&slice).ok_or("no valid backscattering sample (θd = 0)")?;
+        // The valid samples with both directions above the horizon (the fit's grid), the first
+        // `up_to` of them: a measured table holds MIN_VALID_SAMPLES in its first row.
+        let valid = |up_to: usize| {
+            let seen = |s: usize| {
+                let (i, j, k) = (
+                    s / (PHI_D_RES * THETA_D_RES),
+                    s / PHI_D_RES % THETA_D_RES,
+                    s % PHI_D_RES,
+                );
+                let (wi, wo) = from_half_diff(bin_angles(i, j, k));
+                wi.z > 0.0 && wo.z > 0.0
+            };
+            (0..SAMPLES)
+                .filter(|&s| table.value_at(s).is_some() && seen(s))
+                .take(up_to)
+                .count()
+        };
+        let Some(backscatter) = fill_missing(&slice) else {
+            return Err(format!(
+                "no valid backscattering sample (θd = 0) among its {} valid samples above the \
+                 horizon",
+                valid(SAMPLES)
+            ));
+        };
+        let n = valid(MIN_VALID_SAMPLES);
+        if n < MIN_VALID_SAMPLES {
+            return Err(format!(
+                "{n} valid sample{} above the horizon; a source needs at least \
+                 {MIN_VALID_SAMPLES} to be fitted (F on each of the {THETA_D_RES} θd bins and ρd \
+                 per channel, and α)",
+                if n == 1 { "" } else { "s" }
+            ));
+        }
         Ok(MerlBrdf {
             name: name.into(),
             table,
