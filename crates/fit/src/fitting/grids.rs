@@ -7,6 +7,7 @@ use crate::error::FitError;
 use crate::metric::grid::{CoarseGrid, GridSamples};
 use crate::metric::iso_tables::MAX_X;
 use crate::model::brdf::Brdf;
+use crate::model::merl_grid::MIN_VALID_SAMPLES;
 
 /// Every grid of one fit.
 pub(super) struct Grids {
@@ -35,10 +36,10 @@ impl Grids {
         check(src, &full)?;
         // The diffuse lobe is solved on the isotropic grid, on the CPU.
         let diffuse = cfg.diffuse && !cfg.anisotropic && full.iso.is_some();
-        let final_steps = if diffuse {
-            full.diagonal(FINAL_STRIDE)
-        } else {
-            full.subsample(1)
+        // (A sparse source may hold no sample on the quarter: then the full grid.)
+        let final_steps = match diffuse.then(|| full.diagonal(FINAL_STRIDE)) {
+            Some(rows) if !rows.is_empty() => rows,
+            _ => full.subsample(1),
         };
         let analytic = cfg.models.ggx || cfg.models.beckmann;
         let coarse = (analytic || diffuse)
@@ -59,12 +60,16 @@ impl Grids {
     }
 }
 
-/// A set the passes can use: not empty, every x = f_r cos θi finite and within ±[`MAX_X`].
+/// A set the passes can use: at least [`MIN_VALID_SAMPLES`], every x = f_r cos θi finite and
+/// within ±[`MAX_X`].
 fn check(src: &dyn Brdf, set: &GridSamples) -> Result<(), FitError> {
-    if set.is_empty() {
+    if set.len() < MIN_VALID_SAMPLES {
         return Err(FitError::Extraction {
             name: src.name().into(),
-            problem: "no valid sample on the MERL grid".into(),
+            problem: format!(
+                "{} valid samples on the MERL grid; a fit needs at least {MIN_VALID_SAMPLES}",
+                set.len()
+            ),
         });
     }
     if let Some(s) = set.out_of_range() {

@@ -192,7 +192,8 @@ impl FittedMaterial {
         record.fresnel.validate()?;
         let st = record.tabulated.stretch;
         check_alpha("tabulated.stretch", st.alpha_x, st.alpha_y, st.rotation)?;
-        let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)?;
+        let ndf = TabulatedNdf::new(record.tabulated.tables.clone(), record.tabulated.stretch)
+            .map_err(|e| format!("tabulated.tables: {e}"))?;
         Self::with_ndf(record, Arc::new(ndf))
     }
 
@@ -212,6 +213,7 @@ impl FittedMaterial {
 
     /// The models of a record whose Fresnel table and stretch are checked, with its NDF.
     fn with_ndf(record: FitRecord, ndf: Arc<TabulatedNdf>) -> Result<Self, String> {
+        check_normalised(&ndf)?;
         check_albedo("tabulated.diffuse", record.tabulated.diffuse)?;
         let tabulated = MicrofacetBrdf {
             name: format!("{}-tabulated", record.name),
@@ -313,6 +315,25 @@ fn check_alpha(field: &str, alpha_x: f64, alpha_y: f64, rotation: f64) -> Result
         "{field}: α = ({alpha_x}, {alpha_y}), rotation {rotation} (α must lie in [{:e}, {}], the rotation be finite)",
         range.start(),
         range.end()
+    ))
+}
+
+/// The widest factor by which a read NDF table's ∫ D cos θ dω may miss 1: 45 % is the table
+/// quadrature's own error at worst (a Beckmann NDF of α = 10⁻⁴ on 256 nodes; a constant D on
+/// two nodes: 41 %). A table off by more is no distribution but a scaled one: D = 10³⁸ gave
+/// one flake a DPF of P = 10³⁶, D = 10³⁰⁰ overflowed the DPF's f32 table to P = NaN.
+const NORMALISATION_SLACK: f64 = 10.0;
+
+/// The tabulated NDF of a fit read from a file is a distribution: ∫ D cos θ dω = 1 within
+/// [`NORMALISATION_SLACK`], or an error with the integral.
+fn check_normalised(ndf: &TabulatedNdf) -> Result<(), String> {
+    let area = ndf.projected_area();
+    if (1.0 / NORMALISATION_SLACK..=NORMALISATION_SLACK).contains(&area) {
+        return Ok(());
+    }
+    Err(format!(
+        "tabulated.tables: the NDF integrates to ∫ D cos θ dω = {area:e}, not 1 (a normal \
+         distribution; at most a factor of {NORMALISATION_SLACK} off is read)"
     ))
 }
 

@@ -25,6 +25,13 @@ pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
 pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 /// Bytes of a MERL file's header (three `i32` dimensions) before the values.
 pub(crate) const HEADER_BYTES: u64 = 12;
+/// The fewest valid samples a source may hold to be fitted
+/// ([`crate::sources::merl::MerlBrdf::from_table`] refuses a table with fewer, the fit any
+/// source with fewer on the grid). With a diffuse lobe the fit solves, per channel, F on each of
+/// the 90 θd bins and ρd, beside α: below these 92 unknowns every model can match the samples
+/// exactly, and the errors it reports say nothing. (Every pass runs on fewer: the extraction
+/// needs one backscattering sample.)
+pub const MIN_VALID_SAMPLES: usize = THETA_D_RES + 2;
 /// The largest stored value read as a measurement (f_r ≈ 7·10⁸ sr⁻¹, past any mirror-like
 /// MERL material): larger ones would overflow the extraction's sums.
 pub const MAX_STORED: f64 = 1e12;

@@ -105,6 +105,8 @@ pub struct TabulatedNdf {
     cdf: Vec<f64>,
     /// Mass of each cell divided by its solid angle: the sampling pdf inside it.
     cell_pdf: Vec<f64>,
+    /// The cells' total mass ∫ D₀ cos θ dω ([`Self::projected_area`]).
+    area: f64,
     /// The base table's visible-normal sampling tables, built on first use and shared by
     /// every stretch of the same table.
     visible: Arc<OnceLock<VisibleTables>>,
@@ -141,6 +143,10 @@ impl TabulatedNdf {
         if !(total > 0.0) {
             return Err("the NDF table is zero everywhere".into());
         }
+        // Values each finite whose sum is not: the cdf and the pdf would be 0 and NaN.
+        if !total.is_finite() {
+            return Err("the NDF table's integral ∫ D cos θ dω overflows".into());
+        }
         let mut acc = 0.0;
         let cdf = mass.iter().map(|m| {
             acc += m / total;
@@ -157,8 +163,16 @@ impl TabulatedNdf {
             stretch,
             cdf,
             cell_pdf,
+            area: total,
             visible: Arc::default(),
         })
+    }
+
+    /// ∫ D₀ cos θ dω of the unstretched table, summed over its sampling cells (the cells'
+    /// mean D at their mid-angle): 1 for a normalised NDF, up to the cells' quadrature error
+    /// (0.04 % for a GGX of α = 0.1 on 256 nodes, 39 % for α = 10⁻⁴).
+    pub fn projected_area(&self) -> f64 {
+        self.area
     }
 
     /// The tables, unstretched.

@@ -10,9 +10,10 @@
 use crate::error::FitError;
 use crate::io::mapped_file::MappedFile;
 use crate::model::brdf::Brdf;
+use crate::model::geometry::from_half_diff;
 use crate::model::merl_grid::{
-    HEADER_BYTES, MAX_STORED, MerlTable, PHI_D_RES, SAMPLES, Stored, THETA_D_RES, THETA_H_RES,
-    bin_angles, stored,
+    HEADER_BYTES, MAX_STORED, MIN_VALID_SAMPLES, MerlTable, PHI_D_RES, SAMPLES, Stored,
+    THETA_D_RES, THETA_H_RES, bin_angles, stored,
 };
 use crate::model::rgb::Rgb;
 use crate::numerics::interp::fill_missing;
@@ -222,7 +223,8 @@ impl MerlBrdf {
         })
     }
 
-    /// Wraps a table; fails if the table has no backscattering sample at all.
+    /// Wraps a table; fails if the table has no backscattering sample at all, or fewer than
+    /// [`MIN_VALID_SAMPLES`] valid samples.
     pub fn from_table(name: impl Into<String>, table: MerlTable) -> Result<Self, String> {
         let slice: Vec<Option<Rgb>> = (0..THETA_H_RES)
             .map(|i| {
@@ -235,7 +237,39 @@ impl MerlBrdf {
                 })
             })
             .collect();
-        let backscatter = fill_missing(&slice).ok_or("no valid backscattering sample (θd = 0)")?;
+        // The valid samples with both directions above the horizon (the fit's grid), the first
+        // `up_to` of them: a measured table holds MIN_VALID_SAMPLES in its first row.
+        let valid = |up_to: usize| {
+            let seen = |s: usize| {
+                let (i, j, k) = (
+                    s / (PHI_D_RES * THETA_D_RES),
+                    s / PHI_D_RES % THETA_D_RES,
+                    s % PHI_D_RES,
+                );
+                let (wi, wo) = from_half_diff(bin_angles(i, j, k));
+                wi.z > 0.0 && wo.z > 0.0
+            };
+            (0..SAMPLES)
+                .filter(|&s| table.value_at(s).is_some() && seen(s))
+                .take(up_to)
+                .count()
+        };
+        let Some(backscatter) = fill_missing(&slice) else {
+            return Err(format!(
+                "no valid backscattering sample (θd = 0) among its {} valid samples above the \
+                 horizon",
+                valid(SAMPLES)
+            ));
+        };
+        let n = valid(MIN_VALID_SAMPLES);
+        if n < MIN_VALID_SAMPLES {
+            return Err(format!(
+                "{n} valid sample{} above the horizon; a source needs at least \
+                 {MIN_VALID_SAMPLES} to be fitted (F on each of the {THETA_D_RES} θd bins and ρd \
+                 per channel, and α)",
+                if n == 1 { "" } else { "s" }
+            ));
+        }
         Ok(MerlBrdf {
             name: name.into(),
             table,

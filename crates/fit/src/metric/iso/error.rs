@@ -23,12 +23,15 @@ impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
 
     /// The error sums of a model's D, G and ρd/π with each of `fresnels` (F per θd bin) in
     /// place of its own F: one pass, each row's G2 / (4 cos θo) formed once for all of them.
+    /// One sum per table, zero on a set without rows.
     pub fn log_error_sums(&self, tables: &IsoTables, fresnels: &[[Rgb; THETA_D_RES]]) -> Vec<f64> {
-        self.run(&ErrorSums {
+        let mut sums = self.run(&ErrorSums {
             set: self,
             tables,
             fresnels,
-        })
+        });
+        sums.resize(fresnels.len(), 0.0);
+        sums
     }
 }
 

@@ -206,6 +206,7 @@ impl RglBsdf {
         if jacobian.len() != 1 {
             return Err(format!("`jacobian` holds {} bytes, not 1", jacobian.len()));
         }
+        check_values(&tf, field, &data, jacobian[0] != 0)?;
         let description = String::from_utf8_lossy(tf.u8s("description")?).into_owned();
         let isotropic = nphi <= 2;
         let reduction = if isotropic {
@@ -282,6 +283,43 @@ impl RglBsdf {
             u_m,
             params: [phi_i, theta_i],
         }
+    }
+}
+
+/// Refuses the values that pass the shapes and finiteness checks of [`RglBsdf::parse`] but
+/// make no material: data (`rgb` or `spectra`) with no positive mass, a negated or zero table
+/// that reads as black or as nothing; with the Jacobian (f cos θo = data · D / 4σ), an `ndf`
+/// with no positive mass, or a projected area `sigma` that is not positive somewhere, where
+/// f cos θo would be infinite (and is missing in [`RglBsdf::eval`]). A measured file's few
+/// negative values (noise, colours out of gamut) are kept: evaluation clips them at zero, as
+/// brdf-loader does with `POWITACQ_CLIP_RGB`; Mitsuba 3's `measured` plugin reads any values.
+fn check_values(tf: &TensorFile, field: &str, data: &[f64], jacobian: bool) -> Result<(), String> {
+    let mass = |field: &str, v: &[f64]| {
+        let sum: f64 = v.iter().sum();
+        if sum > 0.0 {
+            return Ok(());
+        }
+        let negative = v.iter().filter(|&&x| x < 0.0).count();
+        Err(format!(
+            "`{field}` has no positive mass: its {} values sum to {sum:e} ({negative} negative)",
+            v.len()
+        ))
+    };
+    mass(field, data)?;
+    if !jacobian {
+        return Ok(());
+    }
+    mass("ndf", &tf.floats("ndf")?.0)?;
+    let (sigma, shape) = tf.floats("sigma")?;
+    match sigma.iter().position(|&v| !(v > 0.0)) {
+        None => Ok(()),
+        Some(at) => Err(format!(
+            "`sigma` is {:e} at row {}, column {}: a projected area is positive (the data's \
+             Jacobian D / 4σ divides by it)",
+            sigma[at],
+            at / shape[1],
+            at % shape[1]
+        )),
     }
 }
 
