@@ -11,6 +11,7 @@ use crate::integrator::{Integrator, RenderConfig, RenderStats};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::resources::SceneResources;
+use crate::tags::SlotState;
 use crate::tonemap::ToneMap;
 use facet_gpu::timer::GpuTimer;
 use facet_gpu::{Gpu, buffer};
@@ -98,26 +99,15 @@ pub fn frame_uniform(
         max_depth: config.max_depth,
         seed: config.seed,
         rr_depth: config.rr_depth,
-        n_vertices: scene.n_vertices,
-        n_lights: scene.n_lights,
-        light_cdf: scene.light_cdf,
-        env_kind: scene.env_kind,
-        env_width: scene.env_size.0,
-        env_height: scene.env_size.1,
-        env_texels: scene.env_offsets.0,
-        env_marginal: scene.env_offsets.1,
-        env_conditional: scene.env_offsets.2,
-        scene_radius: scene.scene_radius,
         ray_epsilon: 1e-5,
         strategy: config.strategy as u32,
         ndf_sampling: config.ndf_sampling as u32,
-        moments: 0,
-        pad: 0,
-        env_color: scene.env_color,
+        scene: scene.scene_info,
         cam_pos: camera.position.extend(tan_half).to_array(),
         cam_forward: camera.forward.extend(aspect).to_array(),
         cam_up: camera.up.extend(spread).to_array(),
         cam_right: camera.right.extend(0.0).to_array(),
+        ..Default::default()
     }
 }
 
@@ -367,7 +357,7 @@ impl Wavefront {
                 frame.sample_end = end;
                 gpu.queue
                     .write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
-                let start: Vec<[u32; 4]> = vec![[0, begin, 0, 0]; frame.tile_pixels as usize];
+                let start: Vec<[u32; 4]> = vec![[SlotState::Start as u32, begin, 0, 0]; frame.tile_pixels as usize];
                 gpu.queue
                     .write_buffer(&self.info, 0, bytemuck::cast_slice(&start));
                 gpu.queue
@@ -474,7 +464,7 @@ impl Wavefront {
         frame.tile_pixels = pixels.min(self.slots as u64) as u32;
         frame.sample_end = config.spp.max(1);
         q.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(&frame));
-        let start: Vec<[u32; 4]> = vec![[0, 0, 0, 0]; frame.tile_pixels as usize];
+        let start: Vec<[u32; 4]> = vec![[SlotState::Start as u32, 0, 0, 0]; frame.tile_pixels as usize];
         q.write_buffer(&self.info, 0, bytemuck::cast_slice(&start));
         q.write_buffer(&self.counters, 0, &vec![0u8; self.n_queues as usize * 4]);
         let all_slots = facet_gpu::dispatch::workgroups(self.slots, integrator.workgroup());
