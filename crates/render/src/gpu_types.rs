@@ -60,7 +60,7 @@ pub struct GpuFrame {
     pub strategy: u32,
     /// [`NdfSampling`](crate::tags::NdfSampling) as `u32`.
     pub ndf_sampling: u32,
-    /// 1: the film's squares are accumulated too (`Wavefront::with_variance`).
+    /// 1: the film's squares are accumulated too (`Integrator::wavefront_with_variance`).
     pub moments: u32,
     pub pad0: u32,
     pub pad1: u32,

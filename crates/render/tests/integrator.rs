@@ -9,7 +9,9 @@ use facet_render::camera::CameraFrame;
 use facet_render::scene::{
     Camera, Environment, FacetMaterial, FacetModel, GlintParams, Material, Scene,
 };
-use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::{
+    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use glam::{DVec3, Vec3, Vec4};
 use std::sync::{Arc, OnceLock};
 
@@ -98,11 +100,16 @@ fn render(
 
 fn config(spp: u32) -> RenderConfig {
     RenderConfig {
-        width: SIZE,
-        height: SIZE,
-        spp,
-        max_depth: 8,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: SIZE,
+            height: SIZE,
+            ..ImageConfig::preview()
+        },
+        sampling: SampleConfig {
+            spp,
+            max_depth: 8,
+            ..SampleConfig::preview()
+        },
     }
 }
 
@@ -346,10 +353,8 @@ fn glint_threshold_decides_which_footprints_are_counted() {
         let res = SceneResources::new(&gpu, &scene, None, rc).unwrap();
         let integrator = Integrator::new(&gpu.device, &res).unwrap();
         let camera = CameraFrame::new(&scene.camera).unwrap();
-        let c = RenderConfig {
-            max_depth: 1,
-            ..config(1)
-        };
+        let mut c = config(1);
+        c.sampling.max_depth = 1;
         integrator
             .render(&gpu, &res, &camera, &c, &mut |_| {})
             .unwrap()
@@ -422,19 +427,13 @@ fn same_seed_same_image() {
     };
     let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
     let scene = sphere_scene(facet_material(FacetModel::Tabulated, None));
-    let c = RenderConfig {
-        wavefront: 1000, // several tiles
-        ..config(4)
-    };
+    let mut c = config(4);
+    c.image.wavefront = 1000; // several tiles
     let (a, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
     let (b, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
-    let (other, _, _) = render(
-        &gpu,
-        &scene,
-        &env,
-        ResourceConfig::standard(),
-        RenderConfig { seed: 7, ..c },
-    );
+    let mut seven = c;
+    seven.sampling.seed = 7;
+    let (other, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), seven);
     assert_eq!(a.pixels, b.pixels);
     assert_ne!(a.pixels, other.pixels);
     assert!(a.samples.iter().all(|&s| s == 4));
@@ -551,23 +550,25 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
     let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
     let camera = CameraFrame::new(&scene.camera).unwrap();
-    let c = RenderConfig {
-        wavefront: 1000, // several tiles
-        ..config(2)
-    };
+    let mut c = config(2);
+    c.image.wavefront = 1000; // several tiles
     let fresh = |seed: u32, spp: u32| {
-        let c = RenderConfig { seed, spp, ..c };
+        let mut c = c;
+        (c.sampling.seed, c.sampling.spp) = (seed, spp);
         integrator
             .render(&gpu, &res, &camera, &c, &mut |_| {})
             .unwrap()
             .0
     };
-    let mut wf =
-        facet_render::Wavefront::new(&gpu, &integrator, &res, SIZE, SIZE, c.wavefront).unwrap();
+    let mut wf = integrator.wavefront(&gpu, &res, c.image).unwrap();
     for seed in [3, 9] {
         wf.clear(&gpu);
-        let c = RenderConfig { seed, ..c };
-        wf.render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+        let s = SampleConfig {
+            seed,
+            ..c.sampling
+        };
+        integrator
+            .render_more(&gpu, &mut wf, &camera, &s, &mut |_| {})
             .unwrap();
         assert_eq!(
             wf.image(&gpu).unwrap().pixels,
@@ -577,8 +578,8 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
     }
     wf.clear(&gpu);
     for _ in 0..4 {
-        let stats = wf
-            .render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+        let stats = integrator
+            .render_more(&gpu, &mut wf, &camera, &c.sampling, &mut |_| {})
             .unwrap();
         assert_eq!(stats.spp, 2);
     }
@@ -628,16 +629,22 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
     let camera = CameraFrame::new(&scene.camera).unwrap();
-    let mut wf =
-        facet_render::Wavefront::with_variance(&gpu, &integrator, &res, SIZE, SIZE, 1 << 16)
-            .unwrap();
+    let image = ImageConfig {
+        width: SIZE,
+        height: SIZE,
+        wavefront: 1 << 16,
+    };
+    let mut wf = integrator
+        .wavefront_with_variance(&gpu, &res, image)
+        .unwrap();
     let mut at = |spp: u32, seed: u32| {
         wf.clear(&gpu);
-        let c = RenderConfig {
+        let c = SampleConfig {
             seed,
-            ..config(spp)
+            ..config(spp).sampling
         };
-        wf.render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+        integrator
+            .render_more(&gpu, &mut wf, &camera, &c, &mut |_| {})
             .unwrap();
         (wf.image(&gpu).unwrap(), wf.variance(&gpu).unwrap().unwrap())
     };
@@ -670,6 +677,6 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     assert!((m16 / spread - 1.0).abs() < 0.15, "{m16} vs {spread}");
     assert!(a4.samples.iter().all(|&s| s == 4) && v16.samples.iter().all(|&s| s == 16));
     // Without the moments there is no variance.
-    let plain = facet_render::Wavefront::new(&gpu, &integrator, &res, SIZE, SIZE, 1 << 16).unwrap();
+    let plain = integrator.wavefront(&gpu, &res, image).unwrap();
     assert!(plain.variance(&gpu).unwrap().is_none());
 }

@@ -4,7 +4,9 @@
 use facet_fit::material::FittedMaterial;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, FacetModel, Material, Scene};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::{
+    ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use glam::Vec3;
 use std::path::Path;
 use std::sync::Arc;
@@ -34,10 +36,15 @@ fn sphere_scene(fit: FittedMaterial, model: FacetModel) -> Scene {
 fn render(gpu: &facet_gpu::Gpu, res: &SceneResources, scene: &Scene) -> facet_render::Image {
     let integrator = Integrator::new(&gpu.device, res).unwrap();
     let cfg = RenderConfig {
-        width: 48,
-        height: 48,
-        spp: 2,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: 48,
+            height: 48,
+            ..ImageConfig::preview()
+        },
+        sampling: SampleConfig {
+            spp: 2,
+            ..SampleConfig::preview()
+        },
     };
     let cam = CameraFrame::new(&scene.camera).unwrap();
     integrator

@@ -12,7 +12,7 @@
 use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
+use facet_render::{ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources, Wavefront};
 use glam::Vec3;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
@@ -22,7 +22,7 @@ use std::time::Instant;
 pub const SPHERE: usize = 1;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
-pub use facet_render::wavefront::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
+pub use facet_render::pacing::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
 
 /// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -282,7 +282,13 @@ fn build(gpu: &Gpu, scene: &Scene, env: &Environment, size: (u32, u32)) -> Resul
     let res = SceneResources::new(gpu, scene, Some(env), ResourceConfig::standard())
         .map_err(|e| e.to_string())?;
     let integrator = Integrator::new(&gpu.device, &res).map_err(|e| e.to_string())?;
-    let wavefront = Wavefront::new(gpu, &integrator, &res, size.0, size.1, size.0 * size.1)
+    let image = ImageConfig {
+        width: size.0,
+        height: size.1,
+        wavefront: size.0 * size.1,
+    };
+    let wavefront = integrator
+        .wavefront(gpu, &res, image)
         .map_err(|e| e.to_string())?;
     Ok(Built {
         res,
@@ -412,20 +418,18 @@ fn worker(
         let t = Instant::now();
         let sampling = built.wavefront.spp() < MAX_SAMPLES;
         if sampling {
-            let cfg = RenderConfig {
-                width,
-                height,
+            let cfg = SampleConfig {
                 spp: batch.min(MAX_SAMPLES - built.wavefront.spp()),
                 spp_per_pass: MAX_SPP_PER_FRAME,
-                ..RenderConfig::preview()
+                ..SampleConfig::preview()
             };
             let Built {
-                res,
                 integrator,
                 wavefront,
+                ..
             } = &mut built;
-            wavefront
-                .render_more(&gpu, integrator, res, &camera, &cfg, &mut |_| {})
+            integrator
+                .render_more(&gpu, wavefront, &camera, &cfg, &mut |_| {})
                 .map_err(|e| format!("preview render: {e}"))?;
         } else if !retone {
             continue;
