@@ -587,7 +587,7 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         facet: Some(facet_render::scene::FacetMaterial {
             source: "default_fit.json".into(),
             fit: Arc::new(fit),
-            model: facet_render::scene::FacetModel::Ggx,
+            model: facet_fit::material::ModelChoice::Ggx,
             glint: None,
         }),
         ..Default::default()
@@ -636,11 +636,11 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
 
 /// A fit of an analytic GGX gold conductor, as a Facet material rendering its GGX model.
 fn gold_ggx(alpha: f64) -> Result<Material> {
-    gold_fit(alpha, facet_render::scene::FacetModel::Ggx)
+    gold_fit(alpha, facet_fit::material::ModelChoice::Ggx)
 }
 
 /// A fit of gold GGX(α) written as a MERL table, rendered by `model` of the fit.
-fn gold_fit(alpha: f64, model: facet_render::scene::FacetModel) -> Result<Material> {
+fn gold_fit(alpha: f64, model: facet_fit::material::ModelChoice) -> Result<Material> {
     let spec = format!("ggx?alpha={alpha}&conductor=gold");
     let truth = facet_fit::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
     let src = MerlBrdf::from_table(&spec, MerlTable::sample(&truth))
@@ -704,7 +704,7 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let (side, spp) = sizes.noise;
     let (demo, sky) = demo_scene(true)?;
     let glossy = facet_render::scene::shapes::preview_scene(gold_ggx(0.05)?);
-    let tabulated = gold_fit(0.3, facet_render::scene::FacetModel::Tabulated)?;
+    let tabulated = gold_fit(0.3, facet_fit::material::ModelChoice::Tabulated)?;
     let scenes = [
         (
             "gold sphere, sky and point light",

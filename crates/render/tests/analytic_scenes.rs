@@ -17,7 +17,7 @@ use facet_fit::microfacet::{AnalyticNdf, NdfKind, correlation, g2};
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{
-    Camera, Environment, EnvironmentMap, FacetMaterial, FacetModel, Light, Material, Scene, Texture,
+    Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, Scene, Texture,
 };
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
@@ -894,7 +894,7 @@ fn rotated_anisotropic_ggx_sphere_matches_the_cpu_evaluator() {
         facet: Some(FacetMaterial {
             source: "aniso.json".into(),
             fit: fitted.clone(),
-            model: FacetModel::Ggx,
+            model: ModelChoice::Ggx,
             glint: None,
         }),
         ..Default::default()

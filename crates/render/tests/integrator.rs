@@ -1,13 +1,13 @@
 //! The wavefront integrator against theory: white furnaces, the glints' smooth limit and their
 //! filtered switch, only-what-is-needed resources, determinism. GPU tests (lavapipe in CI).
 
-use facet_fit::material::FittedMaterial;
+use facet_fit::material::{FittedMaterial, ModelChoice};
 use facet_fit::merl::{MerlBrdf, MerlTable};
 use facet_fit::microfacet::MicrofacetBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{
-    Camera, Environment, FacetMaterial, FacetModel, GlintParams, Material, Scene,
+    Camera, Environment, FacetMaterial, GlintParams, Material, Scene,
 };
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
@@ -65,7 +65,7 @@ fn conductor_fit() -> Arc<FittedMaterial> {
     .clone()
 }
 
-fn facet_material(model: FacetModel, glint: Option<GlintParams>) -> Material {
+fn facet_material(model: ModelChoice, glint: Option<GlintParams>) -> Material {
     Material {
         name: format!("{model:?}"),
         facet: Some(FacetMaterial {
@@ -160,17 +160,11 @@ fn white_furnace_conductor_matches_cpu_albedo() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    for model in [FacetModel::Ggx, FacetModel::Beckmann, FacetModel::Tabulated] {
+    for model in [ModelChoice::Ggx, ModelChoice::Beckmann, ModelChoice::Tabulated] {
         let scene = sphere_scene(facet_material(model, None));
         let (img, built, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(32));
         let fit = conductor_fit();
-        let brdf: &MicrofacetBrdf = fit
-            .model(match model {
-                FacetModel::Ggx => facet_fit::material::ModelChoice::Ggx,
-                FacetModel::Beckmann => facet_fit::material::ModelChoice::Beckmann,
-                FacetModel::Tabulated => facet_fit::material::ModelChoice::Tabulated,
-            })
-            .unwrap();
+        let brdf: &MicrofacetBrdf = fit.model(model).unwrap();
         // E(θo) tabulated every degree, interpolated per pixel.
         let table: Vec<f64> = (0..=90)
             .map(|deg| {
@@ -212,10 +206,10 @@ fn scene_without_glints_builds_no_glint_resources() {
     let Some(gpu) = gpu_for_tests("scene_without_glints_builds_no_glint_resources") else {
         return;
     };
-    let mut scene = sphere_scene(facet_material(FacetModel::Ggx, None));
+    let mut scene = sphere_scene(facet_material(ModelChoice::Ggx, None));
     // A glint material that no triangle uses costs nothing either.
     scene.materials.push(facet_material(
-        FacetModel::Ggx,
+        ModelChoice::Ggx,
         Some(GlintParams {
             density: 1e6,
             gamma_deg: 2.0,
@@ -242,7 +236,7 @@ fn scene_without_glints_builds_no_glint_resources() {
 
 fn glint(density: f32, threshold: f32) -> Material {
     facet_material(
-        FacetModel::Ggx,
+        ModelChoice::Ggx,
         Some(GlintParams {
             density,
             gamma_deg: 5.0,
@@ -260,7 +254,7 @@ fn glints_with_huge_density_render_the_smooth_model() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    for model in [FacetModel::Ggx, FacetModel::Tabulated] {
+    for model in [ModelChoice::Ggx, ModelChoice::Tabulated] {
         let (smooth, _, _) = render(
             &gpu,
             &sphere_scene(facet_material(model, None)),
@@ -426,7 +420,7 @@ fn same_seed_same_image() {
         return;
     };
     let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let scene = sphere_scene(facet_material(FacetModel::Tabulated, None));
+    let scene = sphere_scene(facet_material(ModelChoice::Tabulated, None));
     let mut c = config(4);
     c.image.wavefront = 1000; // several tiles
     let (a, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
@@ -546,7 +540,7 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
         return;
     };
     let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let scene = sphere_scene(facet_material(FacetModel::Tabulated, None));
+    let scene = sphere_scene(facet_material(ModelChoice::Tabulated, None));
     let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
     let camera = CameraFrame::new(&scene.camera).unwrap();
@@ -620,7 +614,7 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     let Some(gpu) = gpu_for_tests("reported_variance_matches_the_seed_to_seed_spread") else {
         return;
     };
-    let mut scene = sphere_scene(facet_material(FacetModel::Ggx, None));
+    let mut scene = sphere_scene(facet_material(ModelChoice::Ggx, None));
     scene.lights.push(facet_render::scene::Light::Directional {
         direction: Vec3::new(0.3, -0.4, -1.0).normalize(),
         irradiance: Vec3::splat(2.0),

@@ -3,7 +3,7 @@
 
 use crate::material::{EditedMaterial, MaterialKey, Shown};
 use egui::{Color32, Pos2, Rect, Stroke, Ui, pos2, vec2};
-use facet_fit::material::{FittedMaterial, ModelChoice};
+use facet_fit::material::FittedMaterial;
 use glam::DVec3;
 use std::sync::{Arc, Mutex};
 
@@ -65,11 +65,7 @@ pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
             .collect()
     };
     let data = slice(&m.base.tabulated.ndf);
-    let choice = match m.model() {
-        facet_render::scene::FacetModel::Tabulated => ModelChoice::Tabulated,
-        facet_render::scene::FacetModel::Ggx => ModelChoice::Ggx,
-        facet_render::scene::FacetModel::Beckmann => ModelChoice::Beckmann,
-    };
+    let choice = m.model();
     let edited = edited_fit(m);
     let model = edited
         .as_ref()

@@ -11,7 +11,7 @@ use facet_fit::material::{FittedMaterial, ModelChoice};
 use facet_fit::nbrdf::NbrdfLibrary;
 use facet_glint::dpf::{dpf, query_directions};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{Environment, FacetMaterial, FacetModel, Material, shapes};
+use facet_render::scene::{Environment, FacetMaterial, Material, shapes};
 use facet_render::{
     Gpu, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
@@ -52,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         facet: Some(FacetMaterial {
             source: json.clone(),
             fit: Arc::new(loaded),
-            model: FacetModel::Tabulated,
+            model: ModelChoice::Tabulated,
             glint: None,
         }),
         ..Material::default()

@@ -5,8 +5,7 @@ use super::tables::Tables;
 use crate::error::RenderError;
 use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
-use crate::scene::{FacetModel, GlintParams, Material};
-use facet_fit::material::ModelChoice;
+use crate::scene::{GlintParams, Material};
 use facet_fit::microfacet::{Ndf, NdfKind};
 use facet_fit::tabulated::TabulatedNdf;
 
@@ -174,12 +173,7 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
             glint: None,
         });
     };
-    let choice = match f.model {
-        FacetModel::Tabulated => ModelChoice::Tabulated,
-        FacetModel::Ggx => ModelChoice::Ggx,
-        FacetModel::Beckmann => ModelChoice::Beckmann,
-    };
-    let brdf = f.fit.model(choice).ok_or_else(|| {
+    let brdf = f.fit.model(f.model).ok_or_else(|| {
         RenderError::input(
             &f.source,
             format!("material {:?}: the fit has no {:?} model", m.name, f.model),
