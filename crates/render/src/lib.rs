@@ -28,6 +28,7 @@
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bindings;
 pub mod bvh;
 pub mod camera;
 pub mod config;

@@ -5,6 +5,7 @@
 //! film accumulates, continuing each pixel's sample indices, so 4 calls of 2 spp give the
 //! pixels of one 8 spp render with the same seed.
 
+use crate::bindings::{Group, bind_group};
 use crate::config::ImageConfig;
 use crate::error::RenderError;
 use crate::film::Image;
@@ -299,87 +300,39 @@ impl Buffers {
 }
 
 impl Groups {
-    fn new(
-        d: &wgpu::Device,
-        layouts: &Layouts,
-        b: &Buffers,
-        scene: &SceneResources,
-    ) -> Self {
-        let group = |layout: &wgpu::BindGroupLayout, label, res: &[wgpu::BindingResource]| {
-            let entries: Vec<wgpu::BindGroupEntry> = res
-                .iter()
-                .enumerate()
-                .map(|(i, r)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: r.clone(),
-                })
-                .collect();
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout,
-                entries: &entries,
-            })
+    fn new(d: &wgpu::Device, layouts: &Layouts, b: &Buffers, scene: &SceneResources) -> Self {
+        let group = |g: Group, named: &[(&str, wgpu::BindingResource)]| {
+            bind_group(d, layouts.of(g), g, named)
         };
         let frame = group(
-            &layouts.frame,
-            "frame",
+            Group::Frame,
             &[
-                b.frame.as_entire_binding(),
-                b.paths.as_entire_binding(),
-                b.info.as_entire_binding(),
-                b.counters.as_entire_binding(),
-                b.sizes.as_entire_binding(),
-                b.queues.as_entire_binding(),
-                b.film.as_entire_binding(),
-                b.film_sq.as_entire_binding(),
+                ("frame", b.frame.as_entire_binding()),
+                ("paths", b.paths.as_entire_binding()),
+                ("info", b.info.as_entire_binding()),
+                ("counters", b.counters.as_entire_binding()),
+                ("sizes", b.sizes.as_entire_binding()),
+                ("queues", b.queues.as_entire_binding()),
+                ("film", b.film.as_entire_binding()),
+                ("film_sq", b.film_sq.as_entire_binding()),
             ],
         );
-        let scene_group = group(
-            &layouts.scene,
-            "scene",
-            &[
-                scene.bvh.nodes.as_entire_binding(),
-                scene.bvh.primitives.as_entire_binding(),
-                scene.bvh.triangles.as_entire_binding(),
-                scene.vertices.as_entire_binding(),
-                scene.triangles.as_entire_binding(),
-                scene.materials.as_entire_binding(),
-                scene.textures.as_entire_binding(),
-                scene.lights.as_entire_binding(),
-                scene.tables.as_entire_binding(),
-                scene.triangle_light.as_entire_binding(),
-            ],
-        );
-        let glint = scene
-            .glints
-            .iter()
-            .map(|g| {
-                group(
-                    &layouts.glint,
-                    "glint",
-                    &[
-                        g.field.as_entire_binding(),
-                        g.params.as_entire_binding(),
-                        wgpu::BindingResource::TextureView(&g.level0),
-                        wgpu::BindingResource::TextureView(&g.level1),
-                        g.split_table.as_entire_binding(),
-                    ],
-                )
-            })
-            .collect();
         let args = group(
-            &layouts.queue_args,
-            "queue args",
+            Group::QueueArgs,
             &[
-                b.counters.as_entire_binding(),
-                b.sizes.as_entire_binding(),
-                b.args.as_entire_binding(),
+                ("counters", b.counters.as_entire_binding()),
+                ("sizes", b.sizes.as_entire_binding()),
+                ("args", b.args.as_entire_binding()),
             ],
         );
         Groups {
             frame,
-            scene: scene_group,
-            glint,
+            scene: group(Group::Scene, &scene.bindings()),
+            glint: scene
+                .glints
+                .iter()
+                .map(|g| group(Group::Glint, &g.bindings()))
+                .collect(),
             args,
         }
     }

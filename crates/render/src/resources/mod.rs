@@ -410,7 +410,38 @@ fn check_buffers(
     Ok(())
 }
 
+impl GlintResources {
+    /// Its bind group's resources, named as `shade_glint.wgsl` names them
+    /// ([`Group::Glint`](crate::bindings::Group::Glint)).
+    pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 5] {
+        [
+            ("field", self.field.as_entire_binding()),
+            ("params", self.params.as_entire_binding()),
+            ("level0", wgpu::BindingResource::TextureView(&self.level0)),
+            ("level1", wgpu::BindingResource::TextureView(&self.level1)),
+            ("split_table", self.split_table.as_entire_binding()),
+        ]
+    }
+}
+
 impl SceneResources {
+    /// Its bind group's resources, named as `scene.inc.wgsl` names them
+    /// ([`Group::Scene`](crate::bindings::Group::Scene)).
+    pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 10] {
+        [
+            ("bvh_nodes", self.bvh.nodes.as_entire_binding()),
+            ("bvh_primitives", self.bvh.primitives.as_entire_binding()),
+            ("bvh_triangles", self.bvh.triangles.as_entire_binding()),
+            ("vertices", self.vertices.as_entire_binding()),
+            ("triangles", self.triangles.as_entire_binding()),
+            ("materials", self.materials.as_entire_binding()),
+            ("textures", self.textures.as_entire_binding()),
+            ("lights", self.lights.as_entire_binding()),
+            ("tables", self.tables.as_entire_binding()),
+            ("triangle_light", self.triangle_light.as_entire_binding()),
+        ]
+    }
+
     /// Rewrites material `index` in place from `scene.materials[index]`: its α, rotation,
     /// Fresnel table and diffuse albedo, at the offsets it already has. Edits that change
     /// the material's class, its NDF kind, its tables or its glint pyramids (another fit,
