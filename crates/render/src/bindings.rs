@@ -117,11 +117,7 @@ impl Group {
                 ("level1", Texture3d),
                 ("split_table", StorageReadOnly),
             ],
-            Group::QueueArgs => &[
-                ("counters", Storage),
-                ("sizes", Storage),
-                ("args", Storage),
-            ],
+            Group::QueueArgs => &[("counters", Storage), ("sizes", Storage), ("args", Storage)],
         }
     }
 

@@ -49,12 +49,12 @@ pub mod trace;
 pub mod wavefront;
 
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
+pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Strategy};
 pub use error::RenderError;
 pub use facet_gpu::{Gpu, GpuError};
 pub use film::Image;
 /// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
 pub use glam;
-pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Strategy};
 pub use integrator::{Integrator, RenderStats, StageClock, StageTime};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;

@@ -40,7 +40,7 @@ fn wgsl_bindings(file: &str) -> Vec<(u32, u32, String, BindingKind)> {
             Some((b.group, b.binding, name, kind))
         })
         .collect();
-    out.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)));
+    out.sort_by_key(|b| (b.0, b.1));
     out
 }
 
@@ -75,9 +75,9 @@ fn every_group_list_is_the_wgsl_globals_of_its_pipelines() {
         let mut used: Vec<u32> = wgsl.iter().map(|b| b.0).collect();
         used.dedup();
         for n in used {
-            let group = groups
-                .get(n as usize)
-                .unwrap_or_else(|| panic!("{file} declares @group({n}), its layout has no such group"));
+            let group = groups.get(n as usize).unwrap_or_else(|| {
+                panic!("{file} declares @group({n}), its layout has no such group")
+            });
             let in_wgsl: Vec<_> = wgsl.iter().filter(|b| b.0 == n).cloned().collect();
             assert_eq!(
                 in_wgsl,
@@ -102,7 +102,10 @@ fn every_integrator_pipeline_is_listed() {
             .iter()
             .any(|(g, b, name, _)| (*g, *b, name.as_str()) == (0, 0, "frame"));
         if binds_frame {
-            assert!(pipeline_groups(file).is_some(), "{file} is not in PIPELINES");
+            assert!(
+                pipeline_groups(file).is_some(),
+                "{file} is not in PIPELINES"
+            );
         }
     }
     for g in Group::ALL {

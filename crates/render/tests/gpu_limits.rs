@@ -6,7 +6,8 @@ use facet_gpu::{Gpu, GpuOptions};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
 use facet_render::{
-    ImageConfig, Integrator, RenderConfig, RenderError, ResourceConfig, SampleConfig, SceneResources,
+    ImageConfig, Integrator, RenderConfig, RenderError, ResourceConfig, SampleConfig,
+    SceneResources,
 };
 use glam::Vec3;
 use std::sync::Arc;

@@ -6,9 +6,7 @@ use facet_fit::merl::{MerlBrdf, MerlTable};
 use facet_fit::microfacet::MicrofacetBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{
-    Camera, Environment, FacetMaterial, GlintParams, Material, Scene,
-};
+use facet_render::scene::{Camera, Environment, FacetMaterial, GlintParams, Material, Scene};
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
@@ -160,7 +158,11 @@ fn white_furnace_conductor_matches_cpu_albedo() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    for model in [ModelChoice::Ggx, ModelChoice::Beckmann, ModelChoice::Tabulated] {
+    for model in [
+        ModelChoice::Ggx,
+        ModelChoice::Beckmann,
+        ModelChoice::Tabulated,
+    ] {
         let scene = sphere_scene(facet_material(model, None));
         let (img, built, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(32));
         let fit = conductor_fit();
@@ -557,10 +559,7 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
     let mut wf = integrator.wavefront(&gpu, &res, c.image).unwrap();
     for seed in [3, 9] {
         wf.clear(&gpu);
-        let s = SampleConfig {
-            seed,
-            ..c.sampling
-        };
+        let s = SampleConfig { seed, ..c.sampling };
         integrator
             .render_more(&gpu, &mut wf, &camera, &s, &mut |_| {})
             .unwrap();

@@ -12,7 +12,9 @@
 use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
-use facet_render::{ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources, Wavefront};
+use facet_render::{
+    ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources, Wavefront,
+};
 use glam::Vec3;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};

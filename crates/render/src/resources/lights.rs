@@ -235,7 +235,11 @@ impl ProbeMean {
             .iter()
             .map(|q| {
                 let v = x - q.p;
-                g(v.normalize_or_zero(), v.length_squared().max(self.near), q.n)
+                g(
+                    v.normalize_or_zero(),
+                    v.length_squared().max(self.near),
+                    q.n,
+                )
             })
             .sum::<f32>()
             / self.probes.len().max(1) as f32

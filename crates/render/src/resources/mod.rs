@@ -312,8 +312,7 @@ fn plan_materials(
             built.tabulated_tables += 1;
         }
         if let Some((ndf, spec)) = plan.glint {
-            plan.slot
-                .set_queue(Queue::Glint(glint_specs.len() as u32));
+            plan.slot.set_queue(Queue::Glint(glint_specs.len() as u32));
             glint_specs.push((mi as u32, ndf, spec));
         }
         slots.push(plan.slot);
