@@ -1,6 +1,6 @@
 //! The integrator's bind groups by name. Each [`Group`] lists its bindings as the WGSL names its
 //! globals, in binding order; the layouts are built from these lists and every bind group from
-//! resources given by the same names ([`bind_group`]), so no binding is matched by position
+//! resources given by the same names (`bind_group`), so no binding is matched by position
 //! alone. `crates/render/tests/bindings.rs` checks each list against the `@group`/`@binding`
 //! globals that naga reflects from every pipeline file of [`PIPELINES`].
 
