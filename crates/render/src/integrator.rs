@@ -7,6 +7,10 @@
 //! dispatch; `queue_args.wgsl` closes a queue and writes the arguments). A slot owns one pixel
 //! for a whole tile and takes its samples one after the other (regeneration in the logic
 //! stage), so the film needs no atomics and the same seed gives the same image.
+//!
+//! This file holds the pipelines and the loop (pbrt-v4's `integrator.cpp`); the state the loop
+//! runs over — path state, queues, film and their bind groups — is a [`Wavefront`], which knows
+//! nothing of the loop.
 
 use crate::camera::CameraFrame;
 use crate::config::{ImageConfig, RenderConfig, SampleConfig};
