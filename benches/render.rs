@@ -14,7 +14,9 @@ use facet_render::procedural;
 use facet_render::scene::{
     Camera, Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf,
 };
-use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::{
+    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use glam::{Vec3, Vec4};
 use std::path::Path;
 use std::sync::Arc;
@@ -88,17 +90,23 @@ fn rmse_against_spp(gpu: &Gpu) {
     let (scene, env) = demo();
     let p = prepare(gpu, &scene, &env, ResourceConfig::standard());
     let base = RenderConfig {
-        width: 160,
-        height: 90,
-        ..RenderConfig::standard()
+        image: ImageConfig {
+            width: 160,
+            height: 90,
+            ..ImageConfig::standard()
+        },
+        sampling: SampleConfig::standard(),
     };
     let reference = render(
         gpu,
         &p,
         &RenderConfig {
-            spp: 256,
-            seed: 999,
-            spp_per_pass: 16,
+            sampling: SampleConfig {
+                spp: 256,
+                seed: 999,
+                spp_per_pass: 16,
+                ..base.sampling
+            },
             ..base
         },
     );
@@ -106,7 +114,11 @@ fn rmse_against_spp(gpu: &Gpu) {
     println!("  spp      ms     RMSE");
     for spp in [1, 2, 4, 8, 16, 32, 64] {
         let t = Instant::now();
-        let img = render(gpu, &p, &RenderConfig { spp, ..base });
+        let sampling = SampleConfig {
+            spp,
+            ..base.sampling
+        };
+        let img = render(gpu, &p, &RenderConfig { sampling, ..base });
         println!(
             "  {spp:>3} {:>7.0} {:>8.4}",
             t.elapsed().as_secs_f64() * 1e3,
@@ -130,11 +142,16 @@ fn bench(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(10));
     let config = RenderConfig {
-        width: 128,
-        height: 128,
-        spp: 1,
-        max_depth: 5,
-        ..RenderConfig::standard()
+        image: ImageConfig {
+            width: 128,
+            height: 128,
+            ..ImageConfig::standard()
+        },
+        sampling: SampleConfig {
+            spp: 1,
+            max_depth: 5,
+            ..SampleConfig::standard()
+        },
     };
     g.throughput(Throughput::Elements(128 * 128));
     for n in sizes() {
@@ -165,10 +182,15 @@ fn bench(c: &mut Criterion) {
         .warm_up_time(Duration::from_secs(1))
         .measurement_time(Duration::from_secs(10));
     let config = RenderConfig {
-        width: 240,
-        height: 135,
-        spp: 2,
-        ..RenderConfig::standard()
+        image: ImageConfig {
+            width: 240,
+            height: 135,
+            ..ImageConfig::standard()
+        },
+        sampling: SampleConfig {
+            spp: 2,
+            ..SampleConfig::standard()
+        },
     };
     g.throughput(Throughput::Elements(240 * 135 * 2));
     let filtered = ResourceConfig::standard();

@@ -19,7 +19,7 @@ use facet_render::camera::CameraFrame;
 use facet_render::procedural::{self, Rng};
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf};
 use facet_render::trace::{GpuHit, RayTracer};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
+use facet_render::{ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources};
 use glam::Vec3;
 use serde_json::{Value, json};
 use std::path::PathBuf;
@@ -478,6 +478,15 @@ fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
 }
 
 /// The demo scene and sky; with `glints` false the glint sphere renders its smooth GGX model.
+/// A `side` × `side` image with a path in flight per pixel.
+fn square(side: u32) -> ImageConfig {
+    ImageConfig {
+        width: side,
+        height: side,
+        wavefront: side * side,
+    }
+}
+
 fn demo_scene(glints: bool) -> Result<(Scene, Environment)> {
     let (gltf, sky) = demo_assets();
     let mut scene = load_gltf(&gltf, &LoadOptions::default())?;
@@ -494,12 +503,15 @@ fn demo_scene(glints: bool) -> Result<(Scene, Environment)> {
 
 fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
     let (w, h, spp) = sizes.render;
-    let config = RenderConfig {
+    let image = ImageConfig {
         width: w,
         height: h,
+        ..ImageConfig::standard()
+    };
+    let sampling = SampleConfig {
         spp,
         max_depth: 5,
-        ..RenderConfig::standard()
+        ..SampleConfig::standard()
     };
     let mut rows = Vec::new();
     let mut stages = json!({});
@@ -527,10 +539,10 @@ fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
         }
         let integrator = Integrator::new(&gpu.device, &res)?;
         let camera = CameraFrame::new(&scene.camera)?;
-        let mut wf = Wavefront::new(gpu, &integrator, &res, w, h, config.wavefront)?;
+        let mut wf = integrator.wavefront(gpu, &res, image)?;
         let ms = median_ms(sizes.runs, || {
             wf.clear(gpu);
-            wf.render_more(gpu, &integrator, &res, &camera, &config, &mut |_| {})?;
+            integrator.render_more(gpu, &mut wf, &camera, &sampling, &mut |_| {})?;
             Ok(())
         })?;
         let msps = w as f64 * h as f64 * spp as f64 / (ms * 1e3);
@@ -541,7 +553,7 @@ fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
         );
         rows.push(json!({"scene": "demo", "glints": glints, "glint_filter": filter, "width": w, "height": h, "spp": spp, "depth": 5, "msamples_per_s": msps, "ms": ms, "slots": wf.slots()}));
         let (times, clock) =
-            wf.profile_iteration(gpu, &integrator, &res, &camera, &config, sizes.stage_warm)?;
+            integrator.profile_iteration(gpu, &mut wf, &camera, &sampling, sizes.stage_warm)?;
         let total: f64 = times.iter().map(|t| t.ms).sum();
         println!("    one iteration by stage ({clock:?}), {total:.3} ms:");
         for t in &times {
@@ -576,7 +588,7 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         facet: Some(facet_render::scene::FacetMaterial {
             source: "default_fit.json".into(),
             fit: Arc::new(fit),
-            model: facet_render::scene::FacetModel::Ggx,
+            model: facet_fit::model::material::ModelChoice::Ggx,
             glint: None,
         }),
         ..Default::default()
@@ -586,18 +598,16 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let res = SceneResources::new(gpu, &scene, Some(&env), ResourceConfig::standard())?;
     let integrator = Integrator::new(&gpu.device, &res)?;
     let camera = CameraFrame::new(&scene.camera)?;
-    let mut wf = Wavefront::new(gpu, &integrator, &res, side, side, side * side)?;
+    let mut wf = integrator.wavefront(gpu, &res, square(side))?;
     let (mut batch, mut ms_all, mut spp_all) = (1u32, Vec::new(), Vec::new());
     for _ in 0..frames {
-        let cfg = RenderConfig {
-            width: side,
-            height: side,
+        let cfg = SampleConfig {
             spp: batch,
-            spp_per_pass: facet_render::wavefront::MAX_SPP_PER_FRAME,
-            ..RenderConfig::preview()
+            spp_per_pass: facet_render::pacing::MAX_SPP_PER_FRAME,
+            ..SampleConfig::preview()
         };
         let t = Instant::now();
-        wf.render_more(gpu, &integrator, &res, &camera, &cfg, &mut |_| {})?;
+        integrator.render_more(gpu, &mut wf, &camera, &cfg, &mut |_| {})?;
         let rgba = wf.tone_mapped(gpu, 0.0)?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
         if rgba.len() != (side * side) as usize {
@@ -605,7 +615,7 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         }
         ms_all.push(ms);
         spp_all.push(batch);
-        batch = facet_render::wavefront::next_batch(batch, ms);
+        batch = facet_render::pacing::next_batch(batch, ms);
     }
     // Steady state: the second half of the frames.
     let half = frames as usize / 2;
@@ -627,11 +637,11 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
 
 /// A fit of an analytic GGX gold conductor, as a Facet material rendering its GGX model.
 fn gold_ggx(alpha: f64) -> Result<Material> {
-    gold_fit(alpha, facet_render::scene::FacetModel::Ggx)
+    gold_fit(alpha, facet_fit::model::material::ModelChoice::Ggx)
 }
 
 /// A fit of gold GGX(α) written as a MERL table, rendered by `model` of the fit.
-fn gold_fit(alpha: f64, model: facet_render::scene::FacetModel) -> Result<Material> {
+fn gold_fit(alpha: f64, model: facet_fit::model::material::ModelChoice) -> Result<Material> {
     let spec = format!("ggx?alpha={alpha}&conductor=gold");
     let truth =
         facet_fit::model::analytic::parse_analytic(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -696,7 +706,7 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let (side, spp) = sizes.noise;
     let (demo, sky) = demo_scene(true)?;
     let glossy = facet_render::scene::shapes::preview_scene(gold_ggx(0.05)?);
-    let tabulated = gold_fit(0.3, facet_render::scene::FacetModel::Tabulated)?;
+    let tabulated = gold_fit(0.3, facet_fit::model::material::ModelChoice::Tabulated)?;
     let scenes = [
         (
             "gold sphere, sky and point light",
@@ -732,32 +742,29 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
             };
             let res = SceneResources::new(gpu, scene, Some(env), rc)?;
             let integrator = Integrator::new(&gpu.device, &res)?;
-            let mut wf = Wavefront::new(gpu, &integrator, &res, side, side, side * side)?;
+            let mut wf = integrator.wavefront(gpu, &res, square(side))?;
             let mut images = Vec::new();
             let mut ms = Vec::new();
             // An untimed render first: the first dispatches of fresh pipelines are slower.
-            let warm = RenderConfig {
-                width: side,
-                height: side,
+            let warm = SampleConfig {
                 spp: 1,
                 ndf_sampling,
-                ..RenderConfig::standard()
+                ..SampleConfig::standard()
             };
-            wf.render_more(gpu, &integrator, &res, &camera, &warm, &mut |_| {})?;
+            integrator.render_more(gpu, &mut wf, &camera, &warm, &mut |_| {})?;
             // Seeds 0 and 1 give the variance; seed 2 only a third time for the median.
             for seed in [0, 1, 2] {
-                let cfg = RenderConfig {
-                    width: side,
-                    height: side,
+                let cfg = SampleConfig {
                     spp,
                     max_depth: 5,
                     seed,
                     ndf_sampling,
-                    ..RenderConfig::standard()
+                    ..SampleConfig::standard()
                 };
                 wf.clear(gpu);
                 ms.push(
-                    wf.render_more(gpu, &integrator, &res, &camera, &cfg, &mut |_| {})?
+                    integrator
+                        .render_more(gpu, &mut wf, &camera, &cfg, &mut |_| {})?
                         .ms,
                 );
                 if seed < 2 {

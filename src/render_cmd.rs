@@ -6,7 +6,9 @@ use facet_fit::io::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
+use facet_render::{
+    ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
@@ -187,14 +189,18 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         (None, None) => None,
     };
     let config = RenderConfig {
-        width: args.width,
-        height: args.height,
-        spp: args.spp,
-        max_depth: args.max_depth,
-        seed: args.seed,
-        wavefront: args.wavefront,
-        time_limit: args.time_limit,
-        ..RenderConfig::standard()
+        image: ImageConfig {
+            width: args.width,
+            height: args.height,
+            wavefront: args.wavefront,
+        },
+        sampling: SampleConfig {
+            spp: args.spp,
+            max_depth: args.max_depth,
+            seed: args.seed,
+            time_limit: args.time_limit,
+            ..SampleConfig::standard()
+        },
     };
     let resources = ResourceConfig {
         bvh: BvhConfig {
@@ -246,11 +252,11 @@ pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) ->
     );
     let c = &job.config;
     let mut wf = if job.variance {
-        Wavefront::with_variance(gpu, &integrator, &res, c.width, c.height, c.wavefront)?
+        integrator.wavefront_with_variance(gpu, &res, c.image)?
     } else {
-        Wavefront::new(gpu, &integrator, &res, c.width, c.height, c.wavefront)?
+        integrator.wavefront(gpu, &res, c.image)?
     };
-    let stats = wf.render_more(gpu, &integrator, &res, &camera, c, &mut |f| {
+    let stats = integrator.render_more(gpu, &mut wf, &camera, &c.sampling, &mut |f| {
         bar.set_position((f * 1000.0) as u64)
     })?;
     let image = wf.image(gpu)?;

@@ -175,7 +175,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
     use facet_fit::gpu::{GpuNode, GpuState};
     use facet_glint::cone_rule::Ring;
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
-    use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial};
+    use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial, GpuSceneInfo};
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
     use facet_render::tonemap::ToneMapParams;
     use facet_render::trace::{GpuHit, GpuRay};
@@ -209,10 +209,12 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         }),
         layout_check!(GpuFrame, "render/extend.wgsl", "Frame", {
             width, height, tile_base, tile_pixels, wavefront, sample_end, max_depth, seed,
-            rr_depth, n_vertices, n_lights, light_cdf, env_kind, env_width, env_height,
-            env_texels, env_marginal, env_conditional, scene_radius, ray_epsilon, strategy, ndf_sampling, moments, pad => [pad1],
-            env_color,
+            rr_depth, ray_epsilon, strategy, ndf_sampling, moments, pad0, pad1, pad2, scene,
             cam_pos, cam_forward, cam_up, cam_right,
+        }),
+        layout_check!(GpuSceneInfo, "render/extend.wgsl", "SceneInfo", {
+            n_vertices, n_lights, light_cdf, env_kind, env_width, env_height, env_texels,
+            env_marginal, env_conditional, scene_radius, pad0, pad1, env_color,
         }),
         layout_check!(GpuMaterial, "render/extend.wgsl", "Material", {
             base_color, emissive, diffuse, kind, ndf_kind, alpha_x, alpha_y, rotation,

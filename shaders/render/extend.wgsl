@@ -19,7 +19,7 @@ fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     var l = path_get(R_L, slot);
     let hit = trace_closest(o.xyz, d.xyz, 3.0e38);
     if (hit.prim == 0xffffffffu) {
-        if (frame.env_kind != ENV_NONE) {
+        if (frame.scene.env_kind != ENV_NONE) {
             let w = emission_weight(beta.w, env_light_pmf() * env_pdf(d.xyz));
             l = vec4<f32>(l.xyz + beta.xyz * env_radiance(d.xyz) * w, l.w);
             path_set(R_L, slot, l);

@@ -14,17 +14,9 @@ override Q_SHADOW: u32;
 // Path-state regions R_*, slot states SLOT_* (info.x), strategies STRATEGY_*.
 #include "render/tags.inc.wgsl"
 
-// Rust: facet_render::gpu_types::GpuFrame.
-struct Frame {
-    width: u32,
-    height: u32,
-    tile_base: u32,
-    tile_pixels: u32,
-    wavefront: u32,
-    sample_end: u32,
-    max_depth: u32,
-    seed: u32,
-    rr_depth: u32,
+// Rust: facet_render::gpu_types::GpuSceneInfo. The scene's part of the frame, the same in
+// every frame of a scene.
+struct SceneInfo {
     n_vertices: u32,
     n_lights: u32,
     light_cdf: u32,
@@ -36,6 +28,23 @@ struct Frame {
     env_marginal: u32,
     env_conditional: u32,
     scene_radius: f32,
+    pad0: u32,
+    pad1: u32,
+    // Constant environment radiance (env_kind ENV_CONSTANT).
+    env_color: vec4<f32>,
+}
+
+// Rust: facet_render::gpu_types::GpuFrame.
+struct Frame {
+    width: u32,
+    height: u32,
+    tile_base: u32,
+    tile_pixels: u32,
+    wavefront: u32,
+    sample_end: u32,
+    max_depth: u32,
+    seed: u32,
+    rr_depth: u32,
     ray_epsilon: f32,
     // STRATEGY_*
     strategy: u32,
@@ -43,9 +52,10 @@ struct Frame {
     ndf_sampling: u32,
     // 1: also accumulate squared radiance into film_sq (per-pixel variance)
     moments: u32,
+    pad0: u32,
     pad1: u32,
-    // rgb the constant environment's radiance (ENV_CONSTANT); w unused (0).
-    env_color: vec4<f32>,
+    pad2: u32,
+    scene: SceneInfo,
     // xyz position, w tan(yfov / 2)
     cam_pos: vec4<f32>,
     // xyz forward, w aspect

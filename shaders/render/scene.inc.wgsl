@@ -63,7 +63,7 @@ struct Light {
 @group(1) @binding(9) var<storage, read> triangle_light: array<u32>;
 
 fn vertex(region: u32, i: u32) -> vec4<f32> {
-    return vertices[region * frame.n_vertices + i];
+    return vertices[region * frame.scene.n_vertices + i];
 }
 
 fn luminance(c: vec3<f32>) -> f32 {
@@ -242,17 +242,17 @@ fn env_uv(d: vec3<f32>) -> vec2<f32> {
 
 fn env_pixel(d: vec3<f32>) -> vec2<u32> {
     let uv = env_uv(d);
-    return vec2<u32>(min(u32(uv.x * f32(frame.env_width)), frame.env_width - 1u),
-                     min(u32(uv.y * f32(frame.env_height)), frame.env_height - 1u));
+    return vec2<u32>(min(u32(uv.x * f32(frame.scene.env_width)), frame.scene.env_width - 1u),
+                     min(u32(uv.y * f32(frame.scene.env_height)), frame.scene.env_height - 1u));
 }
 
 fn env_radiance(d: vec3<f32>) -> vec3<f32> {
-    if (frame.env_kind == ENV_CONSTANT) {
-        return frame.env_color.xyz;
+    if (frame.scene.env_kind == ENV_CONSTANT) {
+        return frame.scene.env_color.xyz;
     }
-    if (frame.env_kind == ENV_MAP) {
+    if (frame.scene.env_kind == ENV_MAP) {
         let px = env_pixel(d);
-        let o = frame.env_texels + 3u * (px.y * frame.env_width + px.x);
+        let o = frame.scene.env_texels + 3u * (px.y * frame.scene.env_width + px.x);
         return vec3<f32>(tables[o], tables[o + 1u], tables[o + 2u]);
     }
     return vec3<f32>(0.0);
@@ -260,18 +260,18 @@ fn env_radiance(d: vec3<f32>) -> vec3<f32> {
 
 // Discrete probability of a pixel: cdf differences of its row and column.
 fn env_pixel_prob(px: vec2<u32>) -> f32 {
-    let w1 = frame.env_width + 1u;
-    let row = tables[frame.env_marginal + px.y + 1u] - tables[frame.env_marginal + px.y];
-    let c = frame.env_conditional + px.y * w1 + px.x;
+    let w1 = frame.scene.env_width + 1u;
+    let row = tables[frame.scene.env_marginal + px.y + 1u] - tables[frame.scene.env_marginal + px.y];
+    let c = frame.scene.env_conditional + px.y * w1 + px.x;
     return row * (tables[c + 1u] - tables[c]);
 }
 
 // Solid-angle density of env_sample: p · w · h / (2π² sin θ).
 fn env_pdf(d: vec3<f32>) -> f32 {
-    if (frame.env_kind == ENV_CONSTANT) {
+    if (frame.scene.env_kind == ENV_CONSTANT) {
         return 1.0 / (4.0 * PI);
     }
-    if (frame.env_kind != ENV_MAP) {
+    if (frame.scene.env_kind != ENV_MAP) {
         return 0.0;
     }
     let sin_t = sqrt(max(1.0 - d.y * d.y, 0.0));
@@ -279,7 +279,7 @@ fn env_pdf(d: vec3<f32>) -> f32 {
         return 0.0;
     }
     let px = env_pixel(d);
-    return env_pixel_prob(px) * f32(frame.env_width * frame.env_height) / (2.0 * PI * PI * sin_t);
+    return env_pixel_prob(px) * f32(frame.scene.env_width * frame.scene.env_height) / (2.0 * PI * PI * sin_t);
 }
 
 // Largest i in [0, n) with cdf[base + i] <= u.
@@ -298,20 +298,20 @@ fn cdf_search(base: u32, n: u32, u: f32) -> u32 {
 }
 
 fn env_sample(u: vec2<f32>) -> vec3<f32> {
-    if (frame.env_kind != ENV_MAP) {
+    if (frame.scene.env_kind != ENV_MAP) {
         // Uniform sphere.
         let y = 1.0 - 2.0 * u.x;
         let r = sqrt(max(1.0 - y * y, 0.0));
         let phi = 2.0 * PI * u.y;
         return vec3<f32>(r * cos(phi), y, r * sin(phi));
     }
-    let h = frame.env_height;
-    let w = frame.env_width;
-    let row = cdf_search(frame.env_marginal, h + 1u, u.y);
-    let r0 = tables[frame.env_marginal + row];
-    let r1 = tables[frame.env_marginal + row + 1u];
+    let h = frame.scene.env_height;
+    let w = frame.scene.env_width;
+    let row = cdf_search(frame.scene.env_marginal, h + 1u, u.y);
+    let r0 = tables[frame.scene.env_marginal + row];
+    let r1 = tables[frame.scene.env_marginal + row + 1u];
     let fy = clamp((u.y - r0) / max(r1 - r0, 1e-30), 0.0, 1.0);
-    let base = frame.env_conditional + row * (w + 1u);
+    let base = frame.scene.env_conditional + row * (w + 1u);
     let col = cdf_search(base, w + 1u, u.x);
     let c0 = tables[base + col];
     let c1 = tables[base + col + 1u];
@@ -326,7 +326,7 @@ fn env_sample(u: vec2<f32>) -> vec3<f32> {
 // ---- lights ----------------------------------------------------------------------------------
 
 fn light_pmf(i: u32) -> f32 {
-    return tables[frame.light_cdf + i + 1u] - tables[frame.light_cdf + i];
+    return tables[frame.scene.light_cdf + i + 1u] - tables[frame.scene.light_cdf + i];
 }
 
 struct LightSample {
@@ -358,10 +358,10 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
     ls.weight = vec3<f32>(0.0);
     ls.dist = 0.0;
     ls.wi = vec3<f32>(0.0, 0.0, 1.0);
-    if (frame.n_lights == 0u) {
+    if (frame.scene.n_lights == 0u) {
         return ls;
     }
-    let i = min(cdf_search(frame.light_cdf, frame.n_lights + 1u, u0), frame.n_lights - 1u);
+    let i = min(cdf_search(frame.scene.light_cdf, frame.scene.n_lights + 1u, u0), frame.scene.n_lights - 1u);
     let pmf = light_pmf(i);
     if (pmf <= 0.0) {
         return ls;
@@ -383,7 +383,7 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
         ls.pdf = 0.0;
     } else if (l.kind == LIGHT_DIRECTIONAL) {
         ls.wi = -l.direction.xyz;
-        ls.dist = 4.0 * frame.scene_radius;
+        ls.dist = 4.0 * frame.scene.scene_radius;
         ls.weight = l.intensity.xyz / pmf;
         ls.pdf = 0.0;
     } else if (l.kind == LIGHT_TRIANGLE) {
@@ -415,7 +415,7 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
         }
     } else {
         ls.wi = env_sample(u);
-        ls.dist = 4.0 * frame.scene_radius;
+        ls.dist = 4.0 * frame.scene.scene_radius;
         ls.pdf = pmf * env_pdf(ls.wi);
         if (ls.pdf > 0.0) {
             ls.weight = env_radiance(ls.wi) / ls.pdf;
@@ -426,7 +426,7 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
 
 // The light index of the environment, if it is one of the lights.
 fn env_light_pmf() -> f32 {
-    for (var i = 0u; i < frame.n_lights; i++) {
+    for (var i = 0u; i < frame.scene.n_lights; i++) {
         if (lights[i].kind == LIGHT_ENVIRONMENT) {
             return light_pmf(i);
         }

@@ -1,4 +1,5 @@
-//! The pinhole camera as the generate stage takes it (its uniform: `wavefront::frame_uniform`).
+//! The pinhole camera as the generate stage takes it (its part of the frame uniform, which
+//! `integrator.rs` assembles).
 
 use crate::error::RenderError;
 use crate::scene::Camera;

@@ -3,10 +3,13 @@
 //! glTF scenes ([`scene::load_gltf`]), an obvhs CWBVH traversed in WGSL ([`bvh`]), and a
 //! wavefront integrator ([`Integrator`]) whose stages — logic, generate, extend, shade per
 //! material class (glTF metallic-roughness, fitted analytic or tabulated microfacet, glints),
-//! connect — are separate compute passes over queues. A [`Wavefront`] holds the GPU state of one
-//! image size (path state, queues, film) for reuse: `render_more` accumulates samples on the
-//! GPU, `tone_mapped` reads back the PNG tone map; `profile_iteration` times each stage. The
-//! closed sets shared with WGSL are in [`tags`].
+//! connect — are separate compute passes over queues. The integrator holds the pipelines and the
+//! loop; a [`Wavefront`] holds the GPU state of one image (path state, queues, film) for reuse,
+//! and reads it back. [`Integrator::render_more`] accumulates samples in a wavefront's film on the
+//! GPU, [`Wavefront::tone_mapped`] reads back the PNG tone map and
+//! [`Integrator::profile_iteration`] times each stage. A render's settings come in two parts
+//! ([`config`]): the image, fixed for a wavefront, and the sampling. The closed sets shared with
+//! WGSL are in [`tags`].
 //!
 //! ```no_run
 //! use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, camera::CameraFrame};
@@ -25,13 +28,16 @@
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod bindings;
 pub mod bvh;
 pub mod camera;
+pub mod config;
 mod error;
 pub mod film;
 pub mod gpu_types;
 mod integrator;
 pub(crate) mod limits;
+pub mod pacing;
 pub mod procedural;
 pub(crate) mod queues;
 pub mod resources;
@@ -43,14 +49,15 @@ pub mod trace;
 pub mod wavefront;
 
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
+pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Strategy};
 pub use error::RenderError;
 pub use facet_gpu::{Gpu, GpuError};
 pub use film::Image;
 /// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
 pub use glam;
-pub use integrator::{Integrator, NdfSampling, RenderConfig, RenderStats, Strategy};
+pub use integrator::{Integrator, RenderStats, StageClock, StageTime};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
 pub use resources::{Built, LightSelection, ResourceConfig, SceneResources};
 pub use trace::{GpuHit, GpuRay, RayTracer};
-pub use wavefront::{StageClock, StageTime, Wavefront};
+pub use wavefront::Wavefront;

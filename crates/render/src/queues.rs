@@ -36,18 +36,6 @@ impl Queue {
         }
     }
 
-    pub const fn from_index(i: u32) -> Queue {
-        match i {
-            0 => Queue::Generate,
-            1 => Queue::Extend,
-            2 => Queue::Shadow,
-            3 => Queue::Diffuse,
-            4 => Queue::Analytic,
-            5 => Queue::Tabulated,
-            k => Queue::Glint(k - 6),
-        }
-    }
-
     /// The material class a shading queue serves.
     pub const fn class_name(self) -> &'static str {
         match self {

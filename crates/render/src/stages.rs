@@ -1,98 +1,39 @@
 //! The integrator's stage pipelines (one WGSL file each under `shaders/render/`) and their
-//! bind group layouts. Group 0: frame, path state, queues, film (`frame.inc.wgsl`); group 1: the
-//! scene (`scene.inc.wgsl`); group 2: one glint material's field, parameters and DPF levels.
+//! bind group layouts, built from the named lists of [`crate::bindings`]. Group 0: frame, path
+//! state, queues, film (`frame.inc.wgsl`); group 1: the scene (`scene.inc.wgsl`); group 2: one
+//! glint material's field, parameters and DPF levels.
 
+use crate::bindings::{Group, pipeline_groups};
 use crate::queues::Queue;
 use facet_gpu::{GpuError, shader};
 
-/// Bind group layouts shared by every stage.
+/// Bind group layouts shared by every stage, one per [`Group`].
 pub struct Layouts {
-    pub frame: wgpu::BindGroupLayout,
-    pub scene: wgpu::BindGroupLayout,
-    pub glint: wgpu::BindGroupLayout,
-    pub queue_args: wgpu::BindGroupLayout,
-}
-
-fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn uniform(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn texture_3d(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D3,
-            multisampled: false,
-        },
-        count: None,
-    }
+    /// In the order of [`Group::ALL`].
+    layouts: Vec<wgpu::BindGroupLayout>,
 }
 
 impl Layouts {
     pub fn new(device: &wgpu::Device) -> Self {
-        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
-            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-                label: Some(label),
-                entries,
-            })
-        };
         Layouts {
-            frame: layout(
-                "frame",
-                &[
-                    uniform(0),
-                    storage(1, false),
-                    storage(2, false),
-                    storage(3, false),
-                    storage(4, true),
-                    storage(5, false),
-                    storage(6, false),
-                    storage(7, false),
-                ],
-            ),
-            scene: layout(
-                "scene",
-                &(0..10).map(|b| storage(b, true)).collect::<Vec<_>>(),
-            ),
-            glint: layout(
-                "glint",
-                &[
-                    uniform(0),
-                    uniform(1),
-                    texture_3d(2),
-                    texture_3d(3),
-                    storage(4, true),
-                ],
-            ),
-            queue_args: layout(
-                "queue args",
-                &[storage(0, false), storage(1, false), storage(2, false)],
-            ),
+            layouts: Group::ALL.iter().map(|g| g.layout(device)).collect(),
         }
+    }
+
+    /// The layout of `group`.
+    pub fn of(&self, group: Group) -> &wgpu::BindGroupLayout {
+        let i = Group::ALL.iter().position(|g| *g == group);
+        &self.layouts[i.expect("every group has a layout")]
+    }
+
+    /// The layouts of pipeline file `file`'s groups, in group order.
+    fn of_pipeline(&self, file: &str) -> Result<Vec<&wgpu::BindGroupLayout>, GpuError> {
+        let groups = pipeline_groups(file).ok_or_else(|| {
+            GpuError::Validation(format!(
+                "{file} is not an integrator pipeline (facet_render::bindings::PIPELINES)"
+            ))
+        })?;
+        Ok(groups.iter().map(|g| self.of(*g)).collect())
     }
 }
 
@@ -140,12 +81,7 @@ impl Stage {
     ) -> Result<Stage, GpuError> {
         let mut constants: Vec<(&str, f64)> = Queue::constants().to_vec();
         constants.extend_from_slice(extra_constants);
-        let glint = matches!(queue, Some(Queue::Glint(_)));
-        let groups: Vec<&wgpu::BindGroupLayout> = if glint {
-            vec![&layouts.frame, &layouts.scene, &layouts.glint]
-        } else {
-            vec![&layouts.frame, &layouts.scene]
-        };
+        let groups = layouts.of_pipeline(file)?;
         Ok(Stage {
             name: entry,
             pipeline: pipeline(device, file, entry, &groups, &constants)?,
@@ -162,11 +98,12 @@ pub fn queue_args(
     count: u32,
     stage_wg: u32,
 ) -> Result<wgpu::ComputePipeline, GpuError> {
+    let file = "render/queue_args.wgsl";
     pipeline(
         device,
-        "render/queue_args.wgsl",
+        file,
         "queue_args",
-        &[&layouts.queue_args],
+        &layouts.of_pipeline(file)?,
         &[
             ("FIRST", first as f64),
             ("COUNT", count as f64),

@@ -18,9 +18,12 @@ use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{
-    Camera, Environment, EnvironmentMap, FacetMaterial, FacetModel, Light, Material, Scene, Texture,
+    Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, Scene, Texture,
 };
-use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources, Strategy};
+use facet_render::{
+    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+    Strategy,
+};
 use glam::{DVec2, DVec3, Vec3, Vec4};
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -86,13 +89,18 @@ fn sphere_scene(material: Material) -> Scene {
 
 fn config(spp: u32, strategy: Strategy) -> RenderConfig {
     RenderConfig {
-        width: SIZE,
-        height: SIZE,
-        spp,
-        // Direct light only: every reference below is a single-bounce integral.
-        max_depth: 1,
-        strategy,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: SIZE,
+            height: SIZE,
+            ..ImageConfig::preview()
+        },
+        sampling: SampleConfig {
+            spp,
+            // Direct light only: every reference below is a single-bounce integral.
+            max_depth: 1,
+            strategy,
+            ..SampleConfig::preview()
+        },
     }
 }
 
@@ -112,7 +120,13 @@ fn render_twice(
                 gpu,
                 &res,
                 &camera,
-                &RenderConfig { seed, ..config },
+                &RenderConfig {
+                    sampling: SampleConfig {
+                        seed,
+                        ..config.sampling
+                    },
+                    ..config
+                },
                 &mut |_| {},
             )
             .unwrap();
@@ -881,7 +895,7 @@ fn rotated_anisotropic_ggx_sphere_matches_the_cpu_evaluator() {
         facet: Some(FacetMaterial {
             source: "aniso.json".into(),
             fit: fitted.clone(),
-            model: FacetModel::Ggx,
+            model: ModelChoice::Ggx,
             glint: None,
         }),
         ..Default::default()
@@ -937,10 +951,8 @@ fn three_lights_together_are_the_sum_of_each_alone() {
         intensity: Vec3::new(0.6, 0.5, 0.4),
     };
     let sky = Environment::Constant(Vec3::new(0.2, 0.3, 0.45));
-    let c = RenderConfig {
-        max_depth: 3,
-        ..config(32, Strategy::Mis)
-    };
+    let mut c = config(32, Strategy::Mis);
+    c.sampling.max_depth = 3;
     let with = |lights: Vec<Light>, env: Option<&Environment>| {
         let mut s = base.clone();
         s.lights = lights;

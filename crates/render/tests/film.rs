@@ -4,7 +4,9 @@
 use facet_gpu::gpu_for_tests;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, Material, Scene};
-use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::{
+    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use glam::{Vec3, Vec4};
 use std::path::PathBuf;
 
@@ -90,10 +92,15 @@ fn written_exr_and_png_are_the_image_in_memory() {
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
     let camera = CameraFrame::new(&scene.camera).unwrap();
     let config = RenderConfig {
-        width: 40,
-        height: 24,
-        spp: 2,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: 40,
+            height: 24,
+            ..ImageConfig::preview()
+        },
+        sampling: SampleConfig {
+            spp: 2,
+            ..SampleConfig::preview()
+        },
     };
     let (image, _) = integrator
         .render(&gpu, &res, &camera, &config, &mut |_| {})

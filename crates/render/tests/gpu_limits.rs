@@ -5,7 +5,10 @@
 use facet_gpu::{Gpu, GpuOptions};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
-use facet_render::{Integrator, RenderConfig, RenderError, ResourceConfig, SceneResources};
+use facet_render::{
+    ImageConfig, Integrator, RenderConfig, RenderError, ResourceConfig, SampleConfig,
+    SceneResources,
+};
 use glam::Vec3;
 use std::sync::Arc;
 
@@ -89,11 +92,15 @@ fn over_the_device_limits_is_an_error_naming_the_input() {
     let camera = CameraFrame::new(&scene.camera).unwrap();
     for (width, height) in [(512, 512), (u32::MAX, u32::MAX)] {
         let config = RenderConfig {
-            width,
-            height,
-            spp: 1,
-            wavefront: 1024,
-            ..RenderConfig::preview()
+            image: ImageConfig {
+                width,
+                height,
+                wavefront: 1024,
+            },
+            sampling: SampleConfig {
+                spp: 1,
+                ..SampleConfig::preview()
+            },
         };
         let e = too_large(
             integrator
@@ -105,11 +112,15 @@ fn over_the_device_limits_is_an_error_naming_the_input() {
     }
     // The path state of a large wavefront.
     let config = RenderConfig {
-        width: 128,
-        height: 128,
-        spp: 1,
-        wavefront: 16384,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: 128,
+            height: 128,
+            wavefront: 16384,
+        },
+        sampling: SampleConfig {
+            spp: 1,
+            ..SampleConfig::preview()
+        },
     };
     let e = too_large(
         integrator
@@ -122,11 +133,15 @@ fn over_the_device_limits_is_an_error_naming_the_input() {
     );
     // Within the limits, the same device renders.
     let config = RenderConfig {
-        width: 32,
-        height: 32,
-        spp: 1,
-        wavefront: 1024,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: 32,
+            height: 32,
+            wavefront: 1024,
+        },
+        sampling: SampleConfig {
+            spp: 1,
+            ..SampleConfig::preview()
+        },
     };
     let (image, _) = integrator
         .render(&gpu, &res, &camera, &config, &mut |_| {})

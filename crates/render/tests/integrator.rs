@@ -1,16 +1,16 @@
 //! The wavefront integrator against theory: white furnaces, the glints' smooth limit and their
 //! filtered switch, only-what-is-needed resources, determinism. GPU tests (lavapipe in CI).
 
-use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::MicrofacetBrdf;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{
-    Camera, Environment, FacetMaterial, FacetModel, GlintParams, Material, Scene,
+use facet_render::scene::{Camera, Environment, FacetMaterial, GlintParams, Material, Scene};
+use facet_render::{
+    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
-use facet_render::{Image, Integrator, RenderConfig, ResourceConfig, SceneResources};
 use glam::{DVec3, Vec3, Vec4};
 use std::sync::{Arc, OnceLock};
 
@@ -65,7 +65,7 @@ fn conductor_fit() -> Arc<FittedMaterial> {
     .clone()
 }
 
-fn facet_material(model: FacetModel, glint: Option<GlintParams>) -> Material {
+fn facet_material(model: ModelChoice, glint: Option<GlintParams>) -> Material {
     Material {
         name: format!("{model:?}"),
         facet: Some(FacetMaterial {
@@ -100,11 +100,16 @@ fn render(
 
 fn config(spp: u32) -> RenderConfig {
     RenderConfig {
-        width: SIZE,
-        height: SIZE,
-        spp,
-        max_depth: 8,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: SIZE,
+            height: SIZE,
+            ..ImageConfig::preview()
+        },
+        sampling: SampleConfig {
+            spp,
+            max_depth: 8,
+            ..SampleConfig::preview()
+        },
     }
 }
 
@@ -155,17 +160,15 @@ fn white_furnace_conductor_matches_cpu_albedo() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    for model in [FacetModel::Ggx, FacetModel::Beckmann, FacetModel::Tabulated] {
+    for model in [
+        ModelChoice::Ggx,
+        ModelChoice::Beckmann,
+        ModelChoice::Tabulated,
+    ] {
         let scene = sphere_scene(facet_material(model, None));
         let (img, built, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(32));
         let fit = conductor_fit();
-        let brdf: &MicrofacetBrdf = fit
-            .model(match model {
-                FacetModel::Ggx => facet_fit::model::material::ModelChoice::Ggx,
-                FacetModel::Beckmann => facet_fit::model::material::ModelChoice::Beckmann,
-                FacetModel::Tabulated => facet_fit::model::material::ModelChoice::Tabulated,
-            })
-            .unwrap();
+        let brdf: &MicrofacetBrdf = fit.model(model).unwrap();
         // E(θo) tabulated every degree, interpolated per pixel.
         let table: Vec<f64> = (0..=90)
             .map(|deg| {
@@ -210,10 +213,10 @@ fn scene_without_glints_builds_no_glint_resources() {
     let Some(gpu) = gpu_for_tests("scene_without_glints_builds_no_glint_resources") else {
         return;
     };
-    let mut scene = sphere_scene(facet_material(FacetModel::Ggx, None));
+    let mut scene = sphere_scene(facet_material(ModelChoice::Ggx, None));
     // A glint material that no triangle uses costs nothing either.
     scene.materials.push(facet_material(
-        FacetModel::Ggx,
+        ModelChoice::Ggx,
         Some(GlintParams {
             density: 1e6,
             gamma_deg: 2.0,
@@ -240,7 +243,7 @@ fn scene_without_glints_builds_no_glint_resources() {
 
 fn glint(density: f32, threshold: f32) -> Material {
     facet_material(
-        FacetModel::Ggx,
+        ModelChoice::Ggx,
         Some(GlintParams {
             density,
             gamma_deg: 5.0,
@@ -258,7 +261,7 @@ fn glints_with_huge_density_render_the_smooth_model() {
         return;
     };
     let env = Environment::Constant(Vec3::ONE);
-    for model in [FacetModel::Ggx, FacetModel::Tabulated] {
+    for model in [ModelChoice::Ggx, ModelChoice::Tabulated] {
         let (smooth, _, _) = render(
             &gpu,
             &sphere_scene(facet_material(model, None)),
@@ -351,10 +354,8 @@ fn glint_threshold_decides_which_footprints_are_counted() {
         let res = SceneResources::new(&gpu, &scene, None, rc).unwrap();
         let integrator = Integrator::new(&gpu.device, &res).unwrap();
         let camera = CameraFrame::new(&scene.camera).unwrap();
-        let c = RenderConfig {
-            max_depth: 1,
-            ..config(1)
-        };
+        let mut c = config(1);
+        c.sampling.max_depth = 1;
         integrator
             .render(&gpu, &res, &camera, &c, &mut |_| {})
             .unwrap()
@@ -426,20 +427,14 @@ fn same_seed_same_image() {
         return;
     };
     let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let scene = sphere_scene(facet_material(FacetModel::Tabulated, None));
-    let c = RenderConfig {
-        wavefront: 1000, // several tiles
-        ..config(4)
-    };
+    let scene = sphere_scene(facet_material(ModelChoice::Tabulated, None));
+    let mut c = config(4);
+    c.image.wavefront = 1000; // several tiles
     let (a, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
     let (b, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
-    let (other, _, _) = render(
-        &gpu,
-        &scene,
-        &env,
-        ResourceConfig::standard(),
-        RenderConfig { seed: 7, ..c },
-    );
+    let mut seven = c;
+    seven.sampling.seed = 7;
+    let (other, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), seven);
     assert_eq!(a.pixels, b.pixels);
     assert_ne!(a.pixels, other.pixels);
     assert!(a.samples.iter().all(|&s| s == 4));
@@ -552,27 +547,26 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
         return;
     };
     let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let scene = sphere_scene(facet_material(FacetModel::Tabulated, None));
+    let scene = sphere_scene(facet_material(ModelChoice::Tabulated, None));
     let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
     let camera = CameraFrame::new(&scene.camera).unwrap();
-    let c = RenderConfig {
-        wavefront: 1000, // several tiles
-        ..config(2)
-    };
+    let mut c = config(2);
+    c.image.wavefront = 1000; // several tiles
     let fresh = |seed: u32, spp: u32| {
-        let c = RenderConfig { seed, spp, ..c };
+        let mut c = c;
+        (c.sampling.seed, c.sampling.spp) = (seed, spp);
         integrator
             .render(&gpu, &res, &camera, &c, &mut |_| {})
             .unwrap()
             .0
     };
-    let mut wf =
-        facet_render::Wavefront::new(&gpu, &integrator, &res, SIZE, SIZE, c.wavefront).unwrap();
+    let mut wf = integrator.wavefront(&gpu, &res, c.image).unwrap();
     for seed in [3, 9] {
         wf.clear(&gpu);
-        let c = RenderConfig { seed, ..c };
-        wf.render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+        let s = SampleConfig { seed, ..c.sampling };
+        integrator
+            .render_more(&gpu, &mut wf, &camera, &s, &mut |_| {})
             .unwrap();
         assert_eq!(
             wf.image(&gpu).unwrap().pixels,
@@ -582,8 +576,8 @@ fn a_reused_wavefront_renders_what_fresh_ones_do() {
     }
     wf.clear(&gpu);
     for _ in 0..4 {
-        let stats = wf
-            .render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+        let stats = integrator
+            .render_more(&gpu, &mut wf, &camera, &c.sampling, &mut |_| {})
             .unwrap();
         assert_eq!(stats.spp, 2);
     }
@@ -624,7 +618,7 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     let Some(gpu) = gpu_for_tests("reported_variance_matches_the_seed_to_seed_spread") else {
         return;
     };
-    let mut scene = sphere_scene(facet_material(FacetModel::Ggx, None));
+    let mut scene = sphere_scene(facet_material(ModelChoice::Ggx, None));
     scene.lights.push(facet_render::scene::Light::Directional {
         direction: Vec3::new(0.3, -0.4, -1.0).normalize(),
         irradiance: Vec3::splat(2.0),
@@ -633,16 +627,22 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
     let integrator = Integrator::new(&gpu.device, &res).unwrap();
     let camera = CameraFrame::new(&scene.camera).unwrap();
-    let mut wf =
-        facet_render::Wavefront::with_variance(&gpu, &integrator, &res, SIZE, SIZE, 1 << 16)
-            .unwrap();
+    let image = ImageConfig {
+        width: SIZE,
+        height: SIZE,
+        wavefront: 1 << 16,
+    };
+    let mut wf = integrator
+        .wavefront_with_variance(&gpu, &res, image)
+        .unwrap();
     let mut at = |spp: u32, seed: u32| {
         wf.clear(&gpu);
-        let c = RenderConfig {
+        let c = SampleConfig {
             seed,
-            ..config(spp)
+            ..config(spp).sampling
         };
-        wf.render_more(&gpu, &integrator, &res, &camera, &c, &mut |_| {})
+        integrator
+            .render_more(&gpu, &mut wf, &camera, &c, &mut |_| {})
             .unwrap();
         (wf.image(&gpu).unwrap(), wf.variance(&gpu).unwrap().unwrap())
     };
@@ -675,6 +675,6 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     assert!((m16 / spread - 1.0).abs() < 0.15, "{m16} vs {spread}");
     assert!(a4.samples.iter().all(|&s| s == 4) && v16.samples.iter().all(|&s| s == 16));
     // Without the moments there is no variance.
-    let plain = facet_render::Wavefront::new(&gpu, &integrator, &res, SIZE, SIZE, 1 << 16).unwrap();
+    let plain = integrator.wavefront(&gpu, &res, image).unwrap();
     assert!(plain.variance(&gpu).unwrap().is_none());
 }

@@ -7,7 +7,8 @@
 mod common;
 
 use common::{GltfBuilder, assert_all_finite, demo, small_fit, temp_dir};
-use facet_render::scene::{FacetModel, Light, LoadOptions, Scene, load_gltf};
+use facet_fit::model::material::ModelChoice;
+use facet_render::scene::{Light, LoadOptions, Scene, load_gltf};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::json;
 use std::path::{Path, PathBuf};
@@ -374,7 +375,7 @@ fn facet_extras_attach_a_fit_relative_to_the_gltf() {
     );
     let s = load(&path);
     let f = s.materials[0].facet.as_ref().expect("facet material");
-    assert_eq!(f.model, FacetModel::Ggx);
+    assert_eq!(f.model, ModelChoice::Ggx);
     assert_eq!(f.source, dir.join("fits/m.json"));
     let g = f.glint.unwrap();
     assert_eq!((g.density, g.gamma_deg, g.threshold), (1e6, 2.0, 50.0));
@@ -423,7 +424,7 @@ fn material_override_attaches_a_fit_by_name() {
     let plain = s.materials[1].facet.as_ref().unwrap();
     assert_eq!(
         (metal.model, plain.model),
-        (FacetModel::Ggx, FacetModel::Tabulated)
+        (ModelChoice::Ggx, ModelChoice::Tabulated)
     );
     assert_eq!(plain.source, fit);
     // Without the override the absent fit is an error naming it.
@@ -461,13 +462,13 @@ fn check_demo(path: &Path) {
             && s.materials[0].base_color.x == 0.5
             && s.materials[0].roughness == 1.0
     );
-    let models: Vec<FacetModel> = s.materials[1..]
+    let models: Vec<ModelChoice> = s.materials[1..]
         .iter()
         .map(|m| m.facet.as_ref().unwrap().model)
         .collect();
     assert_eq!(
         models,
-        [FacetModel::Tabulated, FacetModel::Ggx, FacetModel::Ggx]
+        [ModelChoice::Tabulated, ModelChoice::Ggx, ModelChoice::Ggx]
     );
     let glint = s.materials[3].facet.as_ref().unwrap().glint.unwrap();
     assert_eq!(
@@ -526,7 +527,7 @@ fn generated_demo_scene_loads_with_overrides() {
     let f = s.materials[2].facet.as_ref().unwrap();
     assert_eq!(
         (f.source.clone(), f.model),
-        (dir.join("default_fit.json"), FacetModel::Ggx)
+        (dir.join("default_fit.json"), ModelChoice::Ggx)
     );
 }
 

@@ -1,10 +1,12 @@
 //! `SceneResources::update_material`: an edit written in place renders exactly as resources
 //! built from scratch for the edited scene (same seed, same image).
 
-use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{Environment, FacetMaterial, FacetModel, Material, Scene};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::scene::{Environment, FacetMaterial, Material, Scene};
+use facet_render::{
+    ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use glam::Vec3;
 use std::path::Path;
 use std::sync::Arc;
@@ -14,7 +16,7 @@ fn demo_fit() -> FittedMaterial {
     FittedMaterial::load(&p).unwrap()
 }
 
-fn sphere_scene(fit: FittedMaterial, model: FacetModel) -> Scene {
+fn sphere_scene(fit: FittedMaterial, model: ModelChoice) -> Scene {
     let mut scene = Scene::default();
     scene.materials.push(Material {
         name: "sphere".into(),
@@ -34,10 +36,15 @@ fn sphere_scene(fit: FittedMaterial, model: FacetModel) -> Scene {
 fn render(gpu: &facet_gpu::Gpu, res: &SceneResources, scene: &Scene) -> facet_render::Image {
     let integrator = Integrator::new(&gpu.device, res).unwrap();
     let cfg = RenderConfig {
-        width: 48,
-        height: 48,
-        spp: 2,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: 48,
+            height: 48,
+            ..ImageConfig::preview()
+        },
+        sampling: SampleConfig {
+            spp: 2,
+            ..SampleConfig::preview()
+        },
     };
     let cam = CameraFrame::new(&scene.camera).unwrap();
     integrator
@@ -52,7 +59,7 @@ fn in_place_edit_renders_as_a_rebuild() {
         return;
     };
     let env = Environment::Constant(Vec3::splat(1.0));
-    for model in [FacetModel::Ggx, FacetModel::Tabulated] {
+    for model in [ModelChoice::Ggx, ModelChoice::Tabulated] {
         let base = demo_fit();
         let mut edited = base.record.clone();
         edited.tabulated.stretch.alpha_x *= 2.0;
@@ -94,11 +101,11 @@ fn class_changes_ask_for_a_rebuild() {
     let Some(gpu) = facet_gpu::gpu_for_tests("class_changes_ask_for_a_rebuild") else {
         return;
     };
-    let scene0 = sphere_scene(demo_fit(), FacetModel::Ggx);
+    let scene0 = sphere_scene(demo_fit(), ModelChoice::Ggx);
     let mut res = SceneResources::new(&gpu, &scene0, None, ResourceConfig::standard()).unwrap();
-    let scene1 = sphere_scene(demo_fit(), FacetModel::Tabulated);
+    let scene1 = sphere_scene(demo_fit(), ModelChoice::Tabulated);
     assert!(res.update_material(&gpu.queue, &scene1, 0).is_err());
-    let scene2 = sphere_scene(demo_fit(), FacetModel::Beckmann);
+    let scene2 = sphere_scene(demo_fit(), ModelChoice::Beckmann);
     assert!(res.update_material(&gpu.queue, &scene2, 0).is_err());
     assert!(res.update_material(&gpu.queue, &scene0, 5).is_err());
 }

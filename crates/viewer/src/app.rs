@@ -1,5 +1,6 @@
 //! The UI state: the edited material, the open/save fields, errors, the fit job. GPU objects
-//! live in [`crate::preview`]'s worker; this holds only its handle.
+//! live in [`crate::preview`]'s worker; this holds only its handle. The window drawn over this
+//! state (`ViewerApp::show`, the eframe app) is in `panels`.
 
 use crate::material::{EditedMaterial, MaterialKey};
 use crate::preview::{Command, Orbit, Preview, PreviewScene};
@@ -318,25 +319,5 @@ impl ViewerApp {
         for p in dropped {
             self.open(&p.display().to_string());
         }
-    }
-
-    /// The whole UI inside `ui` (the eframe app and the tests call this).
-    pub fn show(&mut self, ui: &mut egui::Ui) {
-        let ctx = ui.ctx().clone();
-        self.handle_drops(&ctx);
-        if self.poll_fit() {
-            ctx.request_repaint_after(std::time::Duration::from_millis(100));
-        }
-        crate::panels::material_panel(self, ui);
-        crate::panels::plots_panel(self, ui);
-        crate::panels::preview_panel(self, ui);
-        self.sync_material();
-    }
-}
-
-impl eframe::App for ViewerApp {
-    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
-        self.show(ui);
-        crate::panels::screenshot_step(self, ui.ctx());
     }
 }

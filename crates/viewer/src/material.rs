@@ -1,7 +1,7 @@
 //! The edited material: a fit record, the model shown, and the edits applied on top of it.
 
-use facet_fit::model::material::{FitRecord, FittedMaterial};
-use facet_render::scene::{FacetMaterial, FacetModel, GlintParams, Material};
+use facet_fit::model::material::{FitRecord, FittedMaterial, ModelChoice};
+use facet_render::scene::{FacetMaterial, GlintParams, Material};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -107,11 +107,11 @@ impl EditedMaterial {
     }
 
     /// The model the shown choice renders with.
-    pub fn model(&self) -> FacetModel {
+    pub fn model(&self) -> ModelChoice {
         match self.lobe() {
-            Shown::Measured | Shown::Tabulated => FacetModel::Tabulated,
-            Shown::Ggx | Shown::Glint => FacetModel::Ggx,
-            Shown::Beckmann => FacetModel::Beckmann,
+            Shown::Measured | Shown::Tabulated => ModelChoice::Tabulated,
+            Shown::Ggx | Shown::Glint => ModelChoice::Ggx,
+            Shown::Beckmann => ModelChoice::Beckmann,
         }
     }
 

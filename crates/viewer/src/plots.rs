@@ -3,7 +3,7 @@
 
 use crate::material::{EditedMaterial, MaterialKey, Shown};
 use egui::{Color32, Pos2, Rect, Stroke, Ui, pos2, vec2};
-use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::model::material::FittedMaterial;
 use glam::DVec3;
 use std::sync::{Arc, Mutex};
 
@@ -53,7 +53,16 @@ fn legend(ui: &mut Ui, items: &[(&str, Color32)]) {
 
 pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
     ui.heading("Plots");
-    // NDF slice at φ = 0, log10 D against θ in degrees.
+    ndf_slice(m, ui);
+    ui.add_space(8.0);
+    fresnel_curves(m, ui);
+    ui.add_space(8.0);
+    fit_errors(m, ui);
+}
+
+/// The NDF slice at φ = 0 of the data's fit and of the edited model.
+fn ndf_slice(m: &EditedMaterial, ui: &mut Ui) {
+    // log10 D against θ in degrees.
     let thetas: Vec<f64> = (0..=160).map(|i| i as f64 * 0.5).collect();
     let slice = |ndf: &facet_fit::model::microfacet::Ndf| -> Vec<f64> {
         thetas
@@ -65,11 +74,7 @@ pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
             .collect()
     };
     let data = slice(&m.base.tabulated.ndf);
-    let choice = match m.model() {
-        facet_render::scene::FacetModel::Tabulated => ModelChoice::Tabulated,
-        facet_render::scene::FacetModel::Ggx => ModelChoice::Ggx,
-        facet_render::scene::FacetModel::Beckmann => ModelChoice::Beckmann,
-    };
+    let choice = m.model();
     let edited = edited_fit(m);
     let model = edited
         .as_ref()
@@ -104,9 +109,10 @@ pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
             ),
         ],
     );
+}
 
-    // Fresnel per channel of the edited model.
-    ui.add_space(8.0);
+/// F(θd) per channel of the edited model.
+fn fresnel_curves(m: &EditedMaterial, ui: &mut Ui) {
     let rec = m.edited_record();
     let table = match m.lobe() {
         Shown::Ggx | Shown::Glint => rec.ggx.as_ref().map(|p| &p.fresnel),
@@ -143,9 +149,10 @@ pub fn plots(m: &EditedMaterial, ui: &mut Ui) {
             .collect();
         painter.add(egui::Shape::line(pts, Stroke::new(1.5, col)));
     }
+}
 
-    // Fit errors.
-    ui.add_space(8.0);
+/// The fit's recorded errors, as bars.
+fn fit_errors(m: &EditedMaterial, ui: &mut Ui) {
     ui.label("Fit errors (relative, as recorded by the fit):");
     let r = &m.base.record;
     let rows = [

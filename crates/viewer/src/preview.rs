@@ -12,7 +12,9 @@
 use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
-use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, Wavefront};
+use facet_render::{
+    ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources, Wavefront,
+};
 use glam::Vec3;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use std::sync::{Arc, Mutex};
@@ -22,7 +24,7 @@ use std::time::Instant;
 pub const SPHERE: usize = 1;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
-pub use facet_render::wavefront::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
+pub use facet_render::pacing::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
 
 /// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -282,7 +284,13 @@ fn build(gpu: &Gpu, scene: &Scene, env: &Environment, size: (u32, u32)) -> Resul
     let res = SceneResources::new(gpu, scene, Some(env), ResourceConfig::standard())
         .map_err(|e| e.to_string())?;
     let integrator = Integrator::new(&gpu.device, &res).map_err(|e| e.to_string())?;
-    let wavefront = Wavefront::new(gpu, &integrator, &res, size.0, size.1, size.0 * size.1)
+    let image = ImageConfig {
+        width: size.0,
+        height: size.1,
+        wavefront: size.0 * size.1,
+    };
+    let wavefront = integrator
+        .wavefront(gpu, &res, image)
         .map_err(|e| e.to_string())?;
     Ok(Built {
         res,
@@ -294,172 +302,270 @@ fn build(gpu: &Gpu, scene: &Scene, env: &Environment, size: (u32, u32)) -> Resul
 fn worker(
     gpu: Gpu,
     preview: PreviewScene,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     rx: Receiver<Command>,
     shared: &Mutex<Shared>,
     repaint: &dyn Fn(),
 ) -> Result<(), String> {
-    let env = preview_environment();
-    let PreviewScene {
-        mut scene,
-        mut edited,
-        orbit,
-    } = preview;
-    let mut orbit = orbit;
-    let size = (width, height);
-    let mut built = build(&gpu, &scene, &env, size)?;
-    let mut camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
-    let n = (width * height) as usize;
-    let mut exposure = 0f32;
-    let mut batch = 1u32;
-    let mut generation = 0u64;
-    let mut pending_latency: Option<Instant> = None;
-    let mut started = Instant::now();
-    let mut frame = 0u64;
-    {
-        let mut s = shared.lock().unwrap();
-        s.rebuilding = false;
-        s.width = width;
-        s.height = height;
-    }
+    let mut w = Worker::new(gpu, preview, size, shared, repaint)?;
     loop {
         // Commands: block only when there is nothing left to render.
-        let mut cmds = Vec::new();
-        if built.wavefront.spp() >= MAX_SAMPLES {
-            match rx.recv() {
-                Ok(c) => cmds.push(c),
-                Err(_) => return Ok(()),
+        let idle = w.built.wavefront.spp() >= MAX_SAMPLES;
+        let Some(cmds) = receive(&rx, idle) else {
+            return Ok(());
+        };
+        let Some(mut asked) = w.apply(cmds) else {
+            return Ok(());
+        };
+        if let Some((generation, material, sent)) = asked.material.take() {
+            if !w.edit_material(generation, *material, sent) {
+                continue;
             }
+            asked.restart = true;
         }
-        loop {
-            match rx.try_recv() {
-                Ok(c) => cmds.push(c),
-                Err(TryRecvError::Empty) => break,
-                Err(TryRecvError::Disconnected) => return Ok(()),
-            }
+        if asked.restart {
+            w.restart()?;
         }
-        let mut restart = false;
-        let mut retone = false;
-        let mut new_material = None;
+        w.step(asked.retone)?;
+    }
+}
+
+/// The commands waiting, after waiting for one when `block`; `None` once the UI is gone.
+fn receive(rx: &Receiver<Command>, block: bool) -> Option<Vec<Command>> {
+    let mut cmds = Vec::new();
+    if block {
+        cmds.push(rx.recv().ok()?);
+    }
+    loop {
+        match rx.try_recv() {
+            Ok(c) => cmds.push(c),
+            Err(TryRecvError::Empty) => return Some(cmds),
+            Err(TryRecvError::Disconnected) => return None,
+        }
+    }
+}
+
+/// What one round of commands asks for.
+#[derive(Default)]
+struct Asked {
+    /// Start the accumulation again (another camera or scene).
+    restart: bool,
+    /// Tone map again (another exposure).
+    retone: bool,
+    /// The last material sent: its generation, the material, when it was edited.
+    material: Option<(u64, Box<Material>, Instant)>,
+}
+
+/// The worker's state between batches.
+struct Worker<'a> {
+    gpu: Gpu,
+    env: Environment,
+    size: (u32, u32),
+    scene: Scene,
+    /// The index of the edited material in `scene`.
+    edited: usize,
+    orbit: Orbit,
+    built: Built,
+    camera: CameraFrame,
+    exposure: f32,
+    /// Samples per pixel of the next batch.
+    batch: u32,
+    /// The material generation being accumulated.
+    generation: u64,
+    /// When the edit being shown was made, until its first frame is published.
+    pending_latency: Option<Instant>,
+    /// When the current accumulation started.
+    started: Instant,
+    /// Frames published.
+    frame: u64,
+    shared: &'a Mutex<Shared>,
+    repaint: &'a dyn Fn(),
+}
+
+impl<'a> Worker<'a> {
+    fn new(
+        gpu: Gpu,
+        preview: PreviewScene,
+        size: (u32, u32),
+        shared: &'a Mutex<Shared>,
+        repaint: &'a dyn Fn(),
+    ) -> Result<Self, String> {
+        let env = preview_environment();
+        let PreviewScene {
+            scene,
+            edited,
+            orbit,
+        } = preview;
+        let built = build(&gpu, &scene, &env, size)?;
+        let camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
+        {
+            let mut s = shared.lock().unwrap();
+            s.rebuilding = false;
+            (s.width, s.height) = size;
+        }
+        Ok(Worker {
+            gpu,
+            env,
+            size,
+            scene,
+            edited,
+            orbit,
+            built,
+            camera,
+            exposure: 0.0,
+            batch: 1,
+            generation: 0,
+            pending_latency: None,
+            started: Instant::now(),
+            frame: 0,
+            shared,
+            repaint,
+        })
+    }
+
+    /// Applies the scene, camera and exposure commands; the last material is left to
+    /// [`Worker::edit_material`]. `None` on `Quit`.
+    fn apply(&mut self, cmds: Vec<Command>) -> Option<Asked> {
+        let mut asked = Asked::default();
         for c in cmds {
             match c {
-                Command::Quit => return Ok(()),
+                Command::Quit => return None,
                 Command::Scene(p) => {
-                    shared.lock().unwrap().rebuilding = true;
-                    repaint();
-                    let b = build(&gpu, &p.scene, &env, size);
-                    let mut s = shared.lock().unwrap();
-                    s.rebuilding = false;
+                    let b = self.rebuild(&p.scene);
+                    let mut s = self.shared.lock().unwrap();
                     match b {
                         Ok(b) => {
-                            built = b;
-                            scene = p.scene;
-                            edited = p.edited;
-                            orbit = p.orbit;
-                            restart = true;
+                            self.built = b;
+                            self.scene = p.scene;
+                            self.edited = p.edited;
+                            self.orbit = p.orbit;
+                            asked.restart = true;
                         }
                         Err(e) => s.error = Some(format!("preview scene: {e}")),
                     }
                 }
                 Command::Camera(o) => {
-                    orbit = o;
-                    restart = true;
+                    self.orbit = o;
+                    asked.restart = true;
                 }
                 Command::Exposure(e) => {
-                    exposure = e;
-                    retone = true;
+                    self.exposure = e;
+                    asked.retone = true;
                 }
                 Command::Material {
-                    generation: g,
+                    generation,
                     material,
                     sent,
-                } => new_material = Some((g, material, sent)),
+                } => asked.material = Some((generation, material, sent)),
             }
         }
-        if let Some((g, material, sent)) = new_material {
-            let name = scene.materials[edited].name.clone();
-            scene.materials[edited] = Material { name, ..*material };
-            let in_place = built
-                .res
-                .update_material(&gpu.queue, &scene, edited)
-                .is_ok();
-            if !in_place {
-                shared.lock().unwrap().rebuilding = true;
-                repaint();
-                let b = build(&gpu, &scene, &env, size);
-                let mut s = shared.lock().unwrap();
-                s.rebuilding = false;
-                match b {
-                    Ok(b) => built = b,
-                    Err(e) => {
-                        s.error = Some(format!("preview: {e}"));
-                        drop(s);
-                        repaint();
-                        continue;
-                    }
+        Some(asked)
+    }
+
+    /// New resources for `scene`, with `rebuilding` published while they are made.
+    fn rebuild(&self, scene: &Scene) -> Result<Built, String> {
+        self.shared.lock().unwrap().rebuilding = true;
+        (self.repaint)();
+        let b = build(&self.gpu, scene, &self.env, self.size);
+        self.shared.lock().unwrap().rebuilding = false;
+        b
+    }
+
+    /// The edited material becomes `material` (generation `generation`, edited at `sent`): in
+    /// place where it can, else with new resources. False when those could not be made (the
+    /// error is published).
+    fn edit_material(&mut self, generation: u64, material: Material, sent: Instant) -> bool {
+        let name = self.scene.materials[self.edited].name.clone();
+        self.scene.materials[self.edited] = Material { name, ..material };
+        let in_place = self
+            .built
+            .res
+            .update_material(&self.gpu.queue, &self.scene, self.edited)
+            .is_ok();
+        if !in_place {
+            match self.rebuild(&self.scene) {
+                Ok(b) => self.built = b,
+                Err(e) => {
+                    self.shared.lock().unwrap().error = Some(format!("preview: {e}"));
+                    (self.repaint)();
+                    return false;
                 }
             }
-            shared.lock().unwrap().last_rebuilt = !in_place;
-            generation = g;
-            pending_latency = Some(sent);
-            restart = true;
         }
-        if restart {
-            camera = CameraFrame::new(&orbit.camera()).map_err(|e| e.to_string())?;
-            built.wavefront.clear(&gpu);
-            started = Instant::now();
-        }
+        self.shared.lock().unwrap().last_rebuilt = !in_place;
+        self.generation = generation;
+        self.pending_latency = Some(sent);
+        true
+    }
+
+    /// Starts the accumulation again, from the current orbit.
+    fn restart(&mut self) -> Result<(), String> {
+        self.camera = CameraFrame::new(&self.orbit.camera()).map_err(|e| e.to_string())?;
+        self.built.wavefront.clear(&self.gpu);
+        self.started = Instant::now();
+        Ok(())
+    }
+
+    /// Renders a batch (unless the film is full), tone maps and publishes the frame; with a
+    /// full film only when `retone`.
+    fn step(&mut self, retone: bool) -> Result<(), String> {
         let t = Instant::now();
-        let sampling = built.wavefront.spp() < MAX_SAMPLES;
+        let sampling = self.built.wavefront.spp() < MAX_SAMPLES;
         if sampling {
-            let cfg = RenderConfig {
-                width,
-                height,
-                spp: batch.min(MAX_SAMPLES - built.wavefront.spp()),
+            let cfg = SampleConfig {
+                spp: self.batch.min(MAX_SAMPLES - self.built.wavefront.spp()),
                 spp_per_pass: MAX_SPP_PER_FRAME,
-                ..RenderConfig::preview()
+                ..SampleConfig::preview()
             };
             let Built {
-                res,
                 integrator,
                 wavefront,
-            } = &mut built;
-            wavefront
-                .render_more(&gpu, integrator, res, &camera, &cfg, &mut |_| {})
+                ..
+            } = &mut self.built;
+            integrator
+                .render_more(&self.gpu, wavefront, &self.camera, &cfg, &mut |_| {})
                 .map_err(|e| format!("preview render: {e}"))?;
         } else if !retone {
-            continue;
+            return Ok(());
         }
-        let rgba = built
+        let rgba = self
+            .built
             .wavefront
-            .tone_mapped(&gpu, exposure)
+            .tone_mapped(&self.gpu, self.exposure)
             .map_err(|e| format!("preview tone map: {e}"))?;
-        gpu.check_lost().map_err(|e| e.to_string())?;
+        self.gpu.check_lost().map_err(|e| e.to_string())?;
         let frame_ms = t.elapsed().as_secs_f64() * 1e3;
-        let added = if sampling { batch } else { 0 };
+        let added = sampling.then_some(self.batch);
         if sampling {
-            batch = next_batch(batch, frame_ms);
+            self.batch = next_batch(self.batch, frame_ms);
         }
-        frame += 1;
-        let samples = built.wavefront.spp();
-        let secs = started.elapsed().as_secs_f64().max(1e-9);
+        self.publish(rgba, frame_ms, added);
+        Ok(())
+    }
+
+    /// Publishes a frame that took `frame_ms`, `added` samples per pixel when it sampled.
+    fn publish(&mut self, rgba: Vec<[u8; 4]>, frame_ms: f64, added: Option<u32>) {
+        self.frame += 1;
+        let samples = self.built.wavefront.spp();
+        let secs = self.started.elapsed().as_secs_f64().max(1e-9);
+        let n = self.size.0 as f64 * self.size.1 as f64;
         {
-            let mut s = shared.lock().unwrap();
-            s.generation = generation;
+            let mut s = self.shared.lock().unwrap();
+            s.generation = self.generation;
             s.rgba = rgba;
-            s.exposure = exposure;
+            s.exposure = self.exposure;
             s.samples = samples;
-            s.frame = frame;
-            if sampling {
+            s.frame = self.frame;
+            if let Some(added) = added {
                 s.frame_ms = frame_ms;
                 s.spp_per_frame = added;
             }
             s.spp_per_s = samples as f64 / secs;
-            s.samples_per_s = samples as f64 * n as f64 / secs;
-            if let Some(sent) = pending_latency.take() {
+            s.samples_per_s = samples as f64 * n / secs;
+            if let Some(sent) = self.pending_latency.take() {
                 s.latency_ms = Some(sent.elapsed().as_secs_f64() * 1e3);
             }
         }
-        repaint();
+        (self.repaint)();
     }
 }

@@ -4,8 +4,7 @@
 use egui::accesskit::Role;
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
-use facet_fit::model::material::FittedMaterial;
-use facet_render::scene::FacetModel;
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_viewer::ViewerApp;
 use facet_viewer::material::Shown;
 
@@ -23,15 +22,15 @@ fn rendered_alpha(app: &ViewerApp) -> (f64, f64) {
     let m = app.material.render_material().unwrap();
     let f = m.facet.unwrap();
     match f.model {
-        FacetModel::Tabulated => {
+        ModelChoice::Tabulated => {
             let s = f.fit.record.tabulated.stretch;
             (s.alpha_x, s.alpha_y)
         }
-        FacetModel::Ggx => {
+        ModelChoice::Ggx => {
             let p = f.fit.record.ggx.as_ref().unwrap();
             (p.alpha_x, p.alpha_y)
         }
-        FacetModel::Beckmann => {
+        ModelChoice::Beckmann => {
             let p = f.fit.record.beckmann.as_ref().unwrap();
             (p.alpha_x, p.alpha_y)
         }

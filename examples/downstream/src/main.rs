@@ -11,8 +11,10 @@ use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_glint::dpf::{dpf, query_directions};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{Environment, FacetMaterial, FacetModel, Material, shapes};
-use facet_render::{Gpu, Integrator, RenderConfig, ResourceConfig, SceneResources};
+use facet_render::scene::{Environment, FacetMaterial, Material, shapes};
+use facet_render::{
+    Gpu, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+};
 use std::path::PathBuf;
 use std::sync::Arc;
 
@@ -50,7 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         facet: Some(FacetMaterial {
             source: json.clone(),
             fit: Arc::new(loaded),
-            model: FacetModel::Tabulated,
+            model: ModelChoice::Tabulated,
             glint: None,
         }),
         ..Material::default()
@@ -63,11 +65,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let integrator = Integrator::new(&gpu.device, &resources)?;
     let camera = CameraFrame::new(&scene.camera)?;
     let config = RenderConfig {
-        width: 64,
-        height: 64,
-        spp: 4,
-        wavefront: 64 * 64,
-        ..RenderConfig::preview()
+        image: ImageConfig {
+            width: 64,
+            height: 64,
+            wavefront: 64 * 64,
+        },
+        sampling: SampleConfig {
+            spp: 4,
+            ..SampleConfig::preview()
+        },
     };
     let (image, stats) = integrator.render(&gpu, &resources, &camera, &config, &mut |_| {})?;
     image.write_png(&out.join("sphere.png"), 0.0)?;

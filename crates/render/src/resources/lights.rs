@@ -110,98 +110,28 @@ impl LightSet {
                 .map(|(p, n)| Probe { p: *p, n: *n })
                 .collect();
         }
-        let probes = set.probes.clone();
-        // Mean over the probes of g(l, d², n): l the unit vector from the probe to x, d² its
-        // squared distance (kept above (r / 1000)²), n the probe's normal.
-        let near = (1e-3 * radius).powi(2);
-        let mean_over = |x: Vec3, g: &dyn Fn(Vec3, f32, Vec3) -> f32| {
-            probes
-                .iter()
-                .map(|q| {
-                    let v = x - q.p;
-                    g(v.normalize_or_zero(), v.length_squared().max(near), q.n)
-                })
-                .sum::<f32>()
-                / probes.len().max(1) as f32
+        let probes = ProbeMean {
+            probes: set.probes.clone(),
+            near: (1e-3 * radius).powi(2),
         };
         for l in &scene.lights {
-            let contribution = match *l {
-                Light::Point {
-                    position,
-                    intensity,
-                } => luminance(intensity) * mean_over(position, &|l, d2, n| n.dot(l).max(0.0) / d2),
-                Light::Spot {
-                    position,
-                    direction,
-                    intensity,
-                    inner_cone,
-                    outer_cone,
-                } => {
-                    let (ci, co) = (inner_cone.cos(), outer_cone.cos());
-                    // glTF's smooth falloff t², t = (cos α − cos outer) / (cos inner − cos outer).
-                    // l points from the probe to the light: the light sees the probe along −l.
-                    let falloff = |l: Vec3| {
-                        let t = ((-l).dot(direction) - co) / (ci - co).max(1e-4);
-                        t.clamp(0.0, 1.0).powi(2)
-                    };
-                    luminance(intensity)
-                        * mean_over(position, &|l, d2, n| falloff(l) * n.dot(l).max(0.0) / d2)
-                }
-                Light::Directional {
-                    direction,
-                    irradiance,
-                } => {
-                    let l = -direction.normalize_or_zero();
-                    luminance(irradiance) * probes.iter().map(|q| q.n.dot(l).max(0.0)).sum::<f32>()
-                        / probes.len().max(1) as f32
-                }
-            };
-            let (g, p) = match *l {
-                Light::Point {
-                    position,
-                    intensity,
-                } => (
-                    GpuLight {
-                        kind: LightKind::Point as u32,
-                        position: position.extend(1.0).to_array(),
-                        intensity: intensity.extend(0.0).to_array(),
-                        ..Default::default()
-                    },
-                    4.0 * PI * luminance(intensity),
-                ),
-                Light::Spot {
-                    position,
-                    direction,
-                    intensity,
-                    inner_cone,
-                    outer_cone,
-                } => (
-                    GpuLight {
-                        kind: LightKind::Spot as u32,
-                        cos_inner: inner_cone.cos(),
-                        cos_outer: outer_cone.cos(),
-                        position: position.extend(1.0).to_array(),
-                        direction: direction.extend(0.0).to_array(),
-                        intensity: intensity.extend(0.0).to_array(),
-                        ..Default::default()
-                    },
-                    2.0 * PI * (1.0 - outer_cone.cos()) * luminance(intensity),
-                ),
-                Light::Directional {
-                    direction,
-                    irradiance,
-                } => (
-                    GpuLight {
-                        kind: LightKind::Directional as u32,
-                        direction: direction.extend(0.0).to_array(),
-                        intensity: irradiance.extend(0.0).to_array(),
-                        ..Default::default()
-                    },
-                    PI * radius * radius * luminance(irradiance),
-                ),
-            };
-            set.push(g, p, contribution);
+            let (g, p) = punctual_record(l, radius);
+            set.push(g, p, probes.punctual_contribution(l));
         }
+        set.add_emissive_triangles(scene, materials, &probes);
+        if set.triangle_light.is_empty() {
+            set.triangle_light.push(NONE);
+        }
+        set
+    }
+
+    /// Adds every triangle whose material emits, with its contribution to `probes`.
+    fn add_emissive_triangles(
+        &mut self,
+        scene: &Scene,
+        materials: &[GpuMaterial],
+        probes: &ProbeMean,
+    ) {
         for (ti, tri) in scene.indices.iter().enumerate() {
             let m = &materials[scene.triangle_material[ti] as usize];
             let le = Vec3::from_slice(&m.emissive[..3]);
@@ -216,27 +146,23 @@ impl LightSet {
             // One-sided: Le A cos θl cos θ / d² toward the probes in front.
             let contribution = luminance(le)
                 * area
-                * mean_over(centre, &|l, d2, n| {
+                * probes.mean(centre, &|l, d2, n| {
                     normal.dot(-l).max(0.0) * n.dot(l).max(0.0) / d2
                 });
-            if set.triangle_light.is_empty() {
-                set.triangle_light = vec![NONE; scene.indices.len()];
+            if self.triangle_light.is_empty() {
+                self.triangle_light = vec![NONE; scene.indices.len()];
             }
-            set.triangle_light[ti] = set.lights.len() as u32;
+            self.triangle_light[ti] = self.lights.len() as u32;
             let light = GpuLight {
                 kind: LightKind::Triangle as u32,
                 prim: ti as u32,
                 ..Default::default()
             };
             // Flux of a Lambertian emitter: π A Le.
-            set.lights.push(light);
-            set.power.push(PI * area * luminance(le));
-            set.contribution.push(contribution);
+            self.lights.push(light);
+            self.power.push(PI * area * luminance(le));
+            self.contribution.push(contribution);
         }
-        if set.triangle_light.is_empty() {
-            set.triangle_light.push(NONE);
-        }
-        set
     }
 
     /// Adds a light if its power is positive.
@@ -288,5 +214,115 @@ impl LightSet {
             *last = 1.0;
         }
         tables.push("the scene's lights", cdf)
+    }
+}
+
+/// Means over the probes, for the lights' contributions.
+struct ProbeMean {
+    probes: Vec<Probe>,
+    /// The least squared distance counted, (r / 1000)².
+    near: f32,
+}
+
+impl ProbeMean {
+    /// Mean over the probes of g(l, d², n): l the unit vector from the probe to x, d² its
+    /// squared distance (kept above `near`), n the probe's normal.
+    fn mean(&self, x: Vec3, g: &dyn Fn(Vec3, f32, Vec3) -> f32) -> f32 {
+        self.probes
+            .iter()
+            .map(|q| {
+                let v = x - q.p;
+                g(
+                    v.normalize_or_zero(),
+                    v.length_squared().max(self.near),
+                    q.n,
+                )
+            })
+            .sum::<f32>()
+            / self.probes.len().max(1) as f32
+    }
+
+    /// The mean irradiance punctual light `l` delivers to the probes.
+    fn punctual_contribution(&self, l: &Light) -> f32 {
+        match *l {
+            Light::Point {
+                position,
+                intensity,
+            } => luminance(intensity) * self.mean(position, &|l, d2, n| n.dot(l).max(0.0) / d2),
+            Light::Spot {
+                position,
+                direction,
+                intensity,
+                inner_cone,
+                outer_cone,
+            } => {
+                let (ci, co) = (inner_cone.cos(), outer_cone.cos());
+                // glTF's smooth falloff t², t = (cos α − cos outer) / (cos inner − cos outer).
+                // l points from the probe to the light: the light sees the probe along −l.
+                let falloff = |l: Vec3| {
+                    let t = ((-l).dot(direction) - co) / (ci - co).max(1e-4);
+                    t.clamp(0.0, 1.0).powi(2)
+                };
+                luminance(intensity)
+                    * self.mean(position, &|l, d2, n| falloff(l) * n.dot(l).max(0.0) / d2)
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+            } => {
+                let l = -direction.normalize_or_zero();
+                luminance(irradiance) * self.probes.iter().map(|q| q.n.dot(l).max(0.0)).sum::<f32>()
+                    / self.probes.len().max(1) as f32
+            }
+        }
+    }
+}
+
+/// Punctual light `l`'s record and power; `radius` bounds the scene (a directional light's
+/// power is its flux through that disc).
+fn punctual_record(l: &Light, radius: f32) -> (GpuLight, f32) {
+    match *l {
+        Light::Point {
+            position,
+            intensity,
+        } => (
+            GpuLight {
+                kind: LightKind::Point as u32,
+                position: position.extend(1.0).to_array(),
+                intensity: intensity.extend(0.0).to_array(),
+                ..Default::default()
+            },
+            4.0 * PI * luminance(intensity),
+        ),
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            inner_cone,
+            outer_cone,
+        } => (
+            GpuLight {
+                kind: LightKind::Spot as u32,
+                cos_inner: inner_cone.cos(),
+                cos_outer: outer_cone.cos(),
+                position: position.extend(1.0).to_array(),
+                direction: direction.extend(0.0).to_array(),
+                intensity: intensity.extend(0.0).to_array(),
+                ..Default::default()
+            },
+            2.0 * PI * (1.0 - outer_cone.cos()) * luminance(intensity),
+        ),
+        Light::Directional {
+            direction,
+            irradiance,
+        } => (
+            GpuLight {
+                kind: LightKind::Directional as u32,
+                direction: direction.extend(0.0).to_array(),
+                intensity: irradiance.extend(0.0).to_array(),
+                ..Default::default()
+            },
+            PI * radius * radius * luminance(irradiance),
+        ),
     }
 }

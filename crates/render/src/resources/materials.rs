@@ -5,20 +5,86 @@ use super::tables::Tables;
 use crate::error::RenderError;
 use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
-use crate::scene::{FacetModel, GlintParams, Material};
-use facet_fit::model::material::ModelChoice;
-use facet_fit::model::microfacet::Ndf;
+use crate::scene::{GlintParams, Material};
+use facet_fit::model::microfacet::{Ndf, NdfKind};
 use facet_fit::model::tabulated::TabulatedNdf;
 use facet_glint::tags::NdfTag;
 
 /// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
 pub const FRESNEL_NODES: usize = 91;
 
-/// What one material needs on the GPU: its record (table offsets and queue still to be
-/// assigned), its Fresnel table, its tabulated NDF, its glint parameters.
+/// An uploaded material as the CPU knows it: its GPU record and, as types, the class, NDF kind
+/// and shading queue that the record carries as tags for the GPU. The CPU reads these from here;
+/// the record's tags are written from them, never parsed back.
+#[derive(Clone, Copy, Debug)]
+pub struct MaterialSlot {
+    gpu: GpuMaterial,
+    kind: MaterialKind,
+    ndf: Option<NdfKind>,
+    queue: Queue,
+}
+
+impl MaterialSlot {
+    /// `gpu` with its class and queue tags written from `kind` and `queue`.
+    fn new(gpu: GpuMaterial, kind: MaterialKind, ndf: Option<NdfKind>, queue: Queue) -> Self {
+        let mut slot = MaterialSlot {
+            gpu,
+            kind,
+            ndf,
+            queue,
+        };
+        slot.gpu.kind = kind as u32;
+        slot.set_queue(queue);
+        slot
+    }
+
+    /// The record as uploaded.
+    pub fn gpu(&self) -> &GpuMaterial {
+        &self.gpu
+    }
+
+    /// The material's class.
+    pub fn kind(&self) -> MaterialKind {
+        self.kind
+    }
+
+    /// The analytic NDF's kind (`None`: a glTF material, or a tabulated NDF).
+    pub fn ndf(&self) -> Option<NdfKind> {
+        self.ndf
+    }
+
+    /// The shading queue its hits go to.
+    pub(crate) fn queue(&self) -> Queue {
+        self.queue
+    }
+
+    /// Routes the material's hits to `queue`.
+    pub(crate) fn set_queue(&mut self, queue: Queue) {
+        self.queue = queue;
+        self.gpu.queue = queue.index();
+    }
+
+    /// The slot with the record's table offsets and queue taken from `old` (an update in place).
+    pub(crate) fn in_place_of(self, old: &MaterialSlot) -> MaterialSlot {
+        let mut slot = MaterialSlot {
+            gpu: GpuMaterial {
+                fresnel_offset: old.gpu.fresnel_offset,
+                fresnel_count: old.gpu.fresnel_count,
+                tab_offset: old.gpu.tab_offset,
+                ..self.gpu
+            },
+            ..self
+        };
+        slot.set_queue(old.queue);
+        slot
+    }
+}
+
+/// What one material needs on the GPU: its slot (table offsets and a glint material's queue
+/// still to be assigned), its Fresnel table, its tabulated NDF, its glint parameters.
 pub struct MaterialPlan<'a> {
-    /// The material's GPU record.
-    pub gpu: GpuMaterial,
+    /// The material's record and class.
+    pub slot: MaterialSlot,
     /// F(θd) at FRESNEL_NODES nodes, RGB interleaved (fitted materials).
     pub fresnel: Option<Vec<f32>>,
     /// A tabulated material's NDF.
@@ -28,13 +94,13 @@ pub struct MaterialPlan<'a> {
 }
 
 impl MaterialPlan<'_> {
-    /// Whether `self` fits in place of `old` (the record uploaded before): the same class and
+    /// Whether `self` fits in place of `old` (the slot uploaded before): the same class and
     /// NDF kind, no glints, so the same tables at the same offsets.
-    pub fn fits_in_place_of(&self, old: &GpuMaterial) -> Result<(), &'static str> {
-        if self.glint.is_some() || old.kind == MaterialKind::Glint as u32 {
+    pub fn fits_in_place_of(&self, old: &MaterialSlot) -> Result<(), &'static str> {
+        if self.glint.is_some() || old.kind == MaterialKind::Glint {
             return Err("glint materials are rebuilt");
         }
-        if self.gpu.kind != old.kind || self.gpu.ndf_kind != old.ndf_kind {
+        if self.slot.kind != old.kind || self.slot.ndf != old.ndf {
             return Err("the material class changed");
         }
         if self.fresnel.is_none() {
@@ -46,11 +112,11 @@ impl MaterialPlan<'_> {
     /// Appends the plan's tables (Fresnel, tabulated NDF) to `tables` and sets their offsets.
     pub fn place_tables(&mut self, tables: &mut Tables, source: &str) {
         if let Some(f) = &self.fresnel {
-            self.gpu.fresnel_offset = tables.push(source, f.iter().copied());
-            self.gpu.fresnel_count = FRESNEL_NODES as u32;
+            self.slot.gpu.fresnel_offset = tables.push(source, f.iter().copied());
+            self.slot.gpu.fresnel_count = FRESNEL_NODES as u32;
         }
         if let Some(tab) = self.tabulated {
-            self.gpu.tab_offset = tables.push(source, tabulated_block(tab));
+            self.slot.gpu.tab_offset = tables.push(source, tabulated_block(tab));
         }
     }
 }
@@ -89,7 +155,6 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
     let mut gpu = GpuMaterial {
         base_color: m.base_color.to_array(),
         emissive: m.emissive.extend(m.specular).to_array(),
-        kind: MaterialKind::Gltf as u32,
         alpha_x: 1.0,
         alpha_y: 1.0,
         metallic: m.metallic,
@@ -99,23 +164,17 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
         tex_mr: texture(m.metallic_roughness_texture),
         tex_normal: texture(m.normal_texture),
         tex_emissive: texture(m.emissive_texture),
-        queue: Queue::Diffuse.index(),
         ..Default::default()
     };
     let Some(f) = &m.facet else {
         return Ok(MaterialPlan {
-            gpu,
+            slot: MaterialSlot::new(gpu, MaterialKind::Gltf, None, Queue::Diffuse),
             fresnel: None,
             tabulated: None,
             glint: None,
         });
     };
-    let choice = match f.model {
-        FacetModel::Tabulated => ModelChoice::Tabulated,
-        FacetModel::Ggx => ModelChoice::Ggx,
-        FacetModel::Beckmann => ModelChoice::Beckmann,
-    };
-    let brdf = f.fit.model(choice).ok_or_else(|| {
+    let brdf = f.fit.model(f.model).ok_or_else(|| {
         RenderError::input(
             &f.source,
             format!("material {:?}: the fit has no {:?} model", m.name, f.model),
@@ -134,14 +193,13 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
         0.0,
     ];
     let mut tabulated = None;
-    match &brdf.ndf {
+    let (mut kind, ndf, queue) = match &brdf.ndf {
         Ndf::Analytic(a) => {
-            gpu.kind = MaterialKind::Analytic as u32;
             gpu.ndf_kind = NdfTag::from(a.kind) as u32;
             (gpu.alpha_x, gpu.alpha_y) = (a.alpha_x as f32, a.alpha_y as f32);
             gpu.rotation = a.rotation as f32;
             gpu.roughness = (a.alpha_x * a.alpha_y).sqrt() as f32;
-            gpu.queue = Queue::Analytic.index();
+            (MaterialKind::Analytic, Some(a.kind), Queue::Analytic)
         }
         Ndf::Tabulated(tab) => {
             // The ray cone widens by the fit's GGX α where there is one.
@@ -151,23 +209,22 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
                 .ggx
                 .as_ref()
                 .map_or(0.3, |p| (p.alpha_x * p.alpha_y).sqrt() as f32);
-            gpu.kind = MaterialKind::Tabulated as u32;
             let s = &tab.stretch;
             (gpu.alpha_x, gpu.alpha_y) = (s.alpha_x as f32, s.alpha_y as f32);
             gpu.rotation = s.rotation as f32;
             gpu.roughness = cone_alpha * (s.alpha_x * s.alpha_y).sqrt() as f32;
-            gpu.queue = Queue::Tabulated.index();
             tabulated = Some(tab.as_ref());
+            (MaterialKind::Tabulated, None, Queue::Tabulated)
         }
-    }
+    };
     // A glint material keeps its NDF's parameters (and a tabulated one its tables) for the
     // glint stage's D, Λ and sampling.
     let glint = f.glint.map(|g| {
-        gpu.kind = MaterialKind::Glint as u32;
+        kind = MaterialKind::Glint;
         (brdf.ndf.clone(), g)
     });
     Ok(MaterialPlan {
-        gpu,
+        slot: MaterialSlot::new(gpu, kind, ndf, queue),
         fresnel: Some(fresnel),
         tabulated,
         glint,

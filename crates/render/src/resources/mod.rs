@@ -12,14 +12,15 @@ pub mod materials;
 mod tables;
 mod textures;
 
-pub use materials::FRESNEL_NODES;
+pub use materials::{FRESNEL_NODES, MaterialSlot};
 
 use crate::bvh::{Bvh, BvhConfig, GpuBvh};
 use crate::error::RenderError;
-use crate::gpu_types::{GpuLight, GpuMaterial};
+use crate::gpu_types::{GpuLight, GpuMaterial, GpuSceneInfo};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
-use crate::scene::{Environment, Scene};
+use crate::scene::{Environment, GlintParams, Scene};
+use facet_fit::model::microfacet::Ndf;
 use facet_glint::dpf::DpfConfig;
 use facet_glint::gpu::GpuDpf;
 use facet_gpu::{Gpu, buffer};
@@ -95,26 +96,13 @@ pub struct SceneResources {
     pub glints: Vec<GlintResources>,
     /// Which shading queues have hits routed to them.
     pub queues_used: Vec<Queue>,
-    /// Vertices uploaded.
-    pub n_vertices: u32,
-    /// Lights uploaded.
-    pub n_lights: u32,
-    /// Offset of the light-selection CDF in `tables`.
-    pub light_cdf: u32,
-    /// The environment's kind tag.
-    pub env_kind: u32,
-    /// The environment map's size.
-    pub env_size: (u32, u32),
-    /// Word offsets of the environment map's texels, marginal and conditional CDFs in `tables`.
-    pub env_offsets: (u32, u32, u32),
-    /// The constant environment's radiance.
-    pub env_color: [f32; 4],
-    /// Radius of the scene's bounding sphere.
-    pub scene_radius: f32,
+    /// The scene's part of the frame uniform: sizes, the light-selection CDF, the environment.
+    pub scene_info: GpuSceneInfo,
     /// What was built.
     pub built: Built,
-    /// The materials as uploaded (for [`SceneResources::update_material`]).
-    pub material_data: Vec<GpuMaterial>,
+    /// The materials as uploaded, with their class and queue (for
+    /// [`SceneResources::update_material`]).
+    pub material_slots: Vec<MaterialSlot>,
 }
 
 /// Settings of the resources that are not in the scene file.
@@ -156,79 +144,16 @@ impl SceneResources {
         let mut built = Built::default();
         let mut tables = Tables::default();
 
-        let t = std::time::Instant::now();
-        let bvh = Bvh::build(&scene.positions, &scene.indices, config.bvh);
-        built.bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
-        built.bvh_nodes = bvh.cwbvh.nodes.len();
-        let bvh_set_by = format!("the scene ({} triangles)", scene.indices.len());
-        limits.check(&[
-            Planned::storage(
-                "the BVH nodes",
-                product(&[bvh.cwbvh.nodes.len() as u64, 80]),
-                &bvh_set_by,
-            ),
-            Planned::storage(
-                "the BVH primitives",
-                product(&[bvh.cwbvh.primitive_indices.len() as u64, 4]),
-                &bvh_set_by,
-            ),
-            Planned::storage(
-                "the BVH triangles",
-                product(&[bvh.cwbvh.primitive_indices.len() as u64, 48]),
-                &bvh_set_by,
-            ),
-        ])?;
+        let bvh = build_bvh(scene, config.bvh, &limits, &mut built)?;
         let gpu_bvh = GpuBvh::upload(d, &bvh)?;
-
-        // Vertices: four regions of n vectors (position, normal, tangent, uv).
-        let n = scene.positions.len();
-        let mut vertices: Vec<[f32; 4]> = Vec::with_capacity(4 * n);
-        vertices.extend(scene.positions.iter().map(|p| p.extend(1.0).to_array()));
-        vertices.extend(scene.normals.iter().map(|p| p.extend(0.0).to_array()));
-        vertices.extend(scene.tangents.iter().map(|t| t.to_array()));
-        vertices.extend(scene.uvs.iter().map(|u| [u.x, u.y, 0.0, 0.0]));
-        let triangles: Vec<[u32; 4]> = scene
-            .indices
-            .iter()
-            .zip(&scene.triangle_material)
-            .map(|(i, m)| [i[0], i[1], i[2], *m])
-            .collect();
-
-        // Materials, their Fresnel and NDF tables; glint materials get a queue each.
-        let mut materials = Vec::with_capacity(scene.materials.len());
-        let mut glint_specs = Vec::new();
-        for (mi, m) in scene.materials.iter().enumerate() {
-            let mut plan = materials::plan(m)?;
-            if let Some(f) = &m.facet {
-                plan.place_tables(
-                    &mut tables,
-                    &format!("the fit {} of material `{}`", f.source.display(), m.name),
-                );
-            }
-            if plan.tabulated.is_some() {
-                built.tabulated_tables += 1;
-            }
-            if let Some((ndf, spec)) = plan.glint {
-                plan.gpu.queue = Queue::Glint(glint_specs.len() as u32).index();
-                glint_specs.push((mi as u32, ndf, spec));
-            }
-            materials.push(plan.gpu);
-        }
+        let (vertices, triangles) = geometry(scene);
+        let (slots, glint_specs) = plan_materials(scene, &mut tables, &mut built)?;
         // Only materials some triangle uses decide which pipelines and pyramids are built.
-        let mut used = vec![false; materials.len()];
+        let mut used = vec![false; slots.len()];
         for &m in &scene.triangle_material {
             used[m as usize] = true;
         }
-        let mut queues_used: Vec<Queue> = materials
-            .iter()
-            .zip(&used)
-            .filter(|(_, u)| **u)
-            .map(|(m, _)| Queue::from_index(m.queue))
-            .collect();
-        queues_used.sort_by_key(|q| q.index());
-        queues_used.dedup();
-        built.classes = queues_used.iter().map(|q| q.class_name()).collect();
-        built.classes.dedup();
+        let queues_used = queues_used(&slots, &used, &mut built);
 
         let t = std::time::Instant::now();
         let mut glints = Vec::new();
@@ -244,6 +169,7 @@ impl SceneResources {
         let tex_words = textures::texture_words(&scene.textures);
         built.textures = scene.textures.len();
 
+        let materials: Vec<GpuMaterial> = slots.iter().map(|s| *s.gpu()).collect();
         let (lo, hi) = scene.bounds();
         let radius = (0.5 * (hi - lo).length()).max(1e-3);
         let mut light_set = LightSet::new(scene, &bvh, &materials, radius);
@@ -265,62 +191,26 @@ impl SceneResources {
         if tables.words.is_empty() {
             tables.words.push(0.0);
         }
-        let size_of = |n: usize, each: usize| product(&[n as u64, each as u64]);
-        let n_tri = scene.indices.len();
-        let largest = scene
-            .textures
-            .iter()
-            .max_by_key(|t| u64::from(t.width) * u64::from(t.height))
-            .map_or(String::new(), |t| {
-                format!("; the largest, {}, is {}×{}", t.name, t.width, t.height)
-            });
-        limits.check(&[
-            Planned::storage(
-                "the vertex buffer",
-                size_of(vertices.len(), 16),
-                format!("the scene ({n} vertices)"),
-            ),
-            Planned::storage(
-                "the triangle buffer",
-                size_of(triangles.len(), 16),
-                format!("the scene ({n_tri} triangles)"),
-            ),
-            Planned::storage(
-                "the material buffer",
-                size_of(materials.len(), std::mem::size_of::<GpuMaterial>()),
-                format!("the scene ({} materials)", materials.len()),
-            ),
-            Planned::storage(
-                "the texture buffer",
-                size_of(tex_words.len(), 4),
-                format!("the scene's {} textures{largest}", scene.textures.len()),
-            ),
-            Planned::storage(
-                "the light buffer",
-                size_of(lights.len(), std::mem::size_of::<GpuLight>()),
-                format!(
-                    "the scene ({} punctual lights, {} emissive triangles)",
-                    scene.lights.len(),
-                    built.emissive_triangles
-                ),
-            ),
-            Planned::storage(
-                "the scene tables",
-                size_of(tables.words.len(), 4),
-                tables.described(),
-            ),
-            Planned::storage(
-                "the per-triangle light index",
-                size_of(triangle_light.len(), 4),
-                format!("the scene ({n_tri} triangles)"),
-            ),
-        ])?;
+        check_buffers(
+            &limits,
+            scene,
+            &built,
+            Buffers {
+                vertices: vertices.len(),
+                triangles: triangles.len(),
+                materials: materials.len(),
+                texture_words: tex_words.len(),
+                lights: lights.len(),
+                tables: &tables,
+                triangle_light: triangle_light.len(),
+            },
+        )?;
 
         let res = gpu.scoped(|| SceneResources {
             vertices: buffer::storage(d, "vertices", &vertices),
             triangles: buffer::storage(d, "triangles", &triangles),
             materials: buffer::storage(d, "materials", &materials),
-            material_data: materials.clone(),
+            material_slots: slots,
             textures: buffer::storage(d, "textures", &tex_words),
             lights: buffer::storage(d, "lights", &lights),
             tables: buffer::storage(d, "tables", &tables.words),
@@ -328,21 +218,229 @@ impl SceneResources {
             bvh: gpu_bvh,
             glints,
             queues_used,
-            n_vertices: n as u32,
-            n_lights: built.lights as u32,
-            light_cdf,
-            env_kind: env.kind as u32,
-            env_size: env.size,
-            env_offsets: env.offsets,
-            env_color: env.color,
-            scene_radius: radius,
+            scene_info: GpuSceneInfo {
+                n_vertices: scene.positions.len() as u32,
+                n_lights: built.lights as u32,
+                light_cdf,
+                env_kind: env.kind as u32,
+                env_width: env.size.0,
+                env_height: env.size.1,
+                env_texels: env.offsets.0,
+                env_marginal: env.offsets.1,
+                env_conditional: env.offsets.2,
+                scene_radius: radius,
+                env_color: env.color,
+                ..Default::default()
+            },
             built,
         })?;
         Ok(res)
     }
 }
 
+/// The scene's CWBVH, checked against the device's limits before it is uploaded.
+fn build_bvh(
+    scene: &Scene,
+    config: BvhConfig,
+    limits: &DeviceLimits,
+    built: &mut Built,
+) -> Result<Bvh, RenderError> {
+    let t = std::time::Instant::now();
+    let bvh = Bvh::build(&scene.positions, &scene.indices, config);
+    built.bvh_build_ms = t.elapsed().as_secs_f64() * 1e3;
+    built.bvh_nodes = bvh.cwbvh.nodes.len();
+    let bvh_set_by = format!("the scene ({} triangles)", scene.indices.len());
+    limits.check(&[
+        Planned::storage(
+            "the BVH nodes",
+            product(&[bvh.cwbvh.nodes.len() as u64, 80]),
+            &bvh_set_by,
+        ),
+        Planned::storage(
+            "the BVH primitives",
+            product(&[bvh.cwbvh.primitive_indices.len() as u64, 4]),
+            &bvh_set_by,
+        ),
+        Planned::storage(
+            "the BVH triangles",
+            product(&[bvh.cwbvh.primitive_indices.len() as u64, 48]),
+            &bvh_set_by,
+        ),
+    ])?;
+    Ok(bvh)
+}
+
+/// The vertex records (four regions of n vectors: position, normal, tangent, uv) and the
+/// triangle records (three indices and the material).
+fn geometry(scene: &Scene) -> (Vec<[f32; 4]>, Vec<[u32; 4]>) {
+    let n = scene.positions.len();
+    let mut vertices: Vec<[f32; 4]> = Vec::with_capacity(4 * n);
+    vertices.extend(scene.positions.iter().map(|p| p.extend(1.0).to_array()));
+    vertices.extend(scene.normals.iter().map(|p| p.extend(0.0).to_array()));
+    vertices.extend(scene.tangents.iter().map(|t| t.to_array()));
+    vertices.extend(scene.uvs.iter().map(|u| [u.x, u.y, 0.0, 0.0]));
+    let triangles: Vec<[u32; 4]> = scene
+        .indices
+        .iter()
+        .zip(&scene.triangle_material)
+        .map(|(i, m)| [i[0], i[1], i[2], *m])
+        .collect();
+    (vertices, triangles)
+}
+
+/// A glint material to build: its index, its NDF and its parameters.
+type GlintSpec = (u32, Ndf, GlintParams);
+
+/// The materials' slots with their Fresnel and NDF tables placed; glint materials get a queue
+/// each, in material order, and are returned to be built.
+fn plan_materials(
+    scene: &Scene,
+    tables: &mut Tables,
+    built: &mut Built,
+) -> Result<(Vec<MaterialSlot>, Vec<GlintSpec>), RenderError> {
+    let mut slots = Vec::with_capacity(scene.materials.len());
+    let mut glint_specs = Vec::new();
+    for (mi, m) in scene.materials.iter().enumerate() {
+        let mut plan = materials::plan(m)?;
+        if let Some(f) = &m.facet {
+            plan.place_tables(
+                tables,
+                &format!("the fit {} of material `{}`", f.source.display(), m.name),
+            );
+        }
+        if plan.tabulated.is_some() {
+            built.tabulated_tables += 1;
+        }
+        if let Some((ndf, spec)) = plan.glint {
+            plan.slot.set_queue(Queue::Glint(glint_specs.len() as u32));
+            glint_specs.push((mi as u32, ndf, spec));
+        }
+        slots.push(plan.slot);
+    }
+    Ok((slots, glint_specs))
+}
+
+/// The shading queues the `used` materials route hits to, in queue order, once each; their
+/// classes go to `built`.
+fn queues_used(slots: &[MaterialSlot], used: &[bool], built: &mut Built) -> Vec<Queue> {
+    let mut queues: Vec<Queue> = slots
+        .iter()
+        .zip(used)
+        .filter(|(_, u)| **u)
+        .map(|(m, _)| m.queue())
+        .collect();
+    queues.sort_by_key(|q| q.index());
+    queues.dedup();
+    built.classes = queues.iter().map(|q| q.class_name()).collect();
+    built.classes.dedup();
+    queues
+}
+
+/// The sizes of the scene's buffers, in records (words for the textures).
+struct Buffers<'a> {
+    vertices: usize,
+    triangles: usize,
+    materials: usize,
+    texture_words: usize,
+    lights: usize,
+    tables: &'a Tables,
+    triangle_light: usize,
+}
+
+/// Every scene buffer within the device's limits, or an error that names the input that set
+/// its size.
+fn check_buffers(
+    limits: &DeviceLimits,
+    scene: &Scene,
+    built: &Built,
+    b: Buffers,
+) -> Result<(), RenderError> {
+    let size_of = |n: usize, each: usize| product(&[n as u64, each as u64]);
+    let n = scene.positions.len();
+    let n_tri = scene.indices.len();
+    let largest = scene
+        .textures
+        .iter()
+        .max_by_key(|t| u64::from(t.width) * u64::from(t.height))
+        .map_or(String::new(), |t| {
+            format!("; the largest, {}, is {}×{}", t.name, t.width, t.height)
+        });
+    limits.check(&[
+        Planned::storage(
+            "the vertex buffer",
+            size_of(b.vertices, 16),
+            format!("the scene ({n} vertices)"),
+        ),
+        Planned::storage(
+            "the triangle buffer",
+            size_of(b.triangles, 16),
+            format!("the scene ({n_tri} triangles)"),
+        ),
+        Planned::storage(
+            "the material buffer",
+            size_of(b.materials, std::mem::size_of::<GpuMaterial>()),
+            format!("the scene ({} materials)", b.materials),
+        ),
+        Planned::storage(
+            "the texture buffer",
+            size_of(b.texture_words, 4),
+            format!("the scene's {} textures{largest}", scene.textures.len()),
+        ),
+        Planned::storage(
+            "the light buffer",
+            size_of(b.lights, std::mem::size_of::<GpuLight>()),
+            format!(
+                "the scene ({} punctual lights, {} emissive triangles)",
+                scene.lights.len(),
+                built.emissive_triangles
+            ),
+        ),
+        Planned::storage(
+            "the scene tables",
+            size_of(b.tables.words.len(), 4),
+            b.tables.described(),
+        ),
+        Planned::storage(
+            "the per-triangle light index",
+            size_of(b.triangle_light, 4),
+            format!("the scene ({n_tri} triangles)"),
+        ),
+    ])?;
+    Ok(())
+}
+
+impl GlintResources {
+    /// Its bind group's resources, named as `shade_glint.wgsl` names them
+    /// ([`Group::Glint`](crate::bindings::Group::Glint)).
+    pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 5] {
+        [
+            ("field", self.field.as_entire_binding()),
+            ("params", self.params.as_entire_binding()),
+            ("level0", wgpu::BindingResource::TextureView(&self.level0)),
+            ("level1", wgpu::BindingResource::TextureView(&self.level1)),
+            ("split_table", self.split_table.as_entire_binding()),
+        ]
+    }
+}
+
 impl SceneResources {
+    /// Its bind group's resources, named as `scene.inc.wgsl` names them
+    /// ([`Group::Scene`](crate::bindings::Group::Scene)).
+    pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 10] {
+        [
+            ("bvh_nodes", self.bvh.nodes.as_entire_binding()),
+            ("bvh_primitives", self.bvh.primitives.as_entire_binding()),
+            ("bvh_triangles", self.bvh.triangles.as_entire_binding()),
+            ("vertices", self.vertices.as_entire_binding()),
+            ("triangles", self.triangles.as_entire_binding()),
+            ("materials", self.materials.as_entire_binding()),
+            ("textures", self.textures.as_entire_binding()),
+            ("lights", self.lights.as_entire_binding()),
+            ("tables", self.tables.as_entire_binding()),
+            ("triangle_light", self.triangle_light.as_entire_binding()),
+        ]
+    }
+
     /// Rewrites material `index` in place from `scene.materials[index]`: its α, rotation,
     /// Fresnel table and diffuse albedo, at the offsets it already has. Edits that change
     /// the material's class, its NDF kind, its tables or its glint pyramids (another fit,
@@ -354,7 +452,7 @@ impl SceneResources {
         index: usize,
     ) -> Result<(), RenderError> {
         let rebuild = |why: &str| Err(RenderError::Scene(format!("material {index}: {why}")));
-        let (Some(m), Some(old)) = (scene.materials.get(index), self.material_data.get(index))
+        let (Some(m), Some(old)) = (scene.materials.get(index), self.material_slots.get(index))
         else {
             return rebuild("no such material");
         };
@@ -363,13 +461,8 @@ impl SceneResources {
             return rebuild(why);
         }
         // The new values at the old offsets, in the old queue.
-        let g = GpuMaterial {
-            fresnel_offset: old.fresnel_offset,
-            fresnel_count: old.fresnel_count,
-            tab_offset: old.tab_offset,
-            queue: old.queue,
-            ..plan.gpu
-        };
+        let slot = plan.slot.in_place_of(old);
+        let g = slot.gpu();
         let fres = plan.fresnel.expect("checked by fits_in_place_of");
         queue.write_buffer(
             &self.tables,
@@ -379,9 +472,9 @@ impl SceneResources {
         queue.write_buffer(
             &self.materials,
             (index * std::mem::size_of::<GpuMaterial>()) as u64,
-            bytemuck::bytes_of(&g),
+            bytemuck::bytes_of(g),
         );
-        self.material_data[index] = g;
+        self.material_slots[index] = slot;
         Ok(())
     }
 }

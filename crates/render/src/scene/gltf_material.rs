@@ -17,7 +17,7 @@
 
 use super::gltf_buffers::Buffers;
 use super::uri::{UriTarget, resolve};
-use super::{FacetMaterial, FacetModel, GlintParams, Material, Texture};
+use super::{FacetMaterial, GlintParams, Material, Texture};
 use crate::error::RenderError;
 use facet_fit::io::input::{self, Cap};
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
@@ -33,7 +33,7 @@ pub struct FacetExtras {
     /// The fit JSON.
     pub fit: Option<PathBuf>,
     /// Which model of the fit to render.
-    pub model: FacetModel,
+    pub model: ModelChoice,
     /// Glint parameters, for a glint material.
     pub glint: Option<GlintParams>,
 }
@@ -58,17 +58,12 @@ pub fn parse_facet_extras(
         Some(other) => return Err(bad(format!("extras.facet.fit is not a string: {other}"))),
     };
     let model = match facet.get("model") {
-        None => FacetModel::Tabulated,
-        Some(Value::String(s)) => match s.as_str() {
-            "tabulated" => FacetModel::Tabulated,
-            "ggx" => FacetModel::Ggx,
-            "beckmann" => FacetModel::Beckmann,
-            other => {
-                return Err(bad(format!(
-                    "unknown extras.facet.model `{other}` (tabulated, ggx or beckmann)"
-                )));
-            }
-        },
+        None => ModelChoice::Tabulated,
+        Some(Value::String(s)) => ModelChoice::parse(s).ok_or_else(|| {
+            bad(format!(
+                "unknown extras.facet.model `{s}` (tabulated, ggx or beckmann)"
+            ))
+        })?,
         Some(other) => return Err(bad(format!("extras.facet.model is not a string: {other}"))),
     };
     let glint = match facet.get("glint") {
@@ -255,7 +250,7 @@ impl<'a> MaterialLoader<'a> {
         let overridden = self.overrides.iter().rev().find(|(n, _)| n == name);
         let (model, glint) = extras
             .as_ref()
-            .map_or((FacetModel::Tabulated, None), |e| (e.model, e.glint));
+            .map_or((ModelChoice::Tabulated, None), |e| (e.model, e.glint));
         let source = match (overridden, extras.as_ref().and_then(|e| e.fit.clone())) {
             (Some((_, file)), _) => file.clone(),
             (None, Some(fit)) => fit,
@@ -281,17 +276,10 @@ impl<'a> MaterialLoader<'a> {
                 f
             }
         };
-        let choice = match model {
-            FacetModel::Tabulated => ModelChoice::Tabulated,
-            FacetModel::Ggx => ModelChoice::Ggx,
-            FacetModel::Beckmann => ModelChoice::Beckmann,
-        };
-        if fit.model(choice).is_none() {
+        if fit.model(model).is_none() {
             return Err(RenderError::input(
                 &source,
-                format!(
-                    "material `{name}` asks for model {choice:?}, which this fit does not have"
-                ),
+                format!("material `{name}` asks for model {model:?}, which this fit does not have"),
             ));
         }
         Ok(Some(FacetMaterial {

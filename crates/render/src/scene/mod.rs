@@ -4,6 +4,7 @@
 //! material per triangle, textures as RGBA8, punctual lights, one camera. glTF is Y-up and
 //! right-handed; so is the scene.
 
+use facet_fit::model::material::ModelChoice;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -126,17 +127,6 @@ impl Default for Material {
     }
 }
 
-/// Which model of a fit a Facet material renders with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FacetModel {
-    /// The extracted tables.
-    Tabulated,
-    /// The GGX fit.
-    Ggx,
-    /// The Beckmann fit.
-    Beckmann,
-}
-
 /// A fitted material attached to a glTF material.
 #[derive(Clone, Debug)]
 pub struct FacetMaterial {
@@ -145,7 +135,7 @@ pub struct FacetMaterial {
     /// The fit.
     pub fit: Arc<facet_fit::model::material::FittedMaterial>,
     /// Which of its models to render.
-    pub model: FacetModel,
+    pub model: ModelChoice,
     /// Glint parameters: render the model's NDF as discrete flakes.
     pub glint: Option<GlintParams>,
 }

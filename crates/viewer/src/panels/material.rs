@@ -1,7 +1,7 @@
 //! The material panel: open, model choice, sliders, save.
 
 use crate::app::ViewerApp;
-use crate::material::Shown;
+use crate::material::{EditedMaterial, Shown};
 use std::time::Instant;
 
 pub fn material_panel(app: &mut ViewerApp, ui: &mut egui::Ui) {
@@ -14,6 +14,30 @@ pub fn material_panel(app: &mut ViewerApp, ui: &mut egui::Ui) {
 }
 
 fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
+    open_section(app, ui);
+    let m = &mut app.material;
+    let before = m.key();
+    ui.label("Shown:");
+    for s in Shown::ALL {
+        let enabled = m.available(s);
+        ui.add_enabled_ui(enabled, |ui| {
+            ui.radio_value(&mut m.shown, s, s.label());
+        });
+    }
+    alpha_sliders(m, ui);
+    diffuse_edit(m, ui);
+    tint_edit(m, ui);
+    if m.shown == Shown::Glint {
+        glint_sliders(m, ui);
+    }
+    if m.key() != before {
+        app.edited_at = Some(Instant::now());
+    }
+    save_section(app, ui);
+}
+
+/// The open field, the neural proxies, the fit in progress, the last error, the source.
+fn open_section(app: &mut ViewerApp, ui: &mut egui::Ui) {
     ui.heading("Material");
     let hint = ui
         .label("MERL file, fit JSON, nbrdf:NAME, analytic:SPEC, or a glTF scene (or drop a file):");
@@ -68,16 +92,11 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     }
     ui.label(format!("Source: {}", app.material.source));
     ui.separator();
+}
 
-    let m = &mut app.material;
-    let before = m.key();
-    ui.label("Shown:");
-    for s in Shown::ALL {
-        let enabled = m.available(s);
-        ui.add_enabled_ui(enabled, |ui| {
-            ui.radio_value(&mut m.shown, s, s.label());
-        });
-    }
+/// αx, αy (locked or not) and the rotation of the shown model, or the stretch of its
+/// tabulated NDF.
+fn alpha_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
     if let Some((mut ax, mut ay, rot)) = m.alpha() {
         let rot_deg0 = rot.to_degrees();
         let mut rot_deg = rot_deg0;
@@ -118,6 +137,10 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     } else {
         ui.label("The measured data are shown as extracted (no edits).");
     }
+}
+
+/// The diffuse albedo ρd, where the shown model has one.
+fn diffuse_edit(m: &mut EditedMaterial, ui: &mut egui::Ui) {
     if let (Some(albedo), Some(fitted)) = (m.diffuse(), m.fitted_diffuse()) {
         ui.label("Diffuse albedo ρd (f = ρd/π):");
         let mut rgb = albedo.map(|v| v as f32);
@@ -139,6 +162,10 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
             m.set_diffuse(albedo);
         }
     }
+}
+
+/// The Fresnel tint.
+fn tint_edit(m: &mut EditedMaterial, ui: &mut egui::Ui) {
     ui.label("Fresnel tint:");
     let tint0 = m.tint.map(|v| v as f32);
     let mut tint = tint0;
@@ -151,26 +178,29 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     if tint != tint0 {
         m.tint = tint.map(|v| v as f64);
     }
-    if m.shown == Shown::Glint {
-        ui.label("Glints:");
-        if m.record.ggx.is_some() {
-            ui.checkbox(&mut m.glint.tabulated, "flakes from the tabulated NDF");
-        }
-        ui.add(
-            egui::Slider::new(&mut m.glint.density, 1e3..=1e7)
-                .logarithmic(true)
-                .text("density"),
-        );
-        ui.add(egui::Slider::new(&mut m.glint.gamma_deg, 0.25..=5.0).text("γ °"));
-        ui.add(
-            egui::Slider::new(&mut m.glint.threshold, 1.0..=1e4)
-                .logarithmic(true)
-                .text("threshold"),
-        );
+}
+
+/// The glint parameters.
+fn glint_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
+    ui.label("Glints:");
+    if m.record.ggx.is_some() {
+        ui.checkbox(&mut m.glint.tabulated, "flakes from the tabulated NDF");
     }
-    if m.key() != before {
-        app.edited_at = Some(Instant::now());
-    }
+    ui.add(
+        egui::Slider::new(&mut m.glint.density, 1e3..=1e7)
+            .logarithmic(true)
+            .text("density"),
+    );
+    ui.add(egui::Slider::new(&mut m.glint.gamma_deg, 0.25..=5.0).text("γ °"));
+    ui.add(
+        egui::Slider::new(&mut m.glint.threshold, 1.0..=1e4)
+            .logarithmic(true)
+            .text("threshold"),
+    );
+}
+
+/// The exposure, the save field and the status line.
+fn save_section(app: &mut ViewerApp, ui: &mut egui::Ui) {
     ui.separator();
     ui.add(egui::Slider::new(&mut app.exposure, -6.0..=6.0).text("exposure"));
     ui.separator();
