@@ -6,7 +6,8 @@
 # the checkout's path where they were built). Results and
 # one log go to $OUT (default ./device_out). To stage (Vulkan loader packages from Debian's
 # libvulkan1 in .gpu/debs): cargo build --release, cargo bench --no-run, cargo test --release
-# --no-run --test glint_flakes --test glint --test gpu_fit, copied and stripped into .gpu/bin.
+# --no-run -p facet-glint --test glint_flakes --test glint, and -p facet-fit --test gpu_fit,
+# copied and stripped into .gpu/bin.
 # Usage, from the repository root:
 #   bash benches/device_run.sh [MODE]        # MODE: facet bench --mode (default: default)
 set -u

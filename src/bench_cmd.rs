@@ -268,7 +268,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
 /// the fast rule (sized to the lobe), median build times side by side, and the fast tables'
 /// relative error against the direct ones per level: max and median over the cells above 1 % of
 /// the level's peak where the direct rule is converged (cone above the horizon, θo + γ ≤ 85°,
-/// θi ≤ 60°; `fast_cone_rule_matches_the_direct_integral` in tests/glint.rs says why), and the
+/// θi ≤ 60°; `fast_cone_rule_matches_the_direct_integral` in crates/glint/tests/glint.rs says why), and the
 /// max over all cells above 1 % of the peak.
 fn dpf_pyramid(gpu: &Gpu, mode: Mode, sizes: &Sizes) -> Result<Value> {
     use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};

@@ -429,7 +429,7 @@ fn rgl_files_that_make_no_material_are_refused_when_read() {
         v.is_some_and(|v| v.iter().all(|c| c.is_finite() && *c >= 0.0)),
         "{v:?}"
     );
-    let spectral = common::spectral_from_rgb(&good);
+    let spectral = facet_oracles::fixtures::spectral_from_rgb(&good);
     assert!(RglBsdf::from_bytes(&dir.join("spectral.bsdf"), spectral).is_ok());
 }
 

@@ -10,6 +10,9 @@
 //! leave out: f32 against f64, the tessellated sphere against the exact one, the sub-pixel grid
 //! against the GPU's random pixel positions.
 
+mod common;
+
+use common::renders::{SIZE, direct_config, lambert, sphere_scene};
 use facet_fit::Brdf;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::model::merl_grid::MerlTable;
@@ -21,31 +24,18 @@ use facet_render::scene::{
     Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, Scene, Texture,
 };
 use facet_render::{
-    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
-    Strategy,
+    Image, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources, Strategy,
 };
 use glam::{DVec2, DVec3, Vec3, Vec4};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
-const SIZE: u32 = 64;
 const Z: f64 = 5.0;
 const BIAS: f64 = 0.01;
 /// Sub-pixel grid of the CPU references (n × n points per pixel).
 const SUB: u32 = 4;
 
 // ---- scenes and renders ---------------------------------------------------------------------
-
-fn lambert(albedo: [f32; 3]) -> Material {
-    Material {
-        name: "lambert".into(),
-        base_color: Vec4::new(albedo[0], albedo[1], albedo[2], 1.0),
-        metallic: 0.0,
-        roughness: 1.0,
-        specular: 0.0,
-        ..Default::default()
-    }
-}
 
 const FLOOR_ALBEDO: [f32; 3] = [0.5, 0.6, 0.7];
 
@@ -69,39 +59,6 @@ fn floor_scene(height: f32, yfov_deg: f32) -> Scene {
         0,
     );
     s
-}
-
-/// A unit sphere at the origin seen from +z at distance 3.
-fn sphere_scene(material: Material) -> Scene {
-    let mut s = Scene {
-        materials: vec![material],
-        camera: Camera {
-            position: Vec3::new(0.0, 0.0, 3.0),
-            forward: Vec3::NEG_Z,
-            up: Vec3::Y,
-            yfov: 36f32.to_radians(),
-        },
-        ..Default::default()
-    };
-    s.add_uv_sphere(Vec3::ZERO, 1.0, 256, 128, 0);
-    s
-}
-
-fn config(spp: u32, strategy: Strategy) -> RenderConfig {
-    RenderConfig {
-        image: ImageConfig {
-            width: SIZE,
-            height: SIZE,
-            ..ImageConfig::preview()
-        },
-        sampling: SampleConfig {
-            spp,
-            // Direct light only: every reference below is a single-bounce integral.
-            max_depth: 1,
-            strategy,
-            ..SampleConfig::preview()
-        },
-    }
 }
 
 /// The scene rendered with seeds 0 and 1.
@@ -323,7 +280,7 @@ fn point_light_on_a_plane_falls_off_as_cos_over_r2() {
         position: LIGHT_POS.as_vec3(),
         intensity: INTENSITY.as_vec3(),
     });
-    let images = render_twice(&gpu, &scene, None, config(16, Strategy::Mis));
+    let images = render_twice(&gpu, &scene, None, direct_config(16, Strategy::Mis));
     let rho = dv(FLOOR_ALBEDO) / PI;
     let expect = |power: i32| {
         reference(&scene, |o, d| {
@@ -354,7 +311,7 @@ fn spot_light_on_a_plane_has_the_gltf_falloff() {
         inner_cone: inner as f32,
         outer_cone: outer as f32,
     });
-    let images = render_twice(&gpu, &scene, None, config(16, Strategy::Mis));
+    let images = render_twice(&gpu, &scene, None, direct_config(16, Strategy::Mis));
     let rho = dv(FLOOR_ALBEDO) / PI;
     let expect = |falloff: &dyn Fn(f64) -> f64| {
         reference(&scene, |o, d| {
@@ -407,7 +364,7 @@ fn directional_light_casts_the_occluders_shadow() {
         direction: travel.as_vec3(),
         irradiance: irradiance.as_vec3(),
     });
-    let images = render_twice(&gpu, &scene, None, config(16, Strategy::Mis));
+    let images = render_twice(&gpu, &scene, None, direct_config(16, Strategy::Mis));
     let lit = dv(FLOOR_ALBEDO) / PI * irradiance * (-travel).y;
     let shade = |with_shadows: bool| {
         move |o: DVec3, d: DVec3| {
@@ -510,7 +467,7 @@ fn emissive_quad_lights_the_plane_by_its_form_factor() {
         ..Default::default()
     });
     scene.add_quad(corner.as_vec3(), eu.as_vec3(), ev.as_vec3(), 1.0, 1);
-    let images = render_twice(&gpu, &scene, None, config(64, Strategy::Mis));
+    let images = render_twice(&gpu, &scene, None, direct_config(64, Strategy::Mis));
     let quad = [corner, corner + eu, corner + eu + ev, corner + ev];
     let rho = dv(FLOOR_ALBEDO) / PI;
     let expect = |scale: f64| {
@@ -614,7 +571,7 @@ fn environment_map_on_a_lambertian_sphere_each_strategy() {
     });
     let mut noise = Vec::new();
     for strategy in [Strategy::Mis, Strategy::Light, Strategy::Bsdf] {
-        let images = render_twice(&gpu, &scene, Some(&env), config(32, strategy));
+        let images = render_twice(&gpu, &scene, Some(&env), direct_config(32, strategy));
         check_with_power(
             &format!("environment map, {strategy:?}"),
             &images,
@@ -691,7 +648,7 @@ fn textured_plane_returns_its_texels() {
         0,
     );
     let env = Environment::Constant(Vec3::ONE);
-    let images = render_twice(&gpu, &scene, Some(&env), config(8, Strategy::Bsdf));
+    let images = render_twice(&gpu, &scene, Some(&env), direct_config(8, Strategy::Bsdf));
     // Bilinear filtering with wrap-around, texel centres at (i + ½) / T.
     let texel = |x: i64, y: i64, srgb: bool| {
         let t = texels[(y.rem_euclid(T as i64) * T as i64 + x.rem_euclid(T as i64)) as usize];
@@ -846,7 +803,7 @@ fn metallic_roughness_sphere_matches_the_cpu_albedo() {
             ..Default::default()
         };
         let scene = sphere_scene(material);
-        let images = render_twice(&gpu, &scene, Some(&env), config(32, Strategy::Mis));
+        let images = render_twice(&gpu, &scene, Some(&env), direct_config(32, Strategy::Mis));
         let b = dv(base);
         let (m, r) = (metallic as f64, roughness as f64);
         let table = albedo_table(|wi, wo| gltf_brdf(b, m, r, 1.0, wi, wo));
@@ -906,7 +863,7 @@ fn rotated_anisotropic_ggx_sphere_matches_the_cpu_evaluator() {
         direction: (-to_light).as_vec3(),
         irradiance: Vec3::splat(irradiance as f32),
     });
-    let images = render_twice(&gpu, &scene, None, config(32, Strategy::Mis));
+    let images = render_twice(&gpu, &scene, None, direct_config(32, Strategy::Mis));
     let expect = |fit: &FittedMaterial| {
         let brdf = fit.model(ModelChoice::Ggx).unwrap();
         reference(&scene, |o, d| {
@@ -951,7 +908,7 @@ fn three_lights_together_are_the_sum_of_each_alone() {
         intensity: Vec3::new(0.6, 0.5, 0.4),
     };
     let sky = Environment::Constant(Vec3::new(0.2, 0.3, 0.45));
-    let mut c = config(32, Strategy::Mis);
+    let mut c = direct_config(32, Strategy::Mis);
     c.sampling.max_depth = 3;
     let with = |lights: Vec<Light>, env: Option<&Environment>| {
         let mut s = base.clone();

@@ -1,48 +1,21 @@
 //! The wavefront integrator against theory: white furnaces, the glints' smooth limit and their
 //! filtered switch, only-what-is-needed resources, determinism. GPU tests (lavapipe in CI).
 
+mod common;
+
+use common::renders::{SIZE, YFOV_DEG, config, lambert, sphere_scene};
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::MicrofacetBrdf;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{Camera, Environment, FacetMaterial, GlintParams, Material, Scene};
+use facet_render::scene::{Environment, FacetMaterial, GlintParams, Material, Scene};
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
-use glam::{DVec3, Vec3, Vec4};
+use glam::{DVec3, Vec3};
 use std::sync::{Arc, OnceLock};
-
-const SIZE: u32 = 64;
-const YFOV_DEG: f32 = 36.0;
-
-/// A unit sphere at the origin seen from +z at distance 3, filling most of the frame.
-fn sphere_scene(material: Material) -> Scene {
-    let mut s = Scene {
-        materials: vec![material],
-        camera: Camera {
-            position: Vec3::new(0.0, 0.0, 3.0),
-            forward: Vec3::NEG_Z,
-            up: Vec3::Y,
-            yfov: YFOV_DEG.to_radians(),
-        },
-        ..Default::default()
-    };
-    s.add_uv_sphere(Vec3::ZERO, 1.0, 256, 128, 0);
-    s
-}
-
-fn lambert(albedo: f32) -> Material {
-    Material {
-        name: "lambert".into(),
-        base_color: Vec4::new(albedo, albedo, albedo, 1.0),
-        metallic: 0.0,
-        roughness: 1.0,
-        specular: 0.0,
-        ..Default::default()
-    }
-}
 
 /// A fit of an analytic GGX α = 0.3 with every Fresnel table set to 1: a perfect conductor.
 fn conductor_fit() -> Arc<FittedMaterial> {
@@ -98,21 +71,6 @@ fn render(
     (image, res.built.clone(), integrator.stage_names())
 }
 
-fn config(spp: u32) -> RenderConfig {
-    RenderConfig {
-        image: ImageConfig {
-            width: SIZE,
-            height: SIZE,
-            ..ImageConfig::preview()
-        },
-        sampling: SampleConfig {
-            spp,
-            max_depth: 8,
-            ..SampleConfig::preview()
-        },
-    }
-}
-
 /// The view direction's angle to the sphere's normal at pixel (x, y)'s centre, or None when the
 /// pixel is not well inside the silhouette (θo below `max_deg`).
 fn theta_o(x: u32, y: u32, max_deg: f64) -> Option<f64> {
@@ -139,7 +97,7 @@ fn white_furnace_lambert_sphere_is_one() {
     let Some(gpu) = gpu_for_tests("white_furnace_lambert_sphere_is_one") else {
         return;
     };
-    let scene = sphere_scene(lambert(1.0));
+    let scene = sphere_scene(lambert([1.0; 3]));
     let env = Environment::Constant(Vec3::ONE);
     let (img, built, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(32));
     let on = img.mean_where(|x, y| theta_o(x, y, 80.0).is_some());
@@ -444,19 +402,19 @@ fn same_seed_same_image() {
 /// before anything reaches the GPU.
 #[test]
 fn broken_scenes_are_refused() {
-    let mut scene = sphere_scene(lambert(0.5));
+    let mut scene = sphere_scene(lambert([0.5; 3]));
     scene.positions[10].x = f32::NAN;
     let err = facet_render::resources::validate(&scene)
         .unwrap_err()
         .to_string();
     assert!(err.contains("vertex 10"), "{err}");
-    let mut scene = sphere_scene(lambert(0.5));
+    let mut scene = sphere_scene(lambert([0.5; 3]));
     scene.indices[3][1] = 1 << 30;
     let err = facet_render::resources::validate(&scene)
         .unwrap_err()
         .to_string();
     assert!(err.contains("triangle 3"), "{err}");
-    assert!(facet_render::resources::validate(&sphere_scene(lambert(0.5))).is_ok());
+    assert!(facet_render::resources::validate(&sphere_scene(lambert([0.5; 3]))).is_ok());
 }
 
 /// Large footprints count on the GPU as on the CPU. Before lit counts per node this hit a known

@@ -6,27 +6,12 @@
 
 mod common;
 
-use common::{GltfBuilder, assert_all_finite, demo, small_fit, temp_dir};
+use common::{GltfBuilder, assert_all_finite, close, demo, load, load_err, small_fit, temp_dir};
 use facet_fit::model::material::ModelChoice;
-use facet_render::scene::{Light, LoadOptions, Scene, load_gltf};
+use facet_render::scene::{Light, LoadOptions, load_gltf};
 use glam::{Mat4, Quat, Vec3};
 use serde_json::json;
 use std::path::{Path, PathBuf};
-
-fn load(path: &Path) -> Scene {
-    load_gltf(path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn load_err(path: &Path, options: &LoadOptions) -> String {
-    match load_gltf(path, options) {
-        Ok(_) => panic!("{} loaded but should not", path.display()),
-        Err(e) => e.to_string(),
-    }
-}
-
-fn close(a: Vec3, b: Vec3) -> bool {
-    (a - b).length() < 1e-5
-}
 
 #[test]
 fn child_under_rotated_scaled_parent_is_placed_in_world() {

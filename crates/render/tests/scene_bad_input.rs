@@ -3,39 +3,24 @@
 
 mod common;
 
-use common::{GltfBuilder, assert_all_finite, temp_dir};
+use common::{GltfBuilder, assert_all_finite, close, load, load_err, temp_dir};
 use facet_render::RenderError;
-use facet_render::scene::{LoadOptions, Scene, load_gltf};
+use facet_render::scene::{LoadOptions, load_gltf};
 use glam::Vec3;
 use serde_json::json;
 use std::path::Path;
 
-fn load(path: &Path) -> Scene {
-    load_gltf(path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
-}
-
-fn load_err(path: &Path) -> String {
-    match load_gltf(path, &LoadOptions::default()) {
-        Ok(_) => panic!("{} loaded but should not", path.display()),
-        Err(e) => e.to_string(),
-    }
-}
-
-fn close(a: Vec3, b: Vec3) -> bool {
-    (a - b).length() < 1e-5
-}
-
 #[test]
 fn bad_files_are_errors_naming_them() {
     let dir = temp_dir("bad");
-    let e = load_err(&dir.join("nowhere.gltf"));
+    let e = load_err(&dir.join("nowhere.gltf"), &LoadOptions::default());
     assert!(e.contains("nowhere.gltf"), "{e}");
     std::fs::write(
         dir.join("broken.gltf"),
         "{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [",
     )
     .unwrap();
-    let e = load_err(&dir.join("broken.gltf"));
+    let e = load_err(&dir.join("broken.gltf"), &LoadOptions::default());
     assert!(e.contains("broken.gltf"), "{e}");
 
     // A valid GLB, then truncated.
@@ -63,13 +48,13 @@ fn bad_files_are_errors_naming_them() {
     std::fs::write(dir.join("ok.glb"), &glb).unwrap();
     assert_eq!(load(&dir.join("ok.glb")).indices.len(), 1);
     std::fs::write(dir.join("cut.glb"), &glb[..glb.len() - 20]).unwrap();
-    let e = load_err(&dir.join("cut.glb"));
+    let e = load_err(&dir.join("cut.glb"), &LoadOptions::default());
     assert!(e.contains("cut.glb"), "{e}");
 
     // A buffer file that does not exist.
     doc["buffers"] = json!([{"byteLength": g.bin.len(), "uri": "gone.bin"}]);
     std::fs::write(dir.join("nobuf.gltf"), serde_json::to_string(&doc).unwrap()).unwrap();
-    let e = load_err(&dir.join("nobuf.gltf"));
+    let e = load_err(&dir.join("nobuf.gltf"), &LoadOptions::default());
     assert!(e.contains("nobuf.gltf") && e.contains("buffer"), "{e}");
 }
 

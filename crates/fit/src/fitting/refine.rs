@@ -382,7 +382,7 @@ mod tests {
     /// e^c, and one round's medians give −c per bin. Every sample of a bin then meets its data
     /// at the same s*, so the median is exact but for the histogram (half a bucket, span / 129)
     /// and the tables' Λ against the data's exact G (1e-3 in the metric,
-    /// `tests/models.rs`): 0.02 in ln s. A bin asked to move beyond the span stops at it.
+    /// `tests/grid.rs`): 0.02 in ln s. A bin asked to move beyond the span stops at it.
     #[test]
     fn bin_medians_recover_scaled_bins() {
         let src =

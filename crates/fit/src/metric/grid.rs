@@ -4,7 +4,7 @@
 //! the MERL grid (bin lower edges, both directions above the horizon, the sample present).
 //! Isotropic sources are held in a compact row form (`iso/`), and isotropic
 //! microfacet models take a fast path there: D depends only on the θh bin, F only on the θd
-//! bin and Λ only on cos θ, so each is a small table; `tests/models.rs` checks it against the
+//! bin and Λ only on cos θ, so each is a small table; `tests/grid.rs` checks it against the
 //! direct evaluation.
 
 use crate::metric::iso::{CoarseSamples, IsoSamples};

@@ -1,13 +1,35 @@
-//! Helpers of the scene tests: a tiny glTF writer (one embedded base64 buffer), temp folders
-//! and a small fit.
+//! Helpers of the render crate's tests: a tiny glTF writer (one embedded base64 buffer),
+//! loading a glTF or its error, temp folders and a small fit; `demo`: the demo scene;
+//! `renders`: the scenes and settings of the GPU render tests.
 #![allow(dead_code)]
 
 pub mod demo;
+pub mod renders;
 
 use facet_render::scene::data_uri::encode_base64;
+use facet_render::scene::{LoadOptions, Scene, load_gltf};
+use glam::Vec3;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+
+/// The glTF at `path`, loaded with the default options; panics with the error.
+pub fn load(path: &Path) -> Scene {
+    load_gltf(path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The error message of loading the glTF at `path`; panics when it loads.
+pub fn load_err(path: &Path, options: &LoadOptions) -> String {
+    match load_gltf(path, options) {
+        Ok(_) => panic!("{} loaded but should not", path.display()),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Equal positions, to 1e-5.
+pub fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-5
+}
 
 /// A fresh, empty folder for one test.
 pub fn temp_dir(name: &str) -> PathBuf {

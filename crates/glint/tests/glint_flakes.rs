@@ -677,7 +677,7 @@ fn blended_counts_do_not_pop_at_cell_edges() {
 #[test]
 fn tabulated_glints_converge_to_the_smooth_tabulated_brdf() {
     let path =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo/default_fit.json");
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/demo/default_fit.json");
     let fit = facet_fit::model::material::FittedMaterial::load(&path).unwrap();
     let model = fit.tabulated.clone();
     assert!(matches!(model.ndf, Ndf::Tabulated(_)));

@@ -1,7 +1,5 @@
 //! The glint model's building blocks: TEA (CPU and WGSL) and the DPF.
 
-mod common;
-
 use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
 use facet_glint::dpf::{DpfConfig, DpfPyramid, DpfTable, cone_solid_angle, dpf, query_directions};
 use facet_glint::lit::select_cell;
@@ -218,7 +216,7 @@ fn gpu_pyramid_matches_the_cpu_reference() {
     };
     let cfg = DpfConfig::preview();
     let fit = facet_fit::fitting::fit_material(
-        &common::merl_from_spec("ggx?alpha=0.25&f0=0.04"),
+        &facet_oracles::fixtures::merl_from_spec("ggx?alpha=0.25&f0=0.04"),
         "test",
         &facet_fit::fitting::FitConfig::isotropic(),
     )

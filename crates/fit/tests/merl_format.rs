@@ -1,0 +1,132 @@
+//! The MERL `.binary` format: written and read back exactly, mapped as read, and looked up
+//! nearest or interpolated.
+
+mod common;
+
+use common::{Rng, scratch, spec_table};
+use facet_fit::model::analytic::parse_analytic;
+use facet_fit::model::geometry::from_half_diff;
+use facet_fit::model::merl_grid::{MerlTable, SAMPLES, bin_angles};
+use facet_fit::sources::merl::MerlBrdf;
+
+#[test]
+fn merl_write_read_round_trip_is_exact() {
+    let dir = scratch("merl_round_trip");
+    let table = spec_table("beckmann?alpha=0.3&conductor=gold&kd=0.1");
+    let path = dir.join("gold.binary");
+    table.write(&path).unwrap();
+    assert_eq!(
+        std::fs::metadata(&path).unwrap().len(),
+        12 + 3 * 8 * SAMPLES as u64
+    );
+    let back = MerlTable::read(&path).unwrap();
+    assert!(back == table, "round trip changed the samples");
+    // Nearest lookup anywhere inside a bin returns that bin; interpolation at the sample's own
+    // angles returns the sample.
+    let src = MerlBrdf::open(&path).unwrap();
+    for &(i, j, k) in &[(10, 20, 30), (45, 5, 170), (80, 60, 90)] {
+        let v = table.value(i, j, k).unwrap();
+        let u = (i as f64 + 0.5) / 90.0;
+        let mid = facet_fit::model::geometry::HalfDiff {
+            theta_h: u * u * std::f64::consts::FRAC_PI_2,
+            phi_h: 0.0,
+            theta_d: (j as f64 + 0.5) / 90.0 * std::f64::consts::FRAC_PI_2,
+            phi_d: (k as f64 + 0.5) / 180.0 * std::f64::consts::PI,
+        };
+        let (wi, wo) = from_half_diff(mid);
+        assert_eq!(table.lookup_nearest(wi, wo).unwrap(), v);
+        let (wi, wo) = from_half_diff(bin_angles(i, j, k));
+        let w = table.lookup_interpolated(wi, wo).unwrap();
+        assert!(
+            (0..3).all(|c| (w[c] / v[c] - 1.0).abs() < 1e-9),
+            "{w:?} vs {v:?}"
+        );
+        assert_eq!(src.table().value(i, j, k), Some(v));
+    }
+}
+
+/// A mapped table (`facet fit`'s way) holds the values a read one does, bit for bit, missing
+/// samples included; changing it copies it into memory and leaves the file as it was.
+#[test]
+fn mapped_merl_table_equals_the_read_one_and_never_writes_the_file() {
+    let dir = scratch("merl_mapped");
+    let mut table = spec_table("ggx?alpha=0.1&f0=0.04&kd=0.2");
+    table.mark_missing(facet_fit::model::merl_grid::index(30, 40, 50));
+    let path = dir.join("plastic.binary");
+    table.write(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let read = MerlTable::read(&path).unwrap();
+    let mut mapped = MerlTable::map(&path).unwrap();
+    assert!(mapped == read && mapped == table);
+    #[cfg(target_os = "linux")]
+    assert!(format!("{mapped:?}").ends_with("mapped)"), "{mapped:?}");
+    assert_eq!(mapped.missing_count(), read.missing_count());
+    for s in [
+        0,
+        1234,
+        facet_fit::model::merl_grid::index(30, 40, 50),
+        SAMPLES - 1,
+    ] {
+        assert_eq!(
+            mapped.value_at(s).map(|v| v.map(f64::to_bits)),
+            read.value_at(s).map(|v| v.map(f64::to_bits))
+        );
+    }
+    // Both sources give the fit the same samples: the same fit, to the bit.
+    let cfg = facet_fit::FitConfig {
+        models: facet_fit::fitting::Models {
+            tabulated: true,
+            ..facet_fit::fitting::Models::NONE
+        },
+        ..facet_fit::FitConfig::isotropic()
+    };
+    let fit = |src: &MerlBrdf| {
+        let m = facet_fit::fit_material(src, "t", &cfg).unwrap();
+        m.record.tabulated.error.map(f64::to_bits)
+    };
+    assert_eq!(
+        fit(&MerlBrdf::map(&path).unwrap()),
+        fit(&MerlBrdf::open(&path).unwrap())
+    );
+    let s = facet_fit::model::merl_grid::index(10, 20, 30);
+    mapped.scale_sample(s, [2.0; 3]);
+    let v = read.value_at(s).unwrap();
+    assert_eq!(mapped.value_at(s).unwrap(), v.map(|v| v * 2.0));
+    assert!(mapped.value_at(s + 1) == read.value_at(s + 1));
+    assert!(format!("{mapped:?}").ends_with("in memory)"), "{mapped:?}");
+    assert_eq!(
+        std::fs::read(&path).unwrap(),
+        bytes,
+        "the mapped file changed"
+    );
+}
+
+#[test]
+fn interpolated_lookup_beats_nearest_between_bins() {
+    let model = parse_analytic("ggx?alpha=0.3&f0=0.04").unwrap();
+    let table = MerlTable::sample(&model);
+    let mut rng = Rng(3);
+    let (mut e_near, mut e_interp) = (0.0, 0.0);
+    for _ in 0..2000 {
+        let c = facet_fit::model::geometry::HalfDiff {
+            theta_h: rng.next() * 1.2,
+            phi_h: 0.0,
+            theta_d: rng.next() * 1.2,
+            phi_d: rng.next() * std::f64::consts::PI,
+        };
+        let (wi, wo) = from_half_diff(c);
+        if wi.z < 0.2 || wo.z < 0.2 {
+            continue;
+        }
+        use facet_fit::model::brdf::Brdf;
+        let t = model.eval(wi, wo).unwrap()[0];
+        e_near += (table.lookup_nearest(wi, wo).unwrap()[0] / t - 1.0).abs();
+        e_interp += (table.lookup_interpolated(wi, wo).unwrap()[0] / t - 1.0).abs();
+    }
+    println!(
+        "mean relative error: nearest {:.4}, interpolated {:.4}",
+        e_near / 2000.0,
+        e_interp / 2000.0
+    );
+    assert!(e_interp < 0.25 * e_near);
+}
