@@ -70,14 +70,14 @@ pub struct FitConfig {
     pub anisotropic: bool,
     /// Which models to fit and report.
     pub models: Models,
-    /// The least-squares searches run on a subsampled grid ([`GridSamples::subsample`]: every
+    /// The least-squares searches run on a subsampled grid
+    /// ([`GridSamples::subsample`](crate::metric::grid::GridSamples::subsample): every
     /// `search_stride`-th (θh, θd) row of an isotropic source, an isotropic fit's α search on
-    /// every fourth φd bin of those rows ([`GridSamples::coarse`]); every `search_stride`-th
-    /// sample of an anisotropic one); an isotropic fit then brackets α
-    /// ([`crate::fitting::params::refine_by_bracket`]) on every fourth φd bin of the final steps' rows
-    /// (the full grid, or with a diffuse lobe a quarter of it, [`GridSamples::diagonal`]) and
-    /// solves F for the α found: averaged over the full grid, or with a diffuse lobe solved with
-    /// ρd on the bracket's rows. The reported errors use every sample.
+    /// every fourth φd bin of those rows; every `search_stride`-th sample of an anisotropic
+    /// one); an isotropic fit then brackets α ([`crate::fitting::params::refine_by_bracket`]) on
+    /// every fourth φd bin of the final steps' rows (the full grid, or with a diffuse lobe a
+    /// quarter of it) and solves F for the α found: averaged over the full grid, or with a
+    /// diffuse lobe solved with ρd on the bracket's rows. The reported errors use every sample.
     pub search_stride: usize,
     /// Fit a Lambertian lobe ρd with every model and keep F in [0, 1] ([`crate::fitting::diffuse`]);
     /// false: the paper's single specular lobe with F averaged. Isotropic fits only: an
