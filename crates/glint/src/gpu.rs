@@ -185,33 +185,7 @@ pub fn build_levels_with(
         );
         let values: Vec<f32> = buffer::read(d, &gpu.queue, &ob, cells)?;
         gpu.check_lost()?;
-        let size = wgpu::Extent3d {
-            width: config.n_dphi as u32,
-            height: config.n_theta as u32,
-            depth_or_array_layers: config.n_theta as u32,
-        };
-        let texture = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("dpf level"),
-            size,
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_DST
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        gpu.queue.write_texture(
-            texture.as_image_copy(),
-            bytemuck::cast_slice(&values),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(4 * config.n_dphi as u32),
-                rows_per_image: Some(config.n_theta as u32),
-            },
-            size,
-        );
+        let texture = level_texture(gpu, config, &values);
         textures.push(texture);
         levels[k] = Some(DpfTable {
             gamma,
@@ -223,6 +197,39 @@ pub fn build_levels_with(
         pyramid: DpfPyramid { levels },
         textures,
     })
+}
+
+/// One level's values as a 3D R32Float texture: Δφ across, θi down, θo in depth.
+fn level_texture(gpu: &Gpu, config: DpfConfig, values: &[f32]) -> wgpu::Texture {
+    let d = &gpu.device;
+    let size = wgpu::Extent3d {
+        width: config.n_dphi as u32,
+        height: config.n_theta as u32,
+        depth_or_array_layers: config.n_theta as u32,
+    };
+    let texture = d.create_texture(&wgpu::TextureDescriptor {
+        label: Some("dpf level"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D3,
+        format: wgpu::TextureFormat::R32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    gpu.queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(values),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(4 * config.n_dphi as u32),
+            rows_per_image: Some(config.n_theta as u32),
+        },
+        size,
+    );
+    texture
 }
 
 /// The flake field as `shaders/glint/glint_count.wgsl` takes it (WGSL `Field`).
