@@ -35,7 +35,7 @@ use super::gltf_check::{
     Attribute, CameraKind, MAX_TRIANGLES, MAX_VERTICES, check_accessor, check_camera, check_light,
 };
 use super::gltf_material::MaterialLoader;
-use super::mesh::{RawPrimitive, clean_primitive};
+use super::mesh::{CleanPrimitive, RawPrimitive, clean_primitive};
 use super::{Camera, Light, Material, Scene};
 use crate::error::RenderError;
 use facet_fit::io::input::{self, Cap};
@@ -306,7 +306,6 @@ fn add_mesh(
     let mirrored = m3.determinant() < 0.0;
     let mut dropped = 0;
     let root = doc.as_json();
-    let buffer_len = |i: usize| buffers.len_of(i);
     for prim in mesh.primitives() {
         if prim.mode() != gltf::mesh::Mode::Triangles {
             scene.warnings.push(format!(
@@ -323,60 +322,15 @@ fn add_mesh(
             ));
             continue;
         };
-        // The accessors this primitive is read through, checked before any reader runs.
-        let attributes = [
-            (Attribute::Position, Some(position_accessor)),
-            (Attribute::Normal, prim.get(&gltf::Semantic::Normals)),
-            (Attribute::Tangent, prim.get(&gltf::Semantic::Tangents)),
-            (
-                Attribute::TexCoord0,
-                prim.get(&gltf::Semantic::TexCoords(0)),
-            ),
-            (Attribute::Indices, prim.indices()),
-        ];
-        let n_positions = root
-            .accessors
-            .get(attributes[0].1.as_ref().map_or(0, |a| a.index()))
-            .map_or(0, |a| a.count.0);
-        for (attribute, accessor) in &attributes {
-            let Some(accessor) = accessor else { continue };
-            let at_fault = |problem: String| {
-                RenderError::input(
-                    path,
-                    format!(
-                        "accessor {} ({} of {mesh_name}, primitive {}): {problem}",
-                        accessor.index(),
-                        attribute.name(),
-                        prim.index()
-                    ),
-                )
-            };
-            check_accessor(root, accessor.index(), *attribute, &buffer_len).map_err(at_fault)?;
-            let count = root.accessors[accessor.index()].count.0;
-            if *attribute != Attribute::Indices && count != n_positions {
-                return Err(at_fault(format!(
-                    "count {count} differs from POSITION's {n_positions}"
-                )));
-            }
-            if *attribute == Attribute::Indices && !count.is_multiple_of(3) {
-                return Err(at_fault(format!("count {count} is not a multiple of 3")));
-            }
-        }
-        let n_triangles = match &attributes[4].1 {
-            Some(a) => root.accessors[a.index()].count.0 / 3,
-            None => n_positions / 3,
-        };
-        if scene.positions.len() as u64 + n_positions > MAX_VERTICES
-            || scene.indices.len() as u64 + n_triangles > MAX_TRIANGLES
-        {
-            return Err(RenderError::input(
-                path,
-                format!(
-                    "{mesh_name}, primitive {}: the scene would have more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (a mesh placed on many nodes counts once per node)",
-                    prim.index()
-                ),
-            ));
-        }
+        check_primitive(
+            scene,
+            root,
+            &prim,
+            position_accessor,
+            &mesh_name,
+            path,
+            buffers,
+        )?;
         let reader = prim.reader(|b| buffers.get(b.index()));
         let Some(positions) = reader.read_positions() else {
             scene.warnings.push(format!(
@@ -431,29 +385,7 @@ fn add_mesh(
             }
             None => None,
         };
-        let flat: Vec<u32> = match reader.read_indices() {
-            Some(it) => it.into_u32().collect(),
-            None => (0..n as u32).collect(),
-        };
-        if !flat.len().is_multiple_of(3) {
-            return Err(bad(&format!(
-                "{} indices is not a multiple of 3",
-                flat.len()
-            )));
-        }
-        if let Some(&i) = flat.iter().find(|&&i| i as usize >= n) {
-            return Err(bad(&format!("index {i} out of range ({n} vertices)")));
-        }
-        let indices = flat
-            .chunks_exact(3)
-            .map(|t| {
-                if mirrored {
-                    [t[0], t[2], t[1]]
-                } else {
-                    [t[0], t[1], t[2]]
-                }
-            })
-            .collect();
+        let indices = triangles(reader.read_indices(), n, mirrored).map_err(|what| bad(&what))?;
         let clean = clean_primitive(RawPrimitive {
             positions,
             normals,
@@ -462,24 +394,8 @@ fn add_mesh(
             indices,
         });
         dropped += clean.dropped;
-        let material = match prim.material().index() {
-            Some(i) => i as u32,
-            None => *default_material.get_or_insert_with(|| {
-                scene.materials.push(Material::default());
-                scene.materials.len() as u32 - 1
-            }),
-        };
-        let offset = scene.positions.len() as u32;
-        scene
-            .indices
-            .extend(clean.indices.iter().map(|t| t.map(|i| i + offset)));
-        scene
-            .triangle_material
-            .extend(std::iter::repeat_n(material, clean.indices.len()));
-        scene.positions.extend(clean.positions);
-        scene.normals.extend(clean.normals);
-        scene.uvs.extend(clean.uvs);
-        scene.tangents.extend(clean.tangents);
+        let material = primitive_material(scene, &prim, default_material);
+        append_primitive(scene, clean, material);
     }
     if dropped > 0 {
         scene.warnings.push(format!(
@@ -487,6 +403,135 @@ fn add_mesh(
         ));
     }
     Ok(())
+}
+
+/// The primitive's material, or the scene's default one (added on first use).
+fn primitive_material(
+    scene: &mut Scene,
+    prim: &gltf::Primitive,
+    default_material: &mut Option<u32>,
+) -> u32 {
+    match prim.material().index() {
+        Some(i) => i as u32,
+        None => *default_material.get_or_insert_with(|| {
+            scene.materials.push(Material::default());
+            scene.materials.len() as u32 - 1
+        }),
+    }
+}
+
+/// Appends a cleaned primitive to the scene, its triangles of `material`.
+fn append_primitive(scene: &mut Scene, clean: CleanPrimitive, material: u32) {
+    let offset = scene.positions.len() as u32;
+    scene
+        .indices
+        .extend(clean.indices.iter().map(|t| t.map(|i| i + offset)));
+    scene
+        .triangle_material
+        .extend(std::iter::repeat_n(material, clean.indices.len()));
+    scene.positions.extend(clean.positions);
+    scene.normals.extend(clean.normals);
+    scene.uvs.extend(clean.uvs);
+    scene.tangents.extend(clean.tangents);
+}
+
+/// Checks every accessor a triangle primitive is read through ([`check_accessor`]), their
+/// counts against POSITION's, and the scene's totals with it against [`MAX_VERTICES`] and
+/// [`MAX_TRIANGLES`], before any reader runs.
+fn check_primitive(
+    scene: &Scene,
+    root: &gltf::json::Root,
+    prim: &gltf::Primitive,
+    position_accessor: gltf::Accessor,
+    mesh_name: &str,
+    path: &Path,
+    buffers: &Buffers,
+) -> Result<(), RenderError> {
+    let buffer_len = |i: usize| buffers.len_of(i);
+    // The accessors this primitive is read through, checked before any reader runs.
+    let attributes = [
+        (Attribute::Position, Some(position_accessor)),
+        (Attribute::Normal, prim.get(&gltf::Semantic::Normals)),
+        (Attribute::Tangent, prim.get(&gltf::Semantic::Tangents)),
+        (
+            Attribute::TexCoord0,
+            prim.get(&gltf::Semantic::TexCoords(0)),
+        ),
+        (Attribute::Indices, prim.indices()),
+    ];
+    let n_positions = root
+        .accessors
+        .get(attributes[0].1.as_ref().map_or(0, |a| a.index()))
+        .map_or(0, |a| a.count.0);
+    for (attribute, accessor) in &attributes {
+        let Some(accessor) = accessor else { continue };
+        let at_fault = |problem: String| {
+            RenderError::input(
+                path,
+                format!(
+                    "accessor {} ({} of {mesh_name}, primitive {}): {problem}",
+                    accessor.index(),
+                    attribute.name(),
+                    prim.index()
+                ),
+            )
+        };
+        check_accessor(root, accessor.index(), *attribute, &buffer_len).map_err(at_fault)?;
+        let count = root.accessors[accessor.index()].count.0;
+        if *attribute != Attribute::Indices && count != n_positions {
+            return Err(at_fault(format!(
+                "count {count} differs from POSITION's {n_positions}"
+            )));
+        }
+        if *attribute == Attribute::Indices && !count.is_multiple_of(3) {
+            return Err(at_fault(format!("count {count} is not a multiple of 3")));
+        }
+    }
+    let n_triangles = match &attributes[4].1 {
+        Some(a) => root.accessors[a.index()].count.0 / 3,
+        None => n_positions / 3,
+    };
+    if scene.positions.len() as u64 + n_positions > MAX_VERTICES
+        || scene.indices.len() as u64 + n_triangles > MAX_TRIANGLES
+    {
+        return Err(RenderError::input(
+            path,
+            format!(
+                "{mesh_name}, primitive {}: the scene would have more than {MAX_VERTICES} vertices or {MAX_TRIANGLES} triangles (a mesh placed on many nodes counts once per node)",
+                prim.index()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The primitive's triangles (its indices, or the vertices in order without), each in range
+/// of `n` vertices, wound the other way under a mirroring transform.
+fn triangles(
+    read: Option<gltf::mesh::util::ReadIndices<'_>>,
+    n: usize,
+    mirrored: bool,
+) -> Result<Vec<[u32; 3]>, String> {
+    let flat: Vec<u32> = match read {
+        Some(it) => it.into_u32().collect(),
+        None => (0..n as u32).collect(),
+    };
+    if !flat.len().is_multiple_of(3) {
+        return Err(format!("{} indices is not a multiple of 3", flat.len()));
+    }
+    if let Some(&i) = flat.iter().find(|&&i| i as usize >= n) {
+        return Err(format!("index {i} out of range ({n} vertices)"));
+    }
+    Ok(flat
+        .chunks_exact(3)
+        .map(|t| {
+            if mirrored {
+                [t[0], t[2], t[1]]
+            } else {
+                [t[0], t[1], t[2]]
+            }
+        })
+        .collect())
 }
 
 /// A punctual light placed by its node's world matrix; `None` when it is not finite.
