@@ -55,6 +55,28 @@ fn real(s: &str, range: RangeInclusive<f64>) -> Result<f64, String> {
     }
 }
 
+/// Largest sample index a render may reach (a shard's `--samples A..B` has B at most this).
+pub const MAX_SAMPLE_INDEX: u32 = 1 << 30;
+
+/// A shard's sample indices `A..B`: 0 ≤ A < B ≤ [`MAX_SAMPLE_INDEX`], at most [`MAX_SPP`] of them.
+pub fn sample_range(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or_else(|| format!("`{s}`: expected A..B (the sample indices A to B − 1)"))?;
+    let a = whole(a, 0..=MAX_SAMPLE_INDEX)?;
+    let b = whole(b, 0..=MAX_SAMPLE_INDEX)?;
+    if a >= b {
+        return Err(format!("`{s}`: A must be below B"));
+    }
+    if b - a > MAX_SPP {
+        return Err(format!(
+            "`{s}`: {} samples; a render takes at most 2^20 per pixel",
+            b - a
+        ));
+    }
+    Ok(a..b)
+}
+
 /// An image side: 1 to [`MAX_SIDE`].
 pub fn side(s: &str) -> Result<u32, String> {
     whole(s, 1..=MAX_SIDE)

@@ -57,6 +57,7 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
         width: args.width,
         height: args.height,
         spp: args.spp,
+        samples: None,
         max_depth: 5,
         seed: 0,
         time_limit: None,

@@ -7,8 +7,10 @@ mod demo_cmd;
 mod dpf_cmd;
 mod export_cmd;
 mod fit_cmd;
+mod merge_cmd;
 mod output;
 mod render_cmd;
+mod render_digest;
 
 use clap::{Parser, Subcommand};
 
@@ -36,6 +38,9 @@ enum Command {
     Dpf(dpf_cmd::DpfArgs),
     /// Path-trace a glTF scene (wavefront, on the GPU) to PNG and EXR.
     Render(render_cmd::RenderArgs),
+    /// Join shards of one render (`facet render --samples A..B`) into one image, weighted by
+    /// their sample counts, the variance too.
+    Merge(merge_cmd::MergeArgs),
     /// Fit the embedded default material and render the demo scene with it (the default).
     Demo(demo_cmd::DemoArgs),
     /// Measure the fitter, ray tracing, the integrator, glints and the preview on this adapter.
@@ -52,6 +57,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Export(args)) => export_cmd::run(&args),
         Some(Command::Dpf(args)) => dpf_cmd::run(&args),
         Some(Command::Render(args)) => render_cmd::run(&args),
+        Some(Command::Merge(args)) => merge_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),
         Some(Command::Bench(args)) => bench_cmd::run(&args),
         None => demo_cmd::run(&demo_cmd::DemoArgs::defaults()),

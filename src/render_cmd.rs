@@ -6,6 +6,7 @@ use facet_fit::io::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
+use facet_render::shard::{PixelKind, ShardRecord};
 use facet_render::{
     ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
@@ -34,9 +35,14 @@ pub struct RenderArgs {
     /// Image height, 1 to 16384.
     #[arg(long, default_value_t = 540, value_parser = crate::args::side)]
     pub height: u32,
-    /// Samples per pixel, 1 to 2^20.
+    /// Samples per pixel, 1 to 2^20: the sample indices 0..SPP of every pixel.
     #[arg(long, default_value_t = 32, value_parser = crate::args::spp)]
     pub spp: u32,
+    /// Only the sample indices A..B (A included, B not) of every pixel, instead of --spp: a
+    /// shard of a render, to be joined with the others by `facet merge` (docs/farm.md).
+    /// B at most 2^30, B − A at most 2^20.
+    #[arg(long, value_name = "A..B", value_parser = crate::args::sample_range, conflicts_with = "spp")]
+    pub samples: Option<std::ops::Range<u32>>,
     /// Bounces after the camera ray, 0 to 64.
     #[arg(long, default_value_t = 5, value_parser = crate::args::depth)]
     pub max_depth: u32,
@@ -126,16 +132,22 @@ pub struct Job {
     pub resources: ResourceConfig,
     /// Write STEM.variance.exr too.
     pub variance: bool,
+    /// The sample indices to render: --samples, or 0..--spp.
+    pub samples: std::ops::Range<u32>,
+    /// The scene's files and the settings that decide the image, digested: written in the
+    /// EXRs so that `facet merge` joins only parts of one render.
+    pub digest: String,
 }
 
 pub fn prepare(args: &RenderArgs) -> Result<Job> {
-    let samples = args.width as u64 * args.height as u64 * args.spp as u64;
+    let range = args.samples.clone().unwrap_or(0..args.spp);
+    let spp = range.len() as u32;
+    let samples = args.width as u64 * args.height as u64 * spp as u64;
     if samples > crate::args::MAX_SAMPLES {
         bail!(
-            "--width {} × --height {} × --spp {} = {samples} samples; a render takes at most 2^40",
+            "--width {} × --height {} × {spp} spp = {samples} samples; a render takes at most 2^40",
             args.width,
             args.height,
-            args.spp
         );
     }
     let mut materials = Vec::new();
@@ -195,7 +207,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
             wavefront: args.wavefront,
         },
         sampling: SampleConfig {
-            spp: args.spp,
+            spp,
             max_depth: args.max_depth,
             seed: args.seed,
             time_limit: args.time_limit,
@@ -209,12 +221,15 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         glint_filter: !args.no_glint_filter,
         ..ResourceConfig::standard()
     };
+    let digest = crate::render_digest::digest(args, &inputs)?;
     Ok(Job {
         scene,
         environment,
         config,
         resources,
         variance: args.variance,
+        samples: range,
+        digest,
     })
 }
 
@@ -256,18 +271,28 @@ pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) ->
     } else {
         integrator.wavefront(gpu, &res, c.image)?
     };
+    wf.start_at(gpu, job.samples.start);
     let stats = integrator.render_more(gpu, &mut wf, &camera, &c.sampling, &mut |f| {
         bar.set_position((f * 1000.0) as u64)
     })?;
     let image = wf.image(gpu)?;
     bar.finish_and_clear();
+    let record = |pixels| {
+        ShardRecord::new(
+            pixels,
+            wf.sample_range(),
+            c.sampling.seed,
+            job.digest.clone(),
+            crate::render_digest::VERSION.into(),
+        )
+    };
     let (png, exr) = outputs(out);
     image.write_png(&png, exposure)?;
-    image.write_exr(&exr)?;
+    image.write_shard_exr(&exr, &record(PixelKind::Mean))?;
     println!("wrote {} and {}", png.display(), exr.display());
     if let Some(var) = wf.variance(gpu)? {
         let path = variance_output(out);
-        var.write_exr(&path)?;
+        var.write_shard_exr(&path, &record(PixelKind::VarianceOfMean))?;
         let mean = var.mean();
         println!(
             "wrote {} (mean variance of a pixel {:.3e} {:.3e} {:.3e})",

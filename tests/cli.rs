@@ -4,6 +4,8 @@
 
 mod common;
 
+use common::{demo_copy, reproducible_demo_copy};
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -15,16 +17,7 @@ fn cwd() -> PathBuf {
 }
 
 fn facet(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_facet"))
-        .args(args)
-        .current_dir(cwd())
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
+    common::facet_in(&cwd(), args)
 }
 
 #[test]
@@ -212,16 +205,6 @@ fn dpf_query_and_exr_slices() {
     }
     let (ok, _, stderr) = facet(&["dpf", "--ndf", "analytic:ggx?alpha=0.3", "--gamma", "5"]);
     assert!(!ok && stderr.contains("--theta-o"), "{stderr}");
-}
-
-/// A copy of the committed demo scene (glTF, fit, sky) in `dir`, so that a render whose guard
-/// fails can only harm the copy.
-fn demo_copy(dir: &Path) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo");
-    for f in ["demo.gltf", "default_fit.json", "sky.exr"] {
-        std::fs::copy(src.join(f), dir.join(f)).unwrap();
-    }
-    dir.join("demo.gltf")
 }
 
 /// `facet render` on bad inputs: each error names the file and nothing is written. Runs on a
@@ -435,27 +418,6 @@ fn render_small(demo: &str, out: &Path, extra: &[&str]) -> String {
     let (ok, stdout, err) = facet(&args);
     assert!(ok, "{args:?}: {stdout}\n{err}");
     stdout
-}
-
-/// A copy of the demo whose glint sphere has 1000× fewer flakes, so that renders repeat bit for
-/// bit on lavapipe too. At the demo's density (and still at a tenth of it) footprints hold
-/// enough flakes for llvmpipe's cap of 65 535 iterations per loop, which it counts over a SIMD
-/// group of invocations, to cut some counts short; which paths share a group changes from run
-/// to run, so a dozen glint pixels of 960 differ between identical renders there.
-fn reproducible_demo_copy(dir: &Path) -> PathBuf {
-    let demo = demo_copy(dir);
-    let mut doc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&demo).unwrap()).unwrap();
-    let mut changed = 0;
-    for m in doc["materials"].as_array_mut().unwrap() {
-        if let Some(g) = m.pointer_mut("/extras/facet/glint/density") {
-            *g = serde_json::json!(g.as_f64().unwrap() / 1000.0);
-            changed += 1;
-        }
-    }
-    assert_eq!(changed, 1, "the demo has one glint material");
-    std::fs::write(&demo, serde_json::to_string(&doc).unwrap()).unwrap();
-    demo
 }
 
 /// `--exposure` scales what the PNG shows exactly as the tone map says, and leaves the EXR

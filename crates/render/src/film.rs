@@ -74,14 +74,38 @@ impl Image {
 
     /// Linear f32 RGB EXR, as rendered.
     pub fn write_exr(&self, path: &Path) -> Result<(), RenderError> {
+        self.write_exr_with(path, None)
+    }
+
+    /// Linear f32 RGB EXR with the text `facet` (a [`ShardRecord`](crate::shard::ShardRecord)'s
+    /// JSON) in its header when given.
+    pub(crate) fn write_exr_with(
+        &self,
+        path: &Path,
+        facet: Option<String>,
+    ) -> Result<(), RenderError> {
+        use exr::meta::attribute::{AttributeValue, Text};
+        use exr::prelude::{SpecificChannels, Vec2, WritableImage as _};
         let w = self.width as usize;
         let px = &self.pixels;
+        let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+            let p: [f32; 3] = px[y * w + x];
+            (p[0], p[1], p[2])
+        });
+        let mut image = exr::prelude::Image::from_channels((w, self.height as usize), channels);
+        if let Some(text) = facet {
+            let key = Text::from(crate::shard::EXR_ATTRIBUTE);
+            let value = Text::new_or_none(text.as_str()).ok_or_else(|| RenderError::Output {
+                path: path.to_owned(),
+                message: "the shard record is not EXR text".into(),
+            })?;
+            image
+                .attributes
+                .other
+                .insert(key, AttributeValue::Text(value));
+        }
         write_atomically(path, |tmp| {
-            exr::prelude::write_rgb_file(tmp, w, self.height as usize, |x, y| {
-                let p = px[y * w + x];
-                (p[0], p[1], p[2])
-            })
-            .map_err(|e| e.to_string())
+            image.write().to_file(tmp).map_err(|e| e.to_string())
         })
     }
 

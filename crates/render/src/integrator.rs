@@ -225,7 +225,8 @@ impl Integrator {
         let mut frame = frame_uniform(wf, camera, sampling);
         let tiles = pixels.div_ceil(w);
         let per_pass = sampling.spp_per_pass.max(1);
-        let (first, last) = (wf.spp(), wf.spp().saturating_add(sampling.spp));
+        let first = wf.sample_range().end;
+        let last = first.saturating_add(sampling.spp);
         let passes = sampling.spp.div_ceil(per_pass);
         let mut stats = RenderStats::default();
         let all_slots = facet_gpu::dispatch::workgroups(wf.slots(), self.wg);
@@ -243,7 +244,7 @@ impl Integrator {
                 let done = (pass as u64 * tiles + tile + 1) as f64 / (passes as u64 * tiles) as f64;
                 progress(done);
             }
-            wf.set_spp(end);
+            wf.set_next_sample(end);
             stats.spp = end - first;
             if let Some(limit) = sampling.time_limit
                 && t0.elapsed().as_secs_f64() >= limit

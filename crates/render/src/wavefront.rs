@@ -30,8 +30,8 @@ pub struct Wavefront {
     moments: bool,
     buffers: Buffers,
     groups: Groups,
-    /// Samples per pixel in the film.
-    spp: u32,
+    /// The sample indices in the film: [first, next) of every pixel.
+    samples: std::ops::Range<u32>,
     /// The tone-mapping pass, made on first use.
     tone_map: Option<ToneMap>,
 }
@@ -96,7 +96,7 @@ impl Wavefront {
             moments,
             buffers,
             groups,
-            spp: 0,
+            samples: 0..0,
             tone_map: None,
         })
     }
@@ -113,7 +113,13 @@ impl Wavefront {
 
     /// Samples per pixel accumulated in the film.
     pub fn spp(&self) -> u32 {
-        self.spp
+        self.samples.len() as u32
+    }
+
+    /// The sample indices in the film, the same for every pixel: [first, next). The next
+    /// [`Integrator::render_more`](crate::Integrator::render_more) continues from `next`.
+    pub fn sample_range(&self) -> std::ops::Range<u32> {
+        self.samples.clone()
     }
 
     /// Whether the film keeps Σ L² per pixel ([`Wavefront::variance`]).
@@ -140,9 +146,10 @@ impl Wavefront {
         &self.buffers.args
     }
 
-    /// Records that the film now holds `spp` samples per pixel.
-    pub(crate) fn set_spp(&mut self, spp: u32) {
-        self.spp = spp;
+    /// Records that the film now holds the samples up to index `next` (exclusive).
+    pub(crate) fn set_next_sample(&mut self, next: u32) {
+        debug_assert!(next >= self.samples.end, "sample indices only grow");
+        self.samples.end = next;
     }
 
     /// Starts a tile: the frame uniform `frame`, every slot of the tile at
@@ -170,11 +177,19 @@ impl Wavefront {
 
     /// Empties the film: the next samples start a new image (sample indices from 0).
     pub fn clear(&mut self, gpu: &Gpu) {
+        self.start_at(gpu, 0);
+    }
+
+    /// Empties the film and starts it at sample index `first`: the next
+    /// [`Integrator::render_more`](crate::Integrator::render_more) takes samples `first`,
+    /// `first + 1`, … of every pixel, the ones a render from 0 would take there. A shard of a
+    /// render is [`Wavefront::start_at`] its range's start, then its count.
+    pub fn start_at(&mut self, gpu: &Gpu, first: u32) {
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         enc.clear_buffer(&self.buffers.film, 0, None);
         enc.clear_buffer(&self.buffers.film_sq, 0, None);
         gpu.queue.submit([enc.finish()]);
-        self.spp = 0;
+        self.samples = first..first;
     }
 
     /// The film read back: the mean of the samples so far.

@@ -1,0 +1,227 @@
+//! Renders split into shards (`facet render --samples A..B`) and joined (`facet merge`): the
+//! union of disjoint shards is the one render of all their samples, and parts that do not belong
+//! together are refused before anything is written.
+
+mod common;
+
+use facet_render::Image;
+use facet_render::shard::{PixelKind, ShardRecord};
+use std::path::{Path, PathBuf};
+
+/// The render of the test scene: 48 × 27 pixels, `samples` ("A..B") or `--spp N`, with
+/// `--variance`, into `out`; any `extra` options.
+fn render(dir: &Path, scene: &Path, samples: &[&str], out: &str, extra: &[&str]) {
+    let sky = dir.join("sky.exr");
+    let mut args = vec![
+        "render",
+        scene.to_str().unwrap(),
+        "--env",
+        sky.to_str().unwrap(),
+        "--width",
+        "48",
+        "--height",
+        "27",
+        "--variance",
+        "--out",
+        out,
+    ];
+    args.extend(samples);
+    args.extend(extra);
+    let (ok, stdout, err) = common::facet_in(dir, &args);
+    assert!(ok, "{args:?}: {stdout}\n{err}");
+}
+
+fn merge(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let mut all = vec!["merge"];
+    all.extend(args);
+    common::facet_in(dir, &all)
+}
+
+fn read(path: PathBuf) -> (Image, ShardRecord) {
+    Image::read_shard_exr(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// The demo with glints (1000× fewer flakes, so that lavapipe repeats it bit for bit: see
+/// `common::reproducible_demo_copy`) and its full render at 8 spp.
+fn scene_and_full_render(dir: &Path) -> PathBuf {
+    let scene = common::reproducible_demo_copy(dir);
+    render(dir, &scene, &["--spp", "8"], "full/r.png", &[]);
+    scene
+}
+
+/// Four shards of 2 spp, merged in a shuffled order, are the 8 spp render: each pixel's mean
+/// equal within the f32 rounding of the sums (each shard's sum and the full render's sum are
+/// rounded at every add, ≤ 8 adds of relative error 2⁻²⁴: 1e-6 relative, kept at 4e-6), and its
+/// variance within the rounding of Σ L² that both compute it from (relative to Σ L² / (n (n − 1)),
+/// the size of the terms that cancel).
+#[test]
+fn four_shards_merge_to_the_one_render() {
+    if facet_gpu::gpu_for_tests("four_shards_merge_to_the_one_render").is_none() {
+        return;
+    }
+    let dir = common::scratch("shards_merge");
+    let scene = scene_and_full_render(&dir);
+    for (k, s) in ["0..2", "2..4", "4..6", "6..8"].iter().enumerate() {
+        render(
+            &dir,
+            &scene,
+            &["--samples", s],
+            &format!("part{k}/r.png"),
+            &[],
+        );
+    }
+    let (ok, stdout, err) = merge(
+        &dir,
+        &[
+            "part2/r.exr",
+            "part0/r.exr",
+            "part3/r.exr",
+            "part1/r.exr",
+            "--variance",
+            "--out",
+            "merged/m.png",
+        ],
+    );
+    assert!(ok, "{stdout}\n{err}");
+    assert!(stdout.contains("samples 0..8 (8 spp)"), "{stdout}");
+    assert!(err.is_empty(), "a full cover gives no notice: {err}");
+    assert!(dir.join("merged/m.png").exists());
+    let (full, full_rec) = read(dir.join("full/r.exr"));
+    let (merged, merged_rec) = read(dir.join("merged/m.exr"));
+    assert_eq!(
+        merged_rec, full_rec,
+        "the merged record is the full render's"
+    );
+    assert_eq!(full_rec.samples, vec![[0, 8]]);
+    let (full_var, _) = read(dir.join("full/r.variance.exr"));
+    let (merged_var, var_rec) = read(dir.join("merged/m.variance.exr"));
+    assert_eq!(var_rec.pixels, PixelKind::VarianceOfMean);
+    let n = 8.0f64;
+    let (mut worst_mean, mut worst_var, mut glinting) = (0.0f64, 0.0f64, 0);
+    for k in 0..full.pixels.len() {
+        for c in 0..3 {
+            let (a, b) = (full.pixels[k][c] as f64, merged.pixels[k][c] as f64);
+            let scale = a.abs().max(b.abs()).max(1e-30);
+            worst_mean = worst_mean.max((a - b).abs() / scale);
+            // Σ L² / n = variance of the samples · (n − 1)/n + mean²: the size of the terms.
+            let (va, vb) = (full_var.pixels[k][c] as f64, merged_var.pixels[k][c] as f64);
+            let second = va * (n - 1.0) + a * a;
+            worst_var = worst_var.max((va - vb).abs() / (second / (n - 1.0)).max(1e-30));
+            glinting += (va > 1.0) as usize;
+        }
+    }
+    assert!(
+        worst_mean <= 4e-6,
+        "mean: worst relative difference {worst_mean:e}"
+    );
+    assert!(
+        worst_var <= 2e-5,
+        "variance: worst relative difference {worst_var:e}"
+    );
+    assert!(glinting > 0, "the scene has noisy (glint) pixels");
+    println!("worst relative difference: mean {worst_mean:e}, variance {worst_var:e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A part of another seed, size, scene or range overlapping another, a variance image given as
+/// a part, an EXR that Facet did not render, a missing variance and an output over a part are
+/// each refused, naming the part; nothing is written.
+#[test]
+fn parts_that_do_not_belong_together_are_refused() {
+    if facet_gpu::gpu_for_tests("parts_that_do_not_belong_together_are_refused").is_none() {
+        return;
+    }
+    let dir = common::scratch("shards_refused");
+    let scene = common::reproducible_demo_copy(&dir);
+    render(&dir, &scene, &["--samples", "0..2"], "a/r.png", &[]);
+    render(&dir, &scene, &["--samples", "1..3"], "overlap/r.png", &[]);
+    render(
+        &dir,
+        &scene,
+        &["--samples", "2..4"],
+        "seed/r.png",
+        &["--seed", "7"],
+    );
+    render(
+        &dir,
+        &scene,
+        &["--samples", "2..4"],
+        "depth/r.png",
+        &["--max-depth", "2"],
+    );
+    let sky = dir.join("sky.exr");
+    let (ok, _, err) = common::facet_in(
+        &dir,
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "--env",
+            sky.to_str().unwrap(),
+            "--width",
+            "40",
+            "--height",
+            "27",
+            "--samples",
+            "2..4",
+            "--out",
+            "size/r.png",
+        ],
+    );
+    assert!(ok, "{err}");
+    std::fs::create_dir_all(dir.join("novar")).unwrap();
+    std::fs::copy(dir.join("a/r.exr"), dir.join("novar/r.exr")).unwrap();
+    let cases: [(&[&str], &str, &str); 9] = [
+        (
+            &["a/r.exr", "overlap/r.exr"],
+            "overlap/r.exr",
+            "overlap the samples 0..2",
+        ),
+        (&["a/r.exr", "a/r.exr"], "a/r.exr", "overlap"),
+        (&["a/r.exr", "seed/r.exr"], "seed/r.exr", "another seed (7)"),
+        (
+            &["a/r.exr", "depth/r.exr"],
+            "depth/r.exr",
+            "another scene or settings",
+        ),
+        (&["a/r.exr", "size/r.exr"], "size/r.exr", "40 × 27 pixels"),
+        (
+            &["a/r.exr", "a/r.variance.exr"],
+            "a/r.variance.exr",
+            "a variance image",
+        ),
+        (&["a/r.exr", "sky.exr"], "sky.exr", "no \"facet\" attribute"),
+        (
+            &["a/r.exr", "novar/r.exr", "--variance"],
+            "novar/r.exr",
+            "no novar/r.variance.exr",
+        ),
+        (
+            &["a/r.exr", "--out", "a/r.png"],
+            "a/r.exr",
+            "would replace the part",
+        ),
+    ];
+    for (args, part, problem) in cases {
+        let mut all = args.to_vec();
+        if !all.contains(&"--out") {
+            all.extend(["--out", "merged/m.png"]);
+        }
+        let (ok, stdout, err) = merge(&dir, &all);
+        assert!(!ok, "{args:?} merged: {stdout}");
+        assert!(
+            err.contains(part) && err.contains(problem),
+            "{args:?}: the message should name {part} and say {problem:?}: {err}"
+        );
+        assert!(!dir.join("merged").exists(), "{args:?} wrote something");
+    }
+    // Samples not from 0 are not an error: the union is an estimate of fewer samples, said in
+    // a notice.
+    let (ok, stdout, err) = merge(&dir, &["overlap/r.exr", "--out", "gap/m.png"]);
+    assert!(ok, "{err}");
+    assert!(stdout.contains("samples 1..3 (2 spp)"), "{stdout}");
+    assert!(
+        err.contains("notice: the parts hold the samples 1..3 only"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
