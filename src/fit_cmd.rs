@@ -1,11 +1,20 @@
-//! `facet fit`: one fit per input, a JSON and tables per fit, a summary table.
+//! `facet fit`: one fit per input, a JSON and tables per fit, a summary table; a sweep split
+//! into shards ([`shard`]) and its table put back together ([`summary`]).
 
+mod shard;
+mod summary;
+
+use self::shard::{Entry, Manifest, Shard, fit_stem, settings};
+use self::summary::{
+    FitRow, SUMMARY_CSV, print_medians, print_summary, refuse_over_input, write_summary_csv,
+};
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
+use facet_fit::Brdf;
 use facet_fit::extract::Stopping;
 use facet_fit::fitting::{Backend, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
-use facet_fit::io::input::same_file;
+use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::fresnel_curves::FresnelChoice;
 use facet_fit::model::material::FittedMaterial;
 use facet_fit::model::merl_grid::MerlTable;
@@ -16,7 +25,6 @@ use facet_fit::sources::{InputSpec, Residence};
 use facet_gpu::Gpu;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -142,7 +150,7 @@ pub enum QuadratureArg {
 #[command(allow_negative_numbers = true)]
 pub struct FitArgs {
     /// MERL .binary file, RGL .bsdf, `nbrdf:NAME`, `analytic:ggx?alpha=0.2&f0=0.04`, or a fit .json.
-    #[arg(required = true)]
+    #[arg(required_unless_present = "summary")]
     inputs: Vec<String>,
     /// Models to fit and report (the tabulated NDF is always extracted).
     #[arg(long, value_enum, default_value = "all")]
@@ -168,9 +176,32 @@ pub struct FitArgs {
     quadrature: QuadratureArg,
     #[arg(long, value_enum, default_value = "auto")]
     backend: BackendArg,
-    /// Output folder for NAME.json and the tables.
+    /// Output folder for NAME.json and the tables, summary.csv (the printed table, when there are
+    /// several inputs) and a shard's manifest.
     #[arg(long, default_value = "out")]
     out: PathBuf,
+    /// Fit only shard I of N of the inputs (I from 0 to N − 1): those at k = I, I + N, I + 2N, …
+    /// in command-line order, from 0. Every shard gets the same inputs and options; each writes
+    /// its fits, named as one run over all the inputs names them, and
+    /// `shard-I-of-N.facet-shard.json`, which --summary reads (no summary.csv: shards may share
+    /// --out).
+    #[arg(long, value_name = "I/N", value_parser = shard::parse_shard)]
+    shard: Option<Shard>,
+    /// Fit nothing: read the fits and shard manifests in the folders DIR… (the --out of one run or
+    /// of every shard of a sweep), print the table one run over all the inputs prints, in its
+    /// order, and write it to --out as summary.csv. Refused, with nothing written, unless the
+    /// manifests make one whole sweep: every shard once, the same N, number of inputs, settings
+    /// and Facet version.
+    #[arg(
+        long,
+        value_name = "DIR",
+        num_args = 1..,
+        conflicts_with_all = [
+            "inputs", "shard", "model", "aniso", "resolution", "phi_resolution", "iterations",
+            "tolerance", "quadrature", "backend", "no_diffuse", "no_refine", "fresnel", "nbrdf",
+        ]
+    )]
+    summary: Vec<PathBuf>,
     /// The paper's single specular lobe: no Lambertian term, F averaged per θd bin and not
     /// clipped to [0, 1], no refinement (default: a diffuse lobe ρd with every model, F in
     /// [0, 1], the tabulated NDF refined in the metric's space). --aniso fits a single lobe.
@@ -191,6 +222,13 @@ pub struct FitArgs {
 }
 
 impl FitArgs {
+    /// `--backend` as it is written on the command line.
+    fn backend_name(&self) -> String {
+        self.backend
+            .to_possible_value()
+            .map_or(String::new(), |v| v.get_name().to_owned())
+    }
+
     fn config(&self) -> Result<FitConfig> {
         let mut cfg = if self.aniso {
             FitConfig::anisotropic()
@@ -259,19 +297,30 @@ impl FitArgs {
     }
 }
 
+/// `facet fit`: each input (or each of `--shard`'s) fitted and written, the table printed;
+/// `summary.csv` across several inputs, a shard's manifest; `--summary` goes to
+/// [`summary::run`].
 pub fn run(args: &FitArgs) -> Result<ExitCode> {
+    if !args.summary.is_empty() {
+        return summary::run(&args.summary, &args.out);
+    }
     let cfg = args.config()?;
     let nbrdf = NbrdfLibrary::override_path(args.nbrdf.as_deref());
     let mut library = None;
     let specs: Vec<InputSpec> = args.inputs.iter().map(|i| InputSpec::parse(i)).collect();
-    let (gpu, mut first) = open_gpu_during(args.backend, cfg.anisotropic, || {
-        let first = specs.first()?;
-        Some(open_timed(first, nbrdf.as_deref(), &mut library))
+    let mine: Vec<usize> = (0..specs.len())
+        .filter(|&k| args.shard.is_none_or(|s| s.holds(k)))
+        .collect();
+    let (gpu, (names, first)) = open_gpu_during(args.backend, cfg.anisotropic, || {
+        let names: Vec<Option<String>> = specs.iter().map(planned_name).collect();
+        let first = mine
+            .first()
+            .map(|&k| open_timed(&specs[k], nbrdf.as_deref(), &mut library));
+        (names, first)
     });
     let gpu = gpu?;
     let fitter = fitter(&gpu, args.backend)?;
     let backend = fitter.as_ref().map_or(Backend::Cpu, Backend::Gpu);
-    crate::output::folder(&args.out, "--out")?;
     let mut outputs = Outputs {
         dir: &args.out,
         read: specs
@@ -281,44 +330,38 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
             .collect(),
         names: HashSet::new(),
     };
-    let bar = (args.inputs.len() > 1).then(|| {
-        let bar = ProgressBar::new(args.inputs.len() as u64);
-        bar.set_style(
-            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed} < {eta}]")
-                .expect("valid template"),
-        );
-        bar
-    });
-    let mut rows = Vec::new();
-    let mut failures = 0;
+    // The sweep's own file, refused before any fit when it would replace an input.
+    let sweep_file = match args.shard {
+        Some(shard) => Some(args.out.join(shard.manifest_name())),
+        None => (args.inputs.len() > 1).then(|| args.out.join(SUMMARY_CSV)),
+    };
+    if let Some(file) = &sweep_file {
+        refuse_over_input(file, &outputs.read)?;
+    }
+    crate::output::folder(&args.out, "--out")?;
+    // Every input claims its file name in command-line order, fitted here or not, so that each
+    // shard names its fits as one run over all the inputs does.
+    let mut planned: Vec<_> = names
+        .iter()
+        .map(|n| n.as_deref().map(|n| outputs.claim(n)))
+        .collect();
+    let jobs = mine
+        .iter()
+        .map(|&k| Job {
+            index: k,
+            input: &args.inputs[k],
+            spec: &specs[k],
+            planned: planned[k].take(),
+        })
+        .collect();
+    let mut first = first;
     let started = Instant::now();
-    for (input, spec) in args.inputs.iter().zip(&specs) {
-        if let Some(bar) = &bar {
-            bar.set_message(input.clone());
-        }
-        let opened = first
+    let (rows, entries) = fit_inputs(jobs, &cfg, backend, &mut outputs, |spec| {
+        first
             .take()
-            .unwrap_or_else(|| open_timed(spec, nbrdf.as_deref(), &mut library));
-        match fit_one(input, opened, &cfg, backend, &mut outputs) {
-            Ok(fit) => rows.push(fit),
-            Err(e) => {
-                failures += 1;
-                // Printed around the bar (a hidden bar, as when stderr is not a terminal,
-                // would swallow `bar.println`).
-                let msg = format!("error: {e:#}");
-                match &bar {
-                    Some(bar) => bar.suspend(|| eprintln!("{msg}")),
-                    None => eprintln!("{msg}"),
-                }
-            }
-        }
-        if let Some(bar) = &bar {
-            bar.inc(1);
-        }
-    }
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+            .unwrap_or_else(|| open_timed(spec, nbrdf.as_deref(), &mut library))
+    });
+    let failed = entries.iter().any(|e| e.outcome.is_err());
     print_summary(&rows);
     if rows.len() > 1 {
         print_medians(&rows, started.elapsed().as_secs_f64());
@@ -326,11 +369,112 @@ pub fn run(args: &FitArgs) -> Result<ExitCode> {
     if !rows.is_empty() {
         println!("wrote {} fit(s) to {}", rows.len(), args.out.display());
     }
-    Ok(if failures > 0 {
+    if let Some(shard) = args.shard {
+        let manifest = Manifest {
+            shard,
+            total_inputs: args.inputs.len(),
+            facet_version: env!("CARGO_PKG_VERSION").into(),
+            settings: settings(&cfg, &args.backend_name(), nbrdf.as_deref()),
+            entries,
+        };
+        let path = args.out.join(shard.manifest_name());
+        facet_fit::io::output::write_bytes_atomically(&path, manifest.to_json())
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    } else if sweep_file.is_some() {
+        println!("wrote {}", write_summary_csv(&args.out, &rows)?.display());
+    }
+    Ok(if failed {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// The name the fit of `spec` will have (its source's name), found without fitting it and,
+/// but for a fit `.json` or an analytic spec, without opening it; `None` when a fit `.json` or
+/// spec cannot be read to tell (it then fails to open, and claims no name).
+fn planned_name(spec: &InputSpec) -> Option<String> {
+    let stem = |path: &Path| {
+        path.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    };
+    match spec {
+        InputSpec::Nbrdf(name) => Some(name.clone()),
+        InputSpec::Analytic(s) => parse_analytic(s).ok().map(|m| Brdf::name(&m).to_owned()),
+        InputSpec::Fit(path) => FittedMaterial::load(path).ok().map(|f| f.record.name),
+        // MERL and RGL sources are named after the file's stem.
+        InputSpec::Rgl(path) | InputSpec::Merl(path) => Some(stem(path)),
+    }
+}
+
+/// One input to fit.
+struct Job<'a> {
+    /// Its index on the command line.
+    index: usize,
+    /// As given.
+    input: &'a str,
+    spec: &'a InputSpec,
+    /// Its JSON and tables paths, claimed from its name before any fit; `None` when the name
+    /// was not known then.
+    planned: Option<Result<(PathBuf, PathBuf)>>,
+}
+
+/// Fits `jobs` in order, each source opened by `open`, with a progress bar across several:
+/// the rows of the fits and every input's outcome. A failed input is reported and the rest
+/// still run.
+fn fit_inputs(
+    jobs: Vec<Job>,
+    cfg: &FitConfig,
+    backend: Backend,
+    outputs: &mut Outputs,
+    mut open: impl FnMut(&InputSpec) -> Opened,
+) -> (Vec<FitRow>, Vec<Entry>) {
+    let bar = (jobs.len() > 1).then(|| {
+        let bar = ProgressBar::new(jobs.len() as u64);
+        bar.set_style(
+            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed} < {eta}]")
+                .expect("valid template"),
+        );
+        bar
+    });
+    let (mut rows, mut entries) = (Vec::new(), Vec::new());
+    for job in jobs {
+        if let Some(bar) = &bar {
+            bar.set_message(job.input.to_owned());
+        }
+        let opened = open(job.spec);
+        let outcome = match fit_one(job.input, opened, job.planned, cfg, backend, outputs) {
+            Ok(row) => {
+                let json = row.json.clone();
+                rows.push(row);
+                Ok(json)
+            }
+            Err(e) => {
+                // Printed around the bar (a hidden bar, as when stderr is not a terminal,
+                // would swallow `bar.println`).
+                let msg = format!("{e:#}");
+                match &bar {
+                    Some(bar) => bar.suspend(|| eprintln!("error: {msg}")),
+                    None => eprintln!("error: {msg}"),
+                }
+                Err(msg)
+            }
+        };
+        entries.push(Entry {
+            index: job.index,
+            input: job.input.to_owned(),
+            outcome,
+        });
+        if let Some(bar) = &bar {
+            bar.inc(1);
+        }
+    }
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    (rows, entries)
 }
 
 /// Where the fits of one run go: `dir/<name>.json` and `.tables.csv`, each name once, never
@@ -343,10 +487,11 @@ struct Outputs<'a> {
 }
 
 impl Outputs<'_> {
-    /// The JSON and CSV paths for a fit named `name` (from data: made a safe file stem; a
-    /// second fit of one name gets -2, -3, ...), refused when one would replace an input.
+    /// The JSON and CSV paths for a fit named `name` (from data: made a safe file stem that no
+    /// shard manifest's name ends like; a second fit of one name gets -2, -3, ...), refused when
+    /// one would replace an input.
     fn claim(&mut self, name: &str) -> Result<(PathBuf, PathBuf)> {
-        let base = facet_fit::io::input::safe_file_stem(name);
+        let base = fit_stem(facet_fit::io::input::safe_file_stem(name));
         let mut name = base.clone();
         for k in 2.. {
             if self.names.insert(name.clone()) {
@@ -357,26 +502,26 @@ impl Outputs<'_> {
         let json = self.dir.join(format!("{name}.json"));
         let csv = self.dir.join(format!("{name}.tables.csv"));
         for o in [&json, &csv] {
-            if let Some(i) = self.read.iter().find(|i| same_file(i, o)) {
-                bail!(
-                    "the output {} would replace the input {}; choose another --out",
-                    o.display(),
-                    i.display()
-                );
-            }
+            refuse_over_input(o, &self.read)?;
         }
         Ok((json, csv))
     }
 }
 
+/// Fits one opened input and writes its JSON and tables to the paths `planned` for it (or, when
+/// its name was not known before, claimed now).
 fn fit_one(
     input: &str,
     (src, load_ms): Opened,
+    planned: Option<Result<(PathBuf, PathBuf)>>,
     cfg: &FitConfig,
     backend: Backend,
     outputs: &mut Outputs,
-) -> Result<FittedMaterial> {
+) -> Result<FitRow> {
     let src = src?;
+    let (json, csv) = planned
+        .unwrap_or_else(|| outputs.claim(src.name()))
+        .with_context(|| input.to_owned())?;
     let mut fit = fit_material_on(src.as_ref(), input, cfg, backend)?;
     if let Some(gpu_error) = &fit.record.fallback {
         eprintln!("notice: {input}: fitted on the CPU after a GPU failure: {gpu_error}");
@@ -391,12 +536,17 @@ fn fit_one(
     }
     fit.record.timings_ms.load = load_ms;
     fit.record.timings_ms.total += load_ms;
-    let (json, csv) = outputs
-        .claim(&fit.record.name)
-        .with_context(|| input.to_owned())?;
     fit.save(&json)?;
     write_tables(&fit, &csv)?;
-    Ok(fit)
+    let json = json
+        .file_name()
+        .expect("a claimed path has a file name")
+        .to_string_lossy()
+        .into_owned();
+    Ok(FitRow {
+        json,
+        record: fit.record,
+    })
 }
 
 /// θ (degrees), D, P = D cos⁴θ and G1 of the tabulated NDF at φ = 0, and F(θd) per channel.
@@ -422,84 +572,6 @@ fn write_tables(fit: &FittedMaterial, path: &Path) -> Result<()> {
     }
     facet_fit::io::output::write_bytes_atomically(path, s)
         .with_context(|| format!("writing {}", path.display()))
-}
-
-fn print_summary(rows: &[FittedMaterial]) {
-    if rows.is_empty() {
-        return;
-    }
-    let mut out = std::io::stdout().lock();
-    let _ = writeln!(
-        out,
-        "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8}",
-        "material",
-        "iters",
-        "tab err",
-        "tab ρd",
-        "ggx αx/αy",
-        "ggx err",
-        "beckmann αx/αy",
-        "beck err",
-        "ms"
-    );
-    for f in rows {
-        let r = &f.record;
-        let param = |p: &Option<facet_fit::model::material::ParamRecord>| match p {
-            Some(p) => (
-                format!("{:.4}/{:.4}", p.alpha_x, p.alpha_y),
-                format!("{:.4}", p.error),
-            ),
-            None => ("-".into(), "-".into()),
-        };
-        let (ga, ge) = param(&r.ggx);
-        let (ba, be) = param(&r.beckmann);
-        let te = r.tabulated.error.map_or("-".into(), |e| format!("{e:.4}"));
-        let kd = r.tabulated.diffuse;
-        let kd = if r.diffuse_lobe {
-            format!("{:.3}/{:.3}/{:.3}", kd[0], kd[1], kd[2])
-        } else {
-            "-".into()
-        };
-        let _ = writeln!(
-            out,
-            "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8.1}",
-            r.name, r.iterations, te, kd, ga, ge, ba, be, r.timings_ms.total
-        );
-    }
-}
-
-fn print_medians(rows: &[FittedMaterial], seconds: f64) {
-    let median = |mut v: Vec<f64>| -> String {
-        if v.is_empty() {
-            return "-".into();
-        }
-        v.sort_by(f64::total_cmp);
-        format!("{:.4}", v[v.len() / 2])
-    };
-    let tab = median(
-        rows.iter()
-            .filter_map(|f| f.record.tabulated.error)
-            .collect(),
-    );
-    let ggx = median(
-        rows.iter()
-            .filter_map(|f| f.record.ggx.as_ref().map(|p| p.error))
-            .collect(),
-    );
-    let ggx_m = median(
-        rows.iter()
-            .filter_map(|f| f.record.ggx.as_ref().map(|p| p.moments.error))
-            .collect(),
-    );
-    let beck = median(
-        rows.iter()
-            .filter_map(|f| f.record.beckmann.as_ref().map(|p| p.error))
-            .collect(),
-    );
-    println!(
-        "median error over {} fits: tabulated {tab}, ggx {ggx} (moments {ggx_m}), beckmann {beck}; {seconds:.2} s in all",
-        rows.len()
-    );
 }
 
 /// The embedded default: a gold GGX conductor (α = 0.15) sampled into an in-memory MERL table
@@ -534,7 +606,10 @@ pub fn fit_default(out: &Path) -> Result<(FittedMaterial, std::path::PathBuf)> {
     let json = out.join("default-gold-ggx.json");
     fit.save(&json)?;
     write_tables(&fit, &out.join("default-gold-ggx.tables.csv"))?;
-    print_summary(std::slice::from_ref(&fit));
+    print_summary(&[FitRow {
+        json: "default-gold-ggx.json".into(),
+        record: fit.record.clone(),
+    }]);
     let r = &fit.record;
     let f = |deg: f64| r.fresnel.eval(f64::to_radians(deg));
     println!(

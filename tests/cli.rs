@@ -145,6 +145,200 @@ fn bad_inputs_fail_cleanly_and_the_rest_still_run() {
     assert!(!ok && stderr.contains("--resolution"), "{stderr}");
 }
 
+/// The sweep of the shard tests: five embedded proxies (not pearl-paint or green-latex, whose
+/// fits vary in their last bits between runs), one of them twice (its second fit is
+/// `nickel-2.json`, in another shard than `nickel.json`), and an unknown name that fails.
+const SWEEP: [&str; 7] = [
+    "nbrdf:gold-metallic-paint",
+    "nbrdf:alum-bronze",
+    "nbrdf:blue-acrylic",
+    "nbrdf:nickel",
+    "nbrdf:delrin",
+    "nbrdf:nickel",
+    "nbrdf:no-such-material",
+];
+
+/// `facet fit` of [`SWEEP`] into `out` on the CPU, with `extra` options.
+fn fit_sweep(out: &Path, extra: &[&str]) -> (bool, String, String) {
+    let mut args = vec!["fit"];
+    args.extend(SWEEP);
+    args.extend(["--backend", "cpu", "--out", out.to_str().unwrap()]);
+    args.extend(extra);
+    facet(&args)
+}
+
+/// `summary.csv` in `dir` without its last column, the time (which changes from run to run).
+fn untimed_summary(dir: &Path) -> String {
+    let csv = std::fs::read_to_string(dir.join("summary.csv")).unwrap();
+    csv.lines()
+        .map(|l| &l[..l.rfind(',').unwrap()])
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// The printed table's rows without their last column, the time.
+fn untimed_rows(stdout: &str) -> Vec<String> {
+    stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("material "))
+        .skip(1)
+        .take_while(|l| !l.starts_with("median error"))
+        .map(|l| {
+            let l = l.trim_end();
+            l[..l.rfind(' ').unwrap()].trim_end().to_owned()
+        })
+        .collect()
+}
+
+/// The fits' files in `dir` (not summary.csv or shard manifests), sorted.
+fn fit_files(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "summary.csv" && !n.ends_with(".facet-shard.json"))
+        .collect();
+    names.sort();
+    names
+}
+
+/// A sweep split into three shards, writing into one folder or into one folder each, and put
+/// back together by `--summary`: the same fits' files, the same printed rows and the same
+/// summary.csv (but for the time) as one run over all the inputs, the failed input reported.
+#[test]
+fn fit_shards_in_one_folder_or_many_sum_up_to_one_run() {
+    let dir = common::scratch("cli_fit_shards");
+    let (ok, one, stderr) = fit_sweep(&dir.join("one"), &[]);
+    assert!(
+        !ok && stderr.contains("no-such-material"),
+        "{one}\n{stderr}"
+    );
+    let rows = untimed_rows(&one);
+    assert_eq!(rows.len(), 6, "{one}");
+    let csv = untimed_summary(&dir.join("one"));
+    assert!(csv.contains("\nnickel,nickel-2.json,"), "{csv}");
+    let runs = [
+        (0, "shared"),
+        (1, "shared"),
+        (2, "shared"),
+        (0, "s0"),
+        (1, "s1"),
+        (2, "s2"),
+    ];
+    for (i, folder) in runs {
+        let folder = dir.join(folder);
+        let (_, stdout, stderr) = fit_sweep(&folder, &["--shard", &format!("{i}/3")]);
+        let manifest = format!("shard-{i}-of-3.facet-shard.json");
+        assert!(folder.join(&manifest).exists(), "{stdout}\n{stderr}");
+        assert!(
+            !folder.join("summary.csv").exists(),
+            "a shard writes no summary.csv"
+        );
+    }
+    // Each shard names its fits as the one run does (nickel-2.json in shard 2).
+    let one_files = fit_files(&dir.join("one"));
+    assert_eq!(fit_files(&dir.join("shared")), one_files);
+    let mut separate: Vec<String> = ["s0", "s1", "s2"]
+        .iter()
+        .flat_map(|d| fit_files(&dir.join(d)))
+        .collect();
+    separate.sort();
+    assert_eq!(separate, one_files);
+    assert!(fit_files(&dir.join("s2")).contains(&"nickel-2.json".to_owned()));
+    let s = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    // The folders in any order: the rows are in the inputs' order.
+    for (folders, out) in [
+        (vec![s("shared")], s("sum-shared")),
+        (vec![s("s2"), s("s0"), s("s1")], s("sum-separate")),
+    ] {
+        let mut args = vec!["fit", "--summary"];
+        args.extend(folders.iter().map(String::as_str));
+        args.extend(["--out", &out]);
+        let (ok, stdout, stderr) = facet(&args);
+        assert!(!ok, "a failed input fails the summary too: {stdout}");
+        assert!(
+            stderr.contains("error: ") && stderr.contains("no-such-material"),
+            "{stderr}"
+        );
+        assert_eq!(untimed_rows(&stdout), rows, "{stdout}");
+        assert!(stdout.contains("median error over 6 fits"), "{stdout}");
+        assert_eq!(untimed_summary(Path::new(&out)), csv, "{out}");
+    }
+}
+
+/// `--summary` refuses, naming the problem and writing nothing, a sweep with a shard missing,
+/// shards of other settings, a fit no manifest lists and a JSON that is not a fit.
+#[test]
+fn fit_summary_refuses_an_incomplete_or_mixed_sweep() {
+    let dir = common::scratch("cli_fit_summary_refusals");
+    let s = |name: &str| dir.join(name).to_str().unwrap().to_owned();
+    let shard = |folder: &str, shard: &str, extra: &[&str]| {
+        let out = s(folder);
+        let mut args = vec![
+            "fit",
+            "analytic:ggx?alpha=0.2",
+            "analytic:beckmann?alpha=0.3",
+            "--model",
+            "ggx",
+            "--backend",
+            "cpu",
+            "--shard",
+            shard,
+            "--out",
+            &out,
+        ];
+        args.extend(extra);
+        let (ok, stdout, stderr) = facet(&args);
+        assert!(ok, "{stdout}\n{stderr}");
+    };
+    shard("missing", "0/2", &[]);
+    shard("mixed", "0/2", &[]);
+    shard("mixed", "1/2", &["--resolution", "32"]);
+    shard("stray", "0/2", &[]);
+    shard("stray", "1/2", &[]);
+    std::fs::copy(
+        dir.join("stray/analytic-ggx_alpha_0.2.json"),
+        dir.join("stray/old-fit.json"),
+    )
+    .unwrap();
+    std::fs::create_dir_all(dir.join("junk")).unwrap();
+    std::fs::write(dir.join("junk/notes.json"), r#"{"a": 1}"#).unwrap();
+    for (folder, problem) in [
+        ("missing", "no shard-1-of-2.facet-shard.json"),
+        ("mixed", "disagree on the fit settings"),
+        (
+            "stray",
+            "old-fit.json is a fit that no shard manifest lists",
+        ),
+        ("junk", "notes.json: neither a fit nor a shard manifest"),
+    ] {
+        let out = s(&format!("{folder}-summary"));
+        let (ok, stdout, stderr) = facet(&["fit", "--summary", &s(folder), "--out", &out]);
+        assert!(
+            !ok && stderr.contains(problem),
+            "{folder}: {stdout}\n{stderr}"
+        );
+        assert!(!Path::new(&out).exists(), "{folder}: something was written");
+    }
+}
+
+/// A bad `--shard` is refused by the parser, naming the option and the rule.
+#[test]
+fn fit_shard_values_are_checked() {
+    for (value, problem) in [
+        ("3/3", "I must be below N"),
+        ("1/0", "N must be at least 1"),
+        ("x", "is not I/N"),
+    ] {
+        let (ok, _, stderr) = facet(&["fit", "analytic:ggx?alpha=0.2", "--shard", value]);
+        assert!(
+            !ok && stderr.contains("--shard") && stderr.contains(problem),
+            "{value}: {stderr}"
+        );
+    }
+    let (ok, _, stderr) = facet(&["fit", "analytic:ggx?alpha=0.2", "--summary", "out"]);
+    assert!(!ok && stderr.contains("cannot be used with"), "{stderr}");
+}
+
 #[test]
 fn dpf_query_and_exr_slices() {
     let (ok, stdout, stderr) = facet(&[

@@ -407,6 +407,7 @@ fn outputs_stay_inside_out_and_never_replace_an_input() {
             "out/___.._escaped.tables.csv",
             "out/_tmp_evil.json",
             "out/_tmp_evil.tables.csv",
+            "out/summary.csv",
         ],
         "{stdout}"
     );
