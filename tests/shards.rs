@@ -86,40 +86,21 @@ fn four_shards_merge_to_the_one_render() {
     assert!(stdout.contains("samples 0..8 (8 spp)"), "{stdout}");
     assert!(err.is_empty(), "a full cover gives no notice: {err}");
     assert!(dir.join("merged/m.png").exists());
-    let (full, full_rec) = read(dir.join("full/r.exr"));
-    let (merged, merged_rec) = read(dir.join("merged/m.exr"));
+    let (_, full_rec) = read(dir.join("full/r.exr"));
+    let (_, merged_rec) = read(dir.join("merged/m.exr"));
     assert_eq!(
         merged_rec, full_rec,
         "the merged record is the full render's"
     );
     assert_eq!(full_rec.samples, vec![[0, 8]]);
-    let (full_var, _) = read(dir.join("full/r.variance.exr"));
-    let (merged_var, var_rec) = read(dir.join("merged/m.variance.exr"));
+    let (_, var_rec) = read(dir.join("merged/m.variance.exr"));
     assert_eq!(var_rec.pixels, PixelKind::VarianceOfMean);
-    let n = 8.0f64;
-    let (mut worst_mean, mut worst_var, mut glinting) = (0.0f64, 0.0f64, 0);
-    for k in 0..full.pixels.len() {
-        for c in 0..3 {
-            let (a, b) = (full.pixels[k][c] as f64, merged.pixels[k][c] as f64);
-            let scale = a.abs().max(b.abs()).max(1e-30);
-            worst_mean = worst_mean.max((a - b).abs() / scale);
-            // Σ L² / n = variance of the samples · (n − 1)/n + mean²: the size of the terms.
-            let (va, vb) = (full_var.pixels[k][c] as f64, merged_var.pixels[k][c] as f64);
-            let second = va * (n - 1.0) + a * a;
-            worst_var = worst_var.max((va - vb).abs() / (second / (n - 1.0)).max(1e-30));
-            glinting += (va > 1.0) as usize;
-        }
-    }
-    assert!(
-        worst_mean <= 4e-6,
-        "mean: worst relative difference {worst_mean:e}"
-    );
-    assert!(
-        worst_var <= 2e-5,
-        "variance: worst relative difference {worst_var:e}"
-    );
-    assert!(glinting > 0, "the scene has noisy (glint) pixels");
-    println!("worst relative difference: mean {worst_mean:e}, variance {worst_var:e}");
+    let (mean, var, noisy) =
+        common::render_differences(&dir.join("full/r.exr"), &dir.join("merged/m.exr"), 8.0);
+    assert!(mean <= 4e-6, "mean: worst relative difference {mean:e}");
+    assert!(var <= 2e-5, "variance: worst relative difference {var:e}");
+    assert!(noisy > 0, "the scene has noisy (glint) pixels");
+    println!("worst relative difference: mean {mean:e}, variance {var:e}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

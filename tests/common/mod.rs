@@ -61,3 +61,36 @@ pub fn reproducible_demo_copy(dir: &Path) -> PathBuf {
     std::fs::write(&demo, serde_json::to_string(&doc).unwrap()).unwrap();
     demo
 }
+
+/// The worst per-pixel differences between two renders of one scene (`STEM.exr` and
+/// `STEM.variance.exr` beside each, of `n` samples per pixel): (mean, variance). The mean's is
+/// relative to the pixel; the variance's relative to Σ L² / (n (n − 1)), the size of the terms
+/// that the variance of the mean is a difference of (the f32 rounding of both renders' sums is
+/// relative to that). Also the number of channels whose variance is over 1 (noisy, as glints).
+pub fn render_differences(a: &Path, b: &Path, n: f64) -> (f64, f64, usize) {
+    use facet_render::Image;
+    let read = |p: PathBuf| {
+        Image::read_shard_exr(&p)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .0
+    };
+    let (ma, mb) = (read(a.with_extension("exr")), read(b.with_extension("exr")));
+    let (va, vb) = (
+        read(a.with_extension("variance.exr")),
+        read(b.with_extension("variance.exr")),
+    );
+    assert_eq!((ma.width, ma.height), (mb.width, mb.height));
+    let (mut mean, mut var, mut noisy) = (0.0f64, 0.0f64, 0);
+    for k in 0..ma.pixels.len() {
+        for c in 0..3 {
+            let (x, y) = (ma.pixels[k][c] as f64, mb.pixels[k][c] as f64);
+            mean = mean.max((x - y).abs() / x.abs().max(y.abs()).max(1e-30));
+            let (u, v) = (va.pixels[k][c] as f64, vb.pixels[k][c] as f64);
+            // Σ L² / (n (n − 1)) = u + m² / (n − 1), from u = (Σ L² − n m²) / (n (n − 1)).
+            let second = u + x * x / (n - 1.0);
+            var = var.max((u - v).abs() / second.max(1e-30));
+            noisy += (u > 1.0) as usize;
+        }
+    }
+    (mean, var, noisy)
+}

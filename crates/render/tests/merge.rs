@@ -10,7 +10,8 @@ use std::path::PathBuf;
 /// Radiance of sample `s` of pixel `k`, channel `c`: spread over four decades, with a rare
 /// bright outlier as a glint gives.
 fn sample(k: usize, s: u32, c: usize) -> f64 {
-    let h = (k as u64 * 2_654_435_761 + s as u64 * 40_503 + c as u64 * 97).wrapping_mul(6_364_136_223_846_793_005);
+    let h = (k as u64 * 2_654_435_761 + s as u64 * 40_503 + c as u64 * 97)
+        .wrapping_mul(6_364_136_223_846_793_005);
     let u = (h >> 11) as f64 / (1u64 << 53) as f64;
     if u > 0.97 { 500.0 * u } else { 0.01 + u * u }
 }
@@ -31,7 +32,11 @@ fn part(a: u32, b: u32) -> Part {
                 std::array::from_fn(|c| (a..b).map(|s| sample(k, s, c)).sum::<f64>() / n);
             let var = std::array::from_fn(|c| {
                 let m2: f64 = (a..b).map(|s| (sample(k, s, c) - mean[c]).powi(2)).sum();
-                if n < 2.0 { 0.0 } else { (m2 / (n * (n - 1.0))) as f32 }
+                if n < 2.0 {
+                    0.0
+                } else {
+                    (m2 / (n * (n - 1.0))) as f32
+                }
             });
             (mean.map(|m| m as f32), var)
         })
@@ -74,7 +79,10 @@ fn parts_merge_to_the_statistics_of_all_their_samples() {
             let m2: f64 = all.iter().map(|x| (x - mean).powi(2)).sum();
             let var = m2 / (n * (n - 1.0));
             let got = merged.image.pixels[k][c] as f64;
-            assert!((got - mean).abs() <= 1e-6 * mean, "pixel {k}: mean {got} for {mean}");
+            assert!(
+                (got - mean).abs() <= 1e-6 * mean,
+                "pixel {k}: mean {got} for {mean}"
+            );
             let second = all.iter().map(|x| x * x).sum::<f64>() / (n * (n - 1.0));
             let got = variance.pixels[k][c] as f64;
             assert!(
@@ -114,29 +122,61 @@ fn refused(parts: &[Part]) -> MergeError {
 fn strangers_are_refused_by_name() {
     let e = refused(&[part(0, 4), part(2, 6)]);
     assert_eq!(e.path, PathBuf::from("part-2-6.exr"));
-    assert!(e.message.contains("overlap the samples 0..4 of part-0-4.exr"), "{e}");
+    assert!(
+        e.message
+            .contains("overlap the samples 0..4 of part-0-4.exr"),
+        "{e}"
+    );
     let mut seed = part(4, 6);
     seed.image.1.seed = 9;
-    assert!(refused(&[part(0, 4), seed]).message.contains("another seed (9)"));
+    assert!(
+        refused(&[part(0, 4), seed])
+            .message
+            .contains("another seed (9)")
+    );
     let mut digest = part(4, 6);
     digest.image.1.digest = "other".into();
-    assert!(refused(&[part(0, 4), digest]).message.contains("scene or settings"));
+    assert!(
+        refused(&[part(0, 4), digest])
+            .message
+            .contains("scene or settings")
+    );
     let mut version = part(4, 6);
     version.image.1.version = "9.9.9".into();
-    assert!(refused(&[part(0, 4), version]).message.contains("Facet version"));
+    assert!(
+        refused(&[part(0, 4), version])
+            .message
+            .contains("Facet version")
+    );
     let mut small = part(4, 6);
     small.image.0.width -= 1;
     small.image.0.pixels.pop();
-    assert!(refused(&[part(0, 4), small]).message.contains("36 × 1 pixels"));
+    assert!(
+        refused(&[part(0, 4), small])
+            .message
+            .contains("36 × 1 pixels")
+    );
     let mut var_of_other = part(4, 6);
     var_of_other.variance.as_mut().unwrap().1.samples = vec![[5, 6]];
-    assert!(refused(&[part(0, 4), var_of_other]).message.contains("its variance image"));
+    assert!(
+        refused(&[part(0, 4), var_of_other])
+            .message
+            .contains("its variance image")
+    );
     let mut no_var = part(4, 6);
     no_var.variance = None;
-    assert!(refused(&[part(0, 4), no_var]).message.contains("no variance image"));
+    assert!(
+        refused(&[part(0, 4), no_var])
+            .message
+            .contains("no variance image")
+    );
     let mut variance_as_part = part(4, 6);
     variance_as_part.image.1.pixels = PixelKind::VarianceOfMean;
-    assert!(refused(&[part(0, 4), variance_as_part]).message.contains("a variance image"));
+    assert!(
+        refused(&[part(0, 4), variance_as_part])
+            .message
+            .contains("a variance image")
+    );
     assert!(merge(&[]).is_err());
 }
 
@@ -156,11 +196,17 @@ fn shard_records_travel_in_the_exr_header() {
     let plain = dir.join("plain.exr");
     p.image.0.write_exr(&plain).unwrap();
     let e = Image::read_shard_exr(&plain).unwrap_err().to_string();
-    assert!(e.contains("plain.exr") && e.contains("no \"facet\" attribute"), "{e}");
+    assert!(
+        e.contains("plain.exr") && e.contains("no \"facet\" attribute"),
+        "{e}"
+    );
     let junk = dir.join("junk.exr");
     std::fs::write(&junk, b"not an exr at all").unwrap();
     let e = Image::read_shard_exr(&junk).unwrap_err().to_string();
-    assert!(e.contains("junk.exr") && e.contains("not a readable OpenEXR"), "{e}");
+    assert!(
+        e.contains("junk.exr") && e.contains("not a readable OpenEXR"),
+        "{e}"
+    );
     let mut bad = p.image.1.clone();
     bad.samples = vec![[3, 3]];
     let bad_path = dir.join("bad.exr");
