@@ -1,8 +1,9 @@
 //! `facet bench`: every speed figure of Facet in one process, on the adapter chosen as
 //! elsewhere (FACET_BACKEND, FACET_ADAPTER): the fitter (CPU and GPU backends), ray tracing,
 //! the integrator with and without glints and its stages, the DPF build, the viewer's preview
-//! path. Prints a table and writes JSON (`--json FILE`). Timings are medians of repeated runs
-//! after a warm-up, measured side by side in this one process.
+//! path, and what a shard process costs besides its work. Prints a table and writes JSON
+//! (`--json FILE`). Timings are medians of repeated runs after a warm-up, measured side by side
+//! in this one process (the shard section times processes of this binary that it starts).
 
 use crate::demo_cmd::demo_assets;
 use crate::fit_cmd::DEFAULT_MATERIAL;
@@ -26,6 +27,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
+
+mod shard;
 
 #[derive(Parser, Clone, Debug)]
 pub struct BenchArgs {
@@ -58,6 +61,8 @@ pub enum Section {
     Viewer,
     Noise,
     Dpf,
+    /// What a shard process costs besides its work (`facet render --samples`, `facet fit --shard`).
+    Shard,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -84,6 +89,8 @@ struct Sizes {
     viewer: (u32, u32),
     /// Side and spp of the noise renders.
     noise: (u32, u32),
+    /// The shard processes' size (None: the demo's) and samples per shard.
+    shard: (Option<(u32, u32)>, &'static [u32]),
 }
 
 impl Mode {
@@ -100,6 +107,7 @@ impl Mode {
                 stage_warm: 2,
                 viewer: (64, 3),
                 noise: (32, 2),
+                shard: (Some((64, 36)), &[1, 2]),
             },
             Mode::Quick => Sizes {
                 runs: 5,
@@ -112,6 +120,7 @@ impl Mode {
                 stage_warm: 4,
                 viewer: (512, 5),
                 noise: (128, 16),
+                shard: (None, &[1, 4, 16]),
             },
             Mode::Default => Sizes {
                 runs: 5,
@@ -124,6 +133,7 @@ impl Mode {
                 stage_warm: 6,
                 viewer: (512, 60),
                 noise: (256, 64),
+                shard: (None, &[1, 16, 64, 256]),
             },
             Mode::Full => Sizes {
                 triangles: &[10_000, 100_000, 1_000_000, 10_000_000],
@@ -252,6 +262,9 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         }
         if on(Section::Dpf) {
             report["dpf"] = dpf_pyramid(g, mode, &sizes)?;
+        }
+        if on(Section::Shard) {
+            report["shard"] = shard::shards(sizes.runs, sizes.shard.0, sizes.shard.1)?;
         }
     }
     report["total_s"] = json!(t0.elapsed().as_secs_f64());

@@ -46,6 +46,7 @@ pub struct RenderArgs {
     /// Bounces after the camera ray, 0 to 64.
     #[arg(long, default_value_t = 5, value_parser = crate::args::depth)]
     pub max_depth: u32,
+    /// Seed of the per-pixel random numbers, 0 to 2^32 − 1 (the shards of one render share it).
     #[arg(long, default_value_t = 0, value_parser = crate::args::seed)]
     pub seed: u32,
     /// Stop after the pass during which this many seconds have passed (positive).

@@ -12,16 +12,22 @@ use std::path::Path;
 /// The version written beside the digest: parts of different Facets do not merge.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
 
-/// SHA-256 (hex) of `files` (the scene, the environment map and every file the scene read, in
-/// the order given) and of the image-deciding settings of `args`.
+/// SHA-256 (hex) of `files` (the scene, the environment map and every file the scene read) and
+/// of the image-deciding settings of `args`. Each file is digested alone and the digests sorted
+/// before they are digested together: the scene lists its files in no fixed order.
 pub fn digest(args: &RenderArgs, files: &[&Path]) -> Result<String> {
+    let mut each = files
+        .iter()
+        .map(|f| {
+            let bytes =
+                std::fs::read(f).with_context(|| format!("{}: reading it again", f.display()))?;
+            Ok(Sha256::digest(&bytes).to_vec())
+        })
+        .collect::<Result<Vec<_>>>()?;
+    each.sort();
     let mut h = Sha256::new();
-    for f in files {
-        let bytes =
-            std::fs::read(f).with_context(|| format!("{}: reading it again", f.display()))?;
-        // Length-prefixed, so that no two lists of files digest alike.
-        h.update((bytes.len() as u64).to_le_bytes());
-        h.update(&bytes);
+    for d in &each {
+        h.update(d);
     }
     h.update(settings(args).as_bytes());
     Ok(h.finalize().iter().map(|b| format!("{b:02x}")).collect())

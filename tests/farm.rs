@@ -60,7 +60,7 @@ fn templates_pass_openjd_check() {
     if !openjd_for_tests("templates_pass_openjd_check") {
         return;
     }
-    for t in ["render.template.yaml", "fit.template.yaml"] {
+    for t in ["render", "fit"] {
         let out = openjd(Path::new("."), &["check", template(t).to_str().unwrap()]);
         assert!(out.contains("passes validation checks"), "{out}");
     }
@@ -93,7 +93,7 @@ fn render_template_run_by_openjd_is_the_one_render() {
     ];
     let mut args = vec![
         "run".to_string(),
-        template("render.template.yaml").display().to_string(),
+        template("render").display().to_string(),
         "--step".into(),
         "Merge".into(),
         "--run-dependencies".into(),
@@ -160,7 +160,7 @@ fn fit_template_run_by_openjd_sums_up_as_one_fit() {
         "nbrdf:white-marble",
     ];
     let job = dir.join("job");
-    let fit_template = template("fit.template.yaml");
+    let fit_template = template("fit");
     let args = [
         "run",
         fit_template.to_str().unwrap(),

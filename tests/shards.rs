@@ -9,12 +9,21 @@ use facet_render::shard::{PixelKind, ShardRecord};
 use std::path::{Path, PathBuf};
 
 /// The render of the test scene: 48 × 27 pixels, `samples` ("A..B") or `--spp N`, with
-/// `--variance`, into `out`; any `extra` options.
+/// `--variance`, into `out`; any `extra` options. The GGX sphere takes a copy of the scene's fit
+/// (`ggx_fit.json`), so that the scene reads several files (which it lists in no fixed order:
+/// the digest must not depend on it).
 fn render(dir: &Path, scene: &Path, samples: &[&str], out: &str, extra: &[&str]) {
     let sky = dir.join("sky.exr");
+    let ggx_fit = dir.join("ggx_fit.json");
+    if !ggx_fit.exists() {
+        std::fs::copy(dir.join("default_fit.json"), &ggx_fit).unwrap();
+    }
+    let ggx = format!("ggx={}", ggx_fit.display());
     let mut args = vec![
         "render",
         scene.to_str().unwrap(),
+        "--material",
+        &ggx,
         "--env",
         sky.to_str().unwrap(),
         "--width",
