@@ -141,12 +141,18 @@ pub struct Job {
 }
 
 pub fn prepare(args: &RenderArgs) -> Result<Job> {
-    let range = args.samples.clone().unwrap_or(0..args.spp);
+    let (range, spp_flag) = match &args.samples {
+        Some(r) => (
+            r.clone(),
+            format!("--samples {}..{} ({} spp)", r.start, r.end, r.len()),
+        ),
+        None => (0..args.spp, format!("--spp {}", args.spp)),
+    };
     let spp = range.len() as u32;
     let samples = args.width as u64 * args.height as u64 * spp as u64;
     if samples > crate::args::MAX_SAMPLES {
         bail!(
-            "--width {} × --height {} × {spp} spp = {samples} samples; a render takes at most 2^40",
+            "--width {} × --height {} × {spp_flag} = {samples} samples; a render takes at most 2^40",
             args.width,
             args.height,
         );

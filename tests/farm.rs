@@ -8,11 +8,12 @@ mod common;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The template `name` in `farm/`.
+/// The template of the job bundle `name` in `farm/` (`farm/NAME/template.yaml`).
 fn template(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("farm")
         .join(name)
+        .join("template.yaml")
 }
 
 /// Whether `openjd` runs here; if not, the test is reported skipped (or fails under
