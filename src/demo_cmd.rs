@@ -71,6 +71,7 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
         bvh: render_cmd::PresetArg::Medium,
         no_glint_filter: false,
         variance: false,
+        light_selection: render_cmd::SelectionArg::Bvh,
     };
     println!(
         "rendering {} (tabulated | GGX | glints), {}×{} at {} spp",

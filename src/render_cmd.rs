@@ -8,7 +8,8 @@ use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
 use facet_render::shard::{PixelKind, ShardRecord};
 use facet_render::{
-    ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+    ImageConfig, Integrator, LightSelection, RenderConfig, ResourceConfig, SampleConfig,
+    SceneResources,
 };
 use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -73,6 +74,28 @@ pub struct RenderArgs {
     /// Also write each pixel's variance (of its mean, linear RGB) as STEM.variance.exr.
     #[arg(long)]
     pub variance: bool,
+    /// How next-event estimation picks a light: bvh (per shading point, by a light BVH over the
+    /// point and spot lights and emissive triangles), robust (one distribution for the scene:
+    /// ½ by what each light gives the camera's view, ½ uniform) or power (by emitted power).
+    #[arg(long, value_enum, default_value_t = SelectionArg::Bvh)]
+    pub light_selection: SelectionArg,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SelectionArg {
+    Bvh,
+    Robust,
+    Power,
+}
+
+impl SelectionArg {
+    fn selection(self) -> LightSelection {
+        match self {
+            SelectionArg::Bvh => LightSelection::Bvh,
+            SelectionArg::Robust => LightSelection::Robust,
+            SelectionArg::Power => LightSelection::Power,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -226,6 +249,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
             preset: args.bvh.preset(),
         },
         glint_filter: !args.no_glint_filter,
+        light_selection: args.light_selection.selection(),
         ..ResourceConfig::standard()
     };
     let digest = crate::render_digest::digest(args, &inputs)?;

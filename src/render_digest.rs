@@ -37,7 +37,8 @@ pub fn digest(args: &RenderArgs, files: &[&Path]) -> Result<String> {
 /// file at different paths; its contents are digested).
 fn settings(args: &RenderArgs) -> String {
     format!(
-        "size {}x{}; max depth {}; camera {:?}; materials {:?}; env color {:?}; glint filter {}",
+        "size {}x{}; max depth {}; camera {:?}; materials {:?}; env color {:?}; glint filter {}; \
+         light selection {:?}",
         args.width,
         args.height,
         args.max_depth,
@@ -49,6 +50,7 @@ fn settings(args: &RenderArgs) -> String {
             .map(|m| m.split_once('=').map_or(m.as_str(), |(name, _)| name))
             .collect::<Vec<_>>(),
         args.env.is_none().then_some(&args.env_color),
-        !args.no_glint_filter
+        !args.no_glint_filter,
+        args.light_selection
     )
 }

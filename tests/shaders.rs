@@ -177,6 +177,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
     use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial, GpuSceneInfo};
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
+    use facet_render::resources::light_bvh::GpuLightNode;
     use facet_render::tonemap::ToneMapParams;
     use facet_render::trace::{GpuHit, GpuRay};
     vec![
@@ -214,7 +215,8 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         }),
         layout_check!(GpuSceneInfo, "render/extend.wgsl", "SceneInfo", {
             n_vertices, n_lights, light_cdf, env_kind, env_width, env_height, env_texels,
-            env_marginal, env_conditional, scene_radius, pad0, pad1, env_color,
+            env_marginal, env_conditional, scene_radius, light_tree_share, light_tree_nodes,
+            env_color,
         }),
         layout_check!(GpuMaterial, "render/extend.wgsl", "Material", {
             base_color, emissive, diffuse, kind, ndf_kind, alpha_x, alpha_y, rotation,
@@ -222,7 +224,11 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
             fresnel_offset, fresnel_count, tab_offset, queue,
         }),
         layout_check!(GpuLight, "render/extend.wgsl", "Light", {
-            kind, prim, cos_inner, cos_outer, position, direction, intensity,
+            kind, prim, cos_inner, cos_outer, position, direction, intensity, leaf, pad0, pad1,
+            pad2,
+        }),
+        layout_check!(GpuLightNode, "render/extend.wgsl", "LightNode", {
+            centre_phi, axis_cos_o, radius, cos_e, sin_o, child, parent, leaf, pad0, pad1,
         }),
         layout_check!(ToneMapParams, "render/tonemap.wgsl", "Params", {
             pixels, scale, pad0, pad1,

@@ -30,7 +30,9 @@ fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     let s = surface_at(hit.prim, hit.u, hit.v, -d.xyz);
     let le = emitted(s);
     if (any(le > vec3<f32>(0.0))) {
-        let w = emission_weight(beta.w, triangle_light_pdf(hit.prim, o.xyz, s.p, s.ng, s.area));
+        // The light BVH is asked as next-event estimation asked it at the ray's origin.
+        let n = path_get(R_PREV_N, slot).xyz;
+        let w = emission_weight(beta.w, triangle_light_pdf(hit.prim, o.xyz, o.xyz, n, s.p, s.ng, s.area));
         path_set(R_L, slot, vec4<f32>(l.xyz + beta.xyz * le * w, l.w));
     }
     path_set(R_HIT, slot, vec4<f32>(hit.t, bitcast<f32>(hit.prim), hit.u, hit.v));

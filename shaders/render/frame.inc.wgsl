@@ -28,8 +28,9 @@ struct SceneInfo {
     env_marginal: u32,
     env_conditional: u32,
     scene_radius: f32,
-    pad0: u32,
-    pad1: u32,
+    // the probability of asking the light BVH (0 without one) and its node count
+    light_tree_share: f32,
+    light_tree_nodes: u32,
     // Constant environment radiance (env_kind ENV_CONSTANT).
     env_color: vec4<f32>,
 }

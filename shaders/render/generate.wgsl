@@ -22,6 +22,8 @@ fn generate(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgrou
     path_set(R_DIR, slot, vec4<f32>(dir, frame.cam_up.w));
     path_set(R_BETA, slot, vec4<f32>(1.0, 1.0, 1.0, 0.0));
     path_set(R_L, slot, vec4<f32>(0.0));
+    // No MIS for a camera ray (β.w = 0); the light BVH's normal is set by each bounce.
+    path_set(R_PREV_N, slot, vec4<f32>(0.0));
     info[slot] = vec4<u32>(SLOT_FLYING, s + 1u, 0u, 0u);
     push(Q_EXTEND, slot);
 }

@@ -5,8 +5,8 @@
 #include "render/tags.inc.wgsl"
 #include "common/math.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
-
-const NONE: u32 = 0xffffffffu;
+#include "render/light_tree.inc.wgsl"
+#include "render/none.inc.wgsl"
 
 // Rust: facet_render::gpu_types::GpuMaterial.
 struct Material {
@@ -45,6 +45,11 @@ struct Light {
     direction: vec4<f32>,
     // point/spot intensity, directional irradiance
     intensity: vec4<f32>,
+    // its leaf in the light BVH, NONE outside it
+    leaf: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 @group(1) @binding(0) var<storage, read> bvh_nodes: array<CwNode>;
@@ -61,6 +66,8 @@ struct Light {
 @group(1) @binding(8) var<storage, read> tables: array<f32>;
 // Light index of each triangle, NONE when it does not emit (one entry when nothing emits).
 @group(1) @binding(9) var<storage, read> triangle_light: array<u32>;
+// The light BVH (one unused node without one: frame.scene.light_tree_nodes == 0).
+@group(1) @binding(10) var<storage, read> light_tree: array<LightNode>;
 
 fn vertex(region: u32, i: u32) -> vec4<f32> {
     return vertices[region * frame.scene.n_vertices + i];
@@ -325,8 +332,20 @@ fn env_sample(u: vec2<f32>) -> vec3<f32> {
 
 // ---- lights ----------------------------------------------------------------------------------
 
+// The CDF's probability of light i (in the tree's absence).
 fn light_pmf(i: u32) -> f32 {
     return tables[frame.scene.light_cdf + i + 1u] - tables[frame.scene.light_cdf + i];
+}
+
+// The probability that next-event estimation at p, geometric normal n, picks light i: by the
+// light BVH for a light in it (asked with probability light_tree_share), else by the CDF.
+fn light_select_pmf(i: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let share = frame.scene.light_tree_share;
+    let leaf = lights[i].leaf;
+    if (leaf != NONE) {
+        return share * light_tree_pmf(leaf, p, n);
+    }
+    return (1.0 - share) * light_pmf(i);
 }
 
 struct LightSample {
@@ -338,21 +357,27 @@ struct LightSample {
     pdf: f32,
 }
 
-fn triangle_light_pdf(prim: u32, p: vec3<f32>, q: vec3<f32>, nq: vec3<f32>, area: f32) -> f32 {
+// The solid-angle pdf of light sampling at the shading point p (geometric normal n; `sel` the
+// point the selection is asked at) toward point q of emissive triangle prim (normal nq, area).
+fn triangle_light_pdf(prim: u32, p: vec3<f32>, sel: vec3<f32>, n: vec3<f32>, q: vec3<f32>, nq: vec3<f32>, area: f32) -> f32 {
     let l = triangle_light[prim];
     if (l == NONE) {
         return 0.0;
     }
+    let pmf = light_select_pmf(l, sel, n);
     let d = q - p;
     let d2 = dot(d, d);
     let cos_l = abs(dot(nq, normalize(d)));
     if (cos_l <= 0.0 || area <= 0.0) {
         return 0.0;
     }
-    return light_pmf(l) * d2 / (cos_l * area);
+    return pmf * d2 / (cos_l * area);
 }
 
-fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
+// Next-event estimation's light for the shading point p: the light BVH asked at `sel` (p lifted
+// off the surface, where the continuation ray starts, so that the emission a BSDF sample finds
+// asks it at the same point) with geometric normal n, or the CDF.
+fn sample_light(p: vec3<f32>, sel: vec3<f32>, n: vec3<f32>, u0_in: f32, u: vec2<f32>) -> LightSample {
     var ls: LightSample;
     ls.pdf = 0.0;
     ls.weight = vec3<f32>(0.0);
@@ -361,9 +386,19 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
     if (frame.scene.n_lights == 0u) {
         return ls;
     }
-    let i = min(cdf_search(frame.scene.light_cdf, frame.scene.n_lights + 1u, u0), frame.scene.n_lights - 1u);
-    let pmf = light_pmf(i);
-    if (pmf <= 0.0) {
+    let share = frame.scene.light_tree_share;
+    var i = 0u;
+    var pmf = 0.0;
+    if (u0_in < share) {
+        let pick = light_tree_sample(sel, n, min(u0_in / share, ONE_MINUS_EPSILON));
+        i = pick.light;
+        pmf = share * pick.pmf;
+    } else {
+        let u0 = select(u0_in, (u0_in - share) / (1.0 - share), share > 0.0);
+        i = min(cdf_search(frame.scene.light_cdf, frame.scene.n_lights + 1u, u0), frame.scene.n_lights - 1u);
+        pmf = (1.0 - share) * light_pmf(i);
+    }
+    if (pmf <= 0.0 || i >= frame.scene.n_lights) {
         return ls;
     }
     let l = lights[i];
@@ -400,7 +435,7 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
         let d = q - p;
         ls.dist = length(d);
         ls.wi = d / ls.dist;
-        ls.pdf = triangle_light_pdf(l.prim, p, q, nq, area);
+        ls.pdf = triangle_light_pdf(l.prim, p, sel, n, q, nq, area);
         let m = materials[tri.w];
         // One-sided emitters: only the front (counter-clockwise) side emits.
         var le = m.emissive.xyz;
@@ -428,7 +463,7 @@ fn sample_light(p: vec3<f32>, u0: f32, u: vec2<f32>) -> LightSample {
 fn env_light_pmf() -> f32 {
     for (var i = 0u; i < frame.scene.n_lights; i++) {
         if (lights[i].kind == LIGHT_ENVIRONMENT) {
-            return light_pmf(i);
+            return (1.0 - frame.scene.light_tree_share) * light_pmf(i);
         }
     }
     return 0.0;

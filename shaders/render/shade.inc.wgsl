@@ -31,7 +31,9 @@ fn shade(slot: u32) {
     let wo = to_local(s, wo_world);
 
     // Next-event estimation's direction and the continuation's, then both evaluated at once.
-    let ls = sample_light(s.p, path_rand(slot, 0u), vec2<f32>(path_rand(slot, 1u), path_rand(slot, 2u)));
+    // The light BVH is asked where the continuation ray will start (its origin, R_ORIGIN).
+    let sel = offset_origin(s, s.ng);
+    let ls = sample_light(s.p, sel, s.ng, path_rand(slot, 0u), vec2<f32>(path_rand(slot, 1u), path_rand(slot, 2u)));
     let nee = frame.strategy != STRATEGY_BSDF || ls.pdf <= 0.0;
     var wi_light = vec3<f32>(0.0, 0.0, -1.0);
     if (nee && any(ls.weight > vec3<f32>(0.0)) && dot(ls.wi, s.ng) > 0.0) {
@@ -71,6 +73,7 @@ fn shade(slot: u32) {
     let spread = d.w + 2.0 * s.curvature * width + 2.0 * atan(bsdf_roughness(b));
     path_set(R_BETA, slot, beta);
     path_set(R_ORIGIN, slot, vec4<f32>(offset_origin(s, wi_world), width));
+    path_set(R_PREV_N, slot, vec4<f32>(s.ng, 0.0));
     path_set(R_DIR, slot, vec4<f32>(wi_world, spread));
     info[slot] = vec4<u32>(SLOT_FLYING, i.y, i.z + 1u, i.w);
 }

@@ -37,6 +37,7 @@ const R_HIT: u32 = 4u; // t, primitive (bits), barycentrics u, v
 const R_SHADOW_O: u32 = 5u; // xyz shadow-ray origin, w tmax
 const R_SHADOW_D: u32 = 6u; // xyz shadow-ray direction
 const R_SHADOW_C: u32 = 7u; // rgb unoccluded contribution
+const R_PREV_N: u32 = 8u; // xyz the geometric normal at the ray's origin (the light BVH's pmf for MIS)
 
 // facet_render::tags::SlotState
 const SLOT_START: u32 = 0u; // nothing yet: start a path

@@ -109,6 +109,7 @@ impl Group {
                 ("lights", StorageReadOnly),
                 ("tables", StorageReadOnly),
                 ("triangle_light", StorageReadOnly),
+                ("light_tree", StorageReadOnly),
             ],
             Group::Glint => &[
                 ("field", Uniform),

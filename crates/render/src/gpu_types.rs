@@ -35,8 +35,10 @@ pub struct GpuSceneInfo {
     pub env_conditional: u32,
     /// Radius of the scene's bounding sphere.
     pub scene_radius: f32,
-    pub pad0: u32,
-    pub pad1: u32,
+    /// The probability that next-event estimation asks the light BVH (0 without one).
+    pub light_tree_share: f32,
+    /// Nodes of the light BVH (0: lights picked by the CDF alone).
+    pub light_tree_nodes: u32,
     /// A constant environment's radiance (rgb).
     pub env_color: [f32; 4],
 }
@@ -116,4 +118,9 @@ pub struct GpuLight {
     pub position: [f32; 4],
     pub direction: [f32; 4],
     pub intensity: [f32; 4],
+    /// Its leaf in the light BVH (NONE: not in the tree, or no tree).
+    pub leaf: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }

@@ -110,6 +110,8 @@ tags!(
         ShadowDir = 6 => "SHADOW_D",
         /// rgb unoccluded contribution
         ShadowContribution = 7 => "SHADOW_C",
+        /// xyz the geometric normal at the ray's origin (the light BVH's pmf for MIS)
+        PrevNormal = 8 => "PREV_N",
     }
 );
 

@@ -921,27 +921,35 @@ fn three_lights_together_are_the_sum_of_each_alone() {
         with(vec![point], None),
         with(vec![], Some(&sky)),
     ];
-    // Per 8 × 8 block: mean and variance of the mean (from the two seeds) of each render.
-    let stats = |imgs: &[Image; 2]| {
-        let mut out = vec![(DVec3::ZERO, DVec3::ZERO, 0usize); 64];
-        for y in 0..SIZE {
-            for x in 0..SIZE {
-                let i = (y * SIZE + x) as usize;
-                let k = blocks(x, y).unwrap();
-                let (a, b) = (dv(imgs[0].pixels[i]), dv(imgs[1].pixels[i]));
-                out[k].0 += 0.5 * (a + b);
-                out[k].1 += (a - b) * (a - b);
-                out[k].2 += 1;
-            }
+    assert_sum_of_parts("three lights", &all, &alone);
+}
+
+/// Per 8 × 8 block: the mean and the variance of the mean (from the two seeds) of a render.
+fn block_stats(imgs: &[Image; 2]) -> Vec<(DVec3, DVec3)> {
+    let mut out = vec![(DVec3::ZERO, DVec3::ZERO, 0usize); 64];
+    for y in 0..SIZE {
+        for x in 0..SIZE {
+            let i = (y * SIZE + x) as usize;
+            let k = blocks(x, y).unwrap();
+            let (a, b) = (dv(imgs[0].pixels[i]), dv(imgs[1].pixels[i]));
+            out[k].0 += 0.5 * (a + b);
+            out[k].1 += (a - b) * (a - b);
+            out[k].2 += 1;
         }
-        out.into_iter()
-            .map(|(s, d2, n)| {
-                let n = n as f64;
-                (s / n, d2 / n / (4.0 * n))
-            })
-            .collect::<Vec<_>>()
-    };
-    let (sa, parts) = (stats(&all), alone.each_ref().map(stats));
+    }
+    out.into_iter()
+        .map(|(s, d2, n)| {
+            let n = n as f64;
+            (s / n, d2 / n / (4.0 * n))
+        })
+        .collect()
+}
+
+/// Asserts that, block by block, the render `all` is the sum of the renders `parts` within
+/// Z standard errors of their combined noise.
+fn assert_sum_of_parts(what: &str, all: &[Image; 2], parts: &[[Image; 2]]) {
+    let sa = block_stats(all);
+    let parts: Vec<_> = parts.iter().map(block_stats).collect();
     let mut worst = 0.0f64;
     for k in 0..64 {
         let sum: DVec3 = parts.iter().map(|p| p[k].0).sum();
@@ -952,14 +960,152 @@ fn three_lights_together_are_the_sum_of_each_alone() {
             worst = worst.max(r);
             assert!(
                 r <= 1.0,
-                "block {k} channel {ch}: all lights {:.5}, sum of each alone {:.5} (se {:.5})",
+                "{what}: block {k} channel {ch}: all {:.5}, sum of the parts {:.5} (se {:.5})",
                 sa[k].0[ch],
                 sum[ch],
                 var[ch].sqrt()
             );
         }
     }
-    println!("three lights: worst |all − Σ alone| / allowance {worst:.3}");
+    println!("{what}: worst |all − Σ parts| / allowance {worst:.3}");
+}
+
+/// 100 point and spot lights at random over the floor, some behind a wall, and an emissive
+/// quad, picked per shading point by the light BVH (the default selection): the render with
+/// all of them is the sum of the renders of four groups of 25 lamps and of the quad alone (its
+/// emission found by BSDF samples too: MIS with the tree's pmf). Each group makes another
+/// tree, so a pmf that did not match its picks, or a light the tree starved to 0, would break
+/// the sum.
+#[test]
+fn hundred_lights_together_are_the_sum_of_their_groups() {
+    let Some(gpu) = gpu_for_tests("hundred_lights_together_are_the_sum_of_their_groups") else {
+        return;
+    };
+    let mut base = floor_scene(3.0, 60.0);
+    base.materials.push(lambert([0.7, 0.5, 0.3]));
+    base.add_uv_sphere(Vec3::new(0.3, 0.5, -0.2), 0.5, 48, 24, 1);
+    // A wall across the floor: the lamps behind it light only its far side and the floor there.
+    base.add_quad(
+        Vec3::new(-3.0, 0.0, 1.0),
+        Vec3::new(6.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.2, 0.0),
+        1.0,
+        1,
+    );
+    base.add_quad(
+        Vec3::new(3.0, 0.0, 1.0),
+        Vec3::new(-6.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.2, 0.0),
+        1.0,
+        1,
+    );
+    // The quad, facing down: emissive in `all` and its own part, not in the others.
+    let dark = base.materials.len() as u32;
+    base.materials.push(lambert([0.2; 3]));
+    base.add_quad(
+        Vec3::new(-1.5, 1.2, -1.5),
+        Vec3::new(1.4, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.2),
+        1.0,
+        dark,
+    );
+    // The same surface, emitting from its front (down).
+    let glowing = |s: &mut Scene| s.materials[dark as usize].emissive = Vec3::new(4.0, 3.5, 3.0);
+    let mut h = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        h ^= h << 13;
+        h ^= h >> 7;
+        h ^= h << 17;
+        (h >> 40) as f32 / (1u64 << 24) as f32
+    };
+    let lamps: Vec<Light> = (0..100)
+        .map(|k| {
+            let position = Vec3::new(next() * 5.0 - 2.5, 0.4 + next(), next() * 5.0 - 2.5);
+            let intensity = Vec3::new(0.02 + 0.1 * next(), 0.05, 0.02 + 0.1 * next());
+            if k % 2 == 0 {
+                Light::Point {
+                    position,
+                    intensity,
+                }
+            } else {
+                Light::Spot {
+                    position,
+                    direction: Vec3::new(next() - 0.5, -1.0, next() - 0.5).normalize(),
+                    intensity: 3.0 * intensity,
+                    inner_cone: 0.3,
+                    outer_cone: 0.5 + next(),
+                }
+            }
+        })
+        .collect();
+    let mut c = direct_config(32, Strategy::Mis);
+    c.sampling.max_depth = 2;
+    let render = |lights: &[Light], glow: bool| {
+        let mut s = base.clone();
+        s.lights = lights.to_vec();
+        if glow {
+            glowing(&mut s);
+        }
+        render_twice(&gpu, &s, None, c)
+    };
+    let all = render(&lamps, true);
+    let mut parts: Vec<[Image; 2]> = lamps.chunks(25).map(|g| render(g, false)).collect();
+    parts.push(render(&[], true));
+    assert_sum_of_parts("100 lights and a quad, light BVH", &all, &parts);
+}
+
+/// MIS with the light BVH weighs the emission a BSDF sample finds by the pmf the tree gives
+/// that emitter at the sample's origin, which must be the pmf with which next-event estimation
+/// picks it there (asked with the same normal); else the two weights do not sum to 1. A large
+/// emissive quad among 40 lamps over a Lambertian floor, direct light only: MIS renders what
+/// light sampling alone renders (which needs no pmf at the emitter), block by block within 5
+/// standard errors.
+#[test]
+fn mis_with_the_light_bvh_matches_light_sampling_alone() {
+    let Some(gpu) = gpu_for_tests("mis_with_the_light_bvh_matches_light_sampling_alone") else {
+        return;
+    };
+    let mut scene = floor_scene(3.0, 60.0);
+    let mut emitter = lambert([0.2; 3]);
+    emitter.emissive = Vec3::new(3.0, 2.5, 2.0);
+    scene.materials.push(emitter);
+    // Facing down (edge_u × edge_v = −Y), just above the floor.
+    scene.add_quad(
+        Vec3::new(-2.0, 0.5, -1.0),
+        Vec3::new(2.5, 0.0, 0.0),
+        Vec3::new(0.0, 0.0, 2.0),
+        1.0,
+        1,
+    );
+    // Dim lamps above and bright ones below the floor, which only the normal's term of the
+    // tree's importance tells apart from the quad at the floor.
+    scene.lights = (0..40)
+        .map(|k| {
+            let below = k % 2 == 1;
+            Light::Point {
+                position: Vec3::new(-2.5 + 0.125 * k as f32, if below { -0.5 } else { 1.0 }, 1.5),
+                intensity: Vec3::splat(if below { 5.0 } else { 0.05 }),
+            }
+        })
+        .collect();
+    let mis = render_twice(&gpu, &scene, None, direct_config(256, Strategy::Mis));
+    let light = render_twice(&gpu, &scene, None, direct_config(256, Strategy::Light));
+    let (a, b) = (block_stats(&mis), block_stats(&light));
+    let mut worst = 0.0f64;
+    for k in 0..64 {
+        for ch in 0..3 {
+            let allowed = Z * (a[k].1[ch] + b[k].1[ch]).sqrt() + 1e-3 * b[k].0[ch] + 1e-5;
+            let r = (a[k].0[ch] - b[k].0[ch]).abs() / allowed;
+            worst = worst.max(r);
+            assert!(
+                r <= 1.0,
+                "block {k} channel {ch}: MIS {:.5}, light sampling {:.5}",
+                a[k].0[ch],
+                b[k].0[ch]
+            );
+        }
+    }
+    println!("MIS against light sampling, light BVH: worst / allowance {worst:.3}");
 }
 
 /// The gold scene of issue 12 (a GGX sphere on a Lambertian plane, a constant sky of 0.5 and a
@@ -1047,7 +1193,11 @@ fn light_selection_weighs_what_the_camera_sees() {
         1.0,
         0,
     );
-    let pmf = SceneResources::new(&gpu, &scene, None, ResourceConfig::standard())
+    let robust = ResourceConfig {
+        light_selection: facet_render::LightSelection::Robust,
+        ..ResourceConfig::standard()
+    };
+    let pmf = SceneResources::new(&gpu, &scene, None, robust)
         .unwrap()
         .built
         .light_pmf;

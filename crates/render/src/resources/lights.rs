@@ -12,6 +12,7 @@
 //! emitted flux, the environment's through the scene's bounding sphere (kept to measure
 //! against).
 
+use super::light_bvh::{LightBounds, LightBvh};
 use super::tables::Tables;
 use crate::bvh::Bvh;
 use crate::camera::CameraFrame;
@@ -26,10 +27,26 @@ use crate::scene::environment::luminance;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LightSelection {
     /// ½ uniform + ½ ∝ the irradiance each light delivers to what the camera sees.
-    #[default]
     Robust,
     /// ∝ emitted flux (the environment's through the bounding sphere).
     Power,
+    /// Per shading point, by the light BVH ([`super::light_bvh`]) over the punctual lights and
+    /// emissive triangles; the environment and directional lights outside it. The tree as a
+    /// whole and each light outside it keep their `Robust` probabilities, so a scene without
+    /// local lights samples as `Robust` does.
+    #[default]
+    Bvh,
+}
+
+/// How the lights are picked, as uploaded: the CDF's pmf, the share of the tree, the tree.
+pub struct Selection {
+    /// The probability of each light by the CDF: every light (`Robust`, `Power`), or in
+    /// `Bvh` the lights outside the tree, given the tree is not asked (0 for those in it).
+    pub cdf_pmf: Vec<f32>,
+    /// The probability of asking the tree (0 without one).
+    pub tree_share: f32,
+    /// The tree (empty unless `Bvh` and a light has bounds).
+    pub tree: LightBvh,
 }
 
 /// Up to this many points stand for the receivers in the contribution estimates.
@@ -90,6 +107,8 @@ pub struct LightSet {
     pub triangle_light: Vec<u32>,
     /// The receivers the contributions are averaged over.
     pub probes: Vec<Probe>,
+    /// Per light, its bounds for the light BVH (None: the environment, a directional light).
+    pub bounds: Vec<Option<LightBounds>>,
 }
 
 impl LightSet {
@@ -116,7 +135,9 @@ impl LightSet {
         };
         for l in &scene.lights {
             let (g, p) = punctual_record(l, radius);
-            set.push(g, p, probes.punctual_contribution(l));
+            if set.push(g, p, probes.punctual_contribution(l)) {
+                *set.bounds.last_mut().expect("pushed") = punctual_bounds(l);
+            }
         }
         set.add_emissive_triangles(scene, materials, &probes);
         if set.triangle_light.is_empty() {
@@ -162,19 +183,65 @@ impl LightSet {
             self.lights.push(light);
             self.power.push(PI * area * luminance(le));
             self.contribution.push(contribution);
+            self.bounds
+                .push(Some(LightBounds::triangle(a, b, c, luminance(le))));
         }
     }
 
-    /// Adds a light if its power is positive.
-    pub fn push(&mut self, light: GpuLight, power: f32, contribution: f32) {
+    /// Adds a light (with no bounds: outside the light BVH) if its power is positive; returns
+    /// whether it did.
+    pub fn push(&mut self, light: GpuLight, power: f32, contribution: f32) -> bool {
         if power > 0.0 {
             self.lights.push(light);
             self.power.push(power);
             self.contribution.push(contribution.max(0.0));
+            self.bounds.push(None);
+        }
+        power > 0.0
+    }
+
+    /// How `selection` picks the lights: the CDF, and for `Bvh` the tree over the lights with
+    /// bounds and its share (their `Robust` probabilities summed).
+    pub fn selection(&self, selection: LightSelection) -> Selection {
+        let n = self.lights.len();
+        if selection != LightSelection::Bvh || self.bounds.iter().all(Option::is_none) {
+            let cdf_pmf = self.pmf(match selection {
+                LightSelection::Bvh => LightSelection::Robust,
+                s => s,
+            });
+            return Selection {
+                cdf_pmf,
+                tree_share: 0.0,
+                tree: LightBvh::build(&[], n),
+            };
+        }
+        let robust = self.pmf(LightSelection::Robust);
+        let in_tree: Vec<(u32, LightBounds)> = (0..n)
+            .filter_map(|i| self.bounds[i].map(|b| (i as u32, b)))
+            .collect();
+        let tree = LightBvh::build(&in_tree, n);
+        let outside: Vec<f32> = (0..n)
+            .map(|i| {
+                if self.bounds[i].is_some() {
+                    0.0
+                } else {
+                    robust[i]
+                }
+            })
+            .collect();
+        let rest: f32 = outside.iter().sum();
+        let tree_share = if rest > 0.0 { 1.0 - rest } else { 1.0 };
+        Selection {
+            cdf_pmf: outside
+                .iter()
+                .map(|p| if rest > 0.0 { p / rest } else { 0.0 })
+                .collect(),
+            tree_share: if tree.is_empty() { 0.0 } else { tree_share },
+            tree,
         }
     }
 
-    /// The probability of picking each light.
+    /// The probability of picking each light by the CDF (`Bvh`: as `Robust`).
     pub fn pmf(&self, selection: LightSelection) -> Vec<f32> {
         let n = self.lights.len();
         let normalised = |w: &[f32]| {
@@ -187,7 +254,8 @@ impl LightSet {
         };
         match selection {
             LightSelection::Power => normalised(&self.power),
-            LightSelection::Robust => normalised(&self.contribution)
+            // The tree's lights share as Robust picks them (`selection`).
+            LightSelection::Robust | LightSelection::Bvh => normalised(&self.contribution)
                 .into_iter()
                 .map(|p: f32| 0.5 * p + 0.5 / n as f32)
                 .collect(),
@@ -275,6 +343,30 @@ impl ProbeMean {
                     / self.probes.len().max(1) as f32
             }
         }
+    }
+}
+
+/// Punctual light `l`'s bounds for the light BVH (None for a directional light).
+fn punctual_bounds(l: &Light) -> Option<LightBounds> {
+    match *l {
+        Light::Point {
+            position,
+            intensity,
+        } => Some(LightBounds::point(position, luminance(intensity))),
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            inner_cone,
+            outer_cone,
+        } => Some(LightBounds::spot(
+            position,
+            direction,
+            luminance(intensity),
+            inner_cone,
+            outer_cone,
+        )),
+        Light::Directional { .. } => None,
     }
 }
 

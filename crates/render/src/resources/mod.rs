@@ -7,6 +7,7 @@
 
 mod environment;
 mod glints;
+pub mod light_bvh;
 mod lights;
 pub mod materials;
 mod tables;
@@ -24,6 +25,7 @@ use facet_fit::model::microfacet::Ndf;
 use facet_glint::dpf::DpfConfig;
 use facet_glint::gpu::GpuDpf;
 use facet_gpu::{Gpu, buffer};
+use light_bvh::GpuLightNode;
 pub use lights::LightSelection;
 use lights::LightSet;
 use tables::Tables;
@@ -52,8 +54,16 @@ pub struct Built {
     pub bvh_build_ms: f64,
     /// Time to build the DPF pyramids, milliseconds.
     pub glint_build_ms: f64,
-    /// The probability of picking each light (punctual, emissive triangles, environment).
+    /// The probability of picking each light (punctual, emissive triangles, environment) by
+    /// the CDF; with [`LightSelection::Bvh`], of the lights outside the tree when the tree is
+    /// not asked (the tree's own picks depend on the shading point).
     pub light_pmf: Vec<f32>,
+    /// With [`LightSelection::Bvh`]: the probability of asking the light BVH.
+    pub light_tree_share: f32,
+    /// Nodes of the light BVH (0 without one).
+    pub light_tree_nodes: usize,
+    /// Time to build the light BVH, milliseconds.
+    pub light_tree_ms: f64,
 }
 
 /// One glint material's GPU resources (bind group 2 of its shading stage).
@@ -92,6 +102,8 @@ pub struct SceneResources {
     pub tables: wgpu::Buffer,
     /// The light of each emissive triangle.
     pub triangle_light: wgpu::Buffer,
+    /// The light BVH's nodes (one unused node without a tree).
+    pub light_tree: wgpu::Buffer,
     /// The GPU state of each glint material.
     pub glints: Vec<GlintResources>,
     /// Which shading queues have hits routed to them.
@@ -119,13 +131,13 @@ pub struct ResourceConfig {
 }
 
 impl ResourceConfig {
-    /// The medium BVH, the standard DPF tables, the glint filter on, robust light selection.
+    /// The medium BVH, the standard DPF tables, the glint filter on, the light BVH.
     pub const fn standard() -> Self {
         ResourceConfig {
             bvh: BvhConfig::medium(),
             dpf: DpfConfig::standard(),
             glint_filter: true,
-            light_selection: LightSelection::Robust,
+            light_selection: LightSelection::Bvh,
         }
     }
 }
@@ -176,17 +188,28 @@ impl SceneResources {
         built.emissive_triangles = light_set.emissive_triangles();
         let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
         built.environment_map = env.kind == crate::tags::EnvKind::Map;
-        let pmf = light_set.pmf(config.light_selection);
-        let light_cdf = LightSet::place_cdf(&pmf, &mut tables);
-        built.light_pmf = pmf;
+        let t = std::time::Instant::now();
+        let selection = light_set.selection(config.light_selection);
+        built.light_tree_ms = t.elapsed().as_secs_f64() * 1e3;
+        let light_cdf = LightSet::place_cdf(&selection.cdf_pmf, &mut tables);
+        built.light_pmf = selection.cdf_pmf;
+        built.light_tree_share = selection.tree_share;
+        built.light_tree_nodes = selection.tree.nodes.len();
         let LightSet {
             mut lights,
             triangle_light,
             ..
         } = light_set;
+        for (l, leaf) in lights.iter_mut().zip(&selection.tree.leaf_of) {
+            l.leaf = *leaf;
+        }
         built.lights = lights.len();
         if lights.is_empty() {
             lights.push(GpuLight::default());
+        }
+        let mut light_tree = selection.tree.nodes;
+        if light_tree.is_empty() {
+            light_tree.push(GpuLightNode::default());
         }
         if tables.words.is_empty() {
             tables.words.push(0.0);
@@ -203,6 +226,7 @@ impl SceneResources {
                 lights: lights.len(),
                 tables: &tables,
                 triangle_light: triangle_light.len(),
+                light_tree: light_tree.len(),
             },
         )?;
 
@@ -215,6 +239,7 @@ impl SceneResources {
             lights: buffer::storage(d, "lights", &lights),
             tables: buffer::storage(d, "tables", &tables.words),
             triangle_light: buffer::storage(d, "triangle lights", &triangle_light),
+            light_tree: buffer::storage(d, "light tree", &light_tree),
             bvh: gpu_bvh,
             glints,
             queues_used,
@@ -229,8 +254,9 @@ impl SceneResources {
                 env_marginal: env.offsets.1,
                 env_conditional: env.offsets.2,
                 scene_radius: radius,
+                light_tree_share: built.light_tree_share,
+                light_tree_nodes: built.light_tree_nodes as u32,
                 env_color: env.color,
-                ..Default::default()
             },
             built,
         })?;
@@ -345,6 +371,7 @@ struct Buffers<'a> {
     lights: usize,
     tables: &'a Tables,
     triangle_light: usize,
+    light_tree: usize,
 }
 
 /// Every scene buffer within the device's limits, or an error that names the input that set
@@ -405,6 +432,15 @@ fn check_buffers(
             size_of(b.triangle_light, 4),
             format!("the scene ({n_tri} triangles)"),
         ),
+        Planned::storage(
+            "the light BVH",
+            size_of(b.light_tree, std::mem::size_of::<GpuLightNode>()),
+            format!(
+                "the scene ({} punctual lights, {} emissive triangles)",
+                scene.lights.len(),
+                built.emissive_triangles
+            ),
+        ),
     ])?;
     Ok(())
 }
@@ -426,7 +462,7 @@ impl GlintResources {
 impl SceneResources {
     /// Its bind group's resources, named as `scene.inc.wgsl` names them
     /// ([`Group::Scene`](crate::bindings::Group::Scene)).
-    pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 10] {
+    pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 11] {
         [
             ("bvh_nodes", self.bvh.nodes.as_entire_binding()),
             ("bvh_primitives", self.bvh.primitives.as_entire_binding()),
@@ -438,6 +474,7 @@ impl SceneResources {
             ("lights", self.lights.as_entire_binding()),
             ("tables", self.tables.as_entire_binding()),
             ("triangle_light", self.triangle_light.as_entire_binding()),
+            ("light_tree", self.light_tree.as_entire_binding()),
         ]
     }
 
