@@ -28,6 +28,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod lights;
 mod shard;
 
 #[derive(Parser, Clone, Debug)]
@@ -63,6 +64,9 @@ pub enum Section {
     Dpf,
     /// What a shard process costs besides its work (`facet render --samples`, `facet fit --shard`).
     Shard,
+    /// Light selection (bvh, robust, power) on the many-light rooms, the gold scene and the
+    /// demo; the light BVH's build.
+    Lights,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -91,6 +95,8 @@ struct Sizes {
     noise: (u32, u32),
     /// The shard processes' size (None: the demo's) and samples per shard.
     shard: (Option<(u32, u32)>, &'static [u32]),
+    /// Side and spp of the light-selection renders, and emissive triangles of the tree builds.
+    lights: (u32, u32, &'static [usize]),
 }
 
 impl Mode {
@@ -108,6 +114,7 @@ impl Mode {
                 viewer: (64, 3),
                 noise: (32, 2),
                 shard: (Some((64, 36)), &[1, 2]),
+                lights: (32, 2, &[1_000]),
             },
             Mode::Quick => Sizes {
                 runs: 5,
@@ -121,6 +128,7 @@ impl Mode {
                 viewer: (512, 5),
                 noise: (128, 16),
                 shard: (None, &[1, 4, 16]),
+                lights: (128, 16, &[10_000, 1_000_000]),
             },
             Mode::Default => Sizes {
                 runs: 5,
@@ -134,6 +142,7 @@ impl Mode {
                 viewer: (512, 60),
                 noise: (256, 64),
                 shard: (None, &[1, 16, 64, 256]),
+                lights: (256, 64, &[10_000, 1_000_000]),
             },
             Mode::Full => Sizes {
                 triangles: &[10_000, 100_000, 1_000_000, 10_000_000],
@@ -262,6 +271,9 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         }
         if on(Section::Dpf) {
             report["dpf"] = dpf_pyramid(g, mode, &sizes)?;
+        }
+        if on(Section::Lights) {
+            report["lights"] = lights::lights(g, &sizes)?;
         }
         if on(Section::Shard) {
             report["shard"] = shard::shards(sizes.runs, sizes.shard.0, sizes.shard.1)?;
@@ -709,6 +721,107 @@ fn gold_scene(sphere: Material) -> Result<(Scene, Environment)> {
     Ok((scene, Environment::Constant(Vec3::splat(0.5))))
 }
 
+/// The noise and speed of one configuration on one scene.
+pub(crate) struct Measured {
+    /// The variance of a pixel: E[(a − b)²] / 2 over two seeds, averaged over pixels and
+    /// channels.
+    pub var: f64,
+    /// Nanoseconds a sample (median of three renders).
+    pub ns: f64,
+    /// The mean of both renders' pixels.
+    pub mean: f64,
+    /// The squared standard error of that mean (pixels independent).
+    pub se2: f64,
+    /// The two renders (seeds 0 and 1).
+    pub images: [facet_render::Image; 2],
+}
+
+impl Measured {
+    /// The variance of a pixel over the pixels `keep` accepts.
+    pub fn variance_where(&self, keep: impl Fn(usize) -> bool) -> f64 {
+        let [a, b] = &self.images;
+        let (mut sum, mut n) = (0.0, 0usize);
+        for (k, (pa, pb)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+            if keep(k) {
+                sum += (0..3)
+                    .map(|c| 0.5 * (pa[c] as f64 - pb[c] as f64).powi(2))
+                    .sum::<f64>();
+                n += 3;
+            }
+        }
+        sum / n.max(1) as f64
+    }
+}
+
+/// Renders `scene` at `image` and `spp` (depth 5) with seeds 0, 1 and 2 after an untimed
+/// 1-spp render: the variance from the first two, the time a sample the median of the three.
+pub(crate) fn measure_noise(
+    gpu: &Gpu,
+    scene: &Scene,
+    env: Option<&Environment>,
+    rc: ResourceConfig,
+    image: ImageConfig,
+    spp: u32,
+    ndf_sampling: facet_render::NdfSampling,
+) -> Result<Measured> {
+    let camera = CameraFrame::new(&scene.camera)?;
+    let res = SceneResources::new(gpu, scene, env, rc)?;
+    let integrator = Integrator::new(&gpu.device, &res)?;
+    let mut wf = integrator.wavefront(gpu, &res, image)?;
+    let mut images = Vec::new();
+    let mut ms = Vec::new();
+    // An untimed render first: the first dispatches of fresh pipelines are slower.
+    let warm = SampleConfig {
+        spp: 1,
+        ndf_sampling,
+        ..SampleConfig::standard()
+    };
+    integrator.render_more(gpu, &mut wf, &camera, &warm, &mut |_| {})?;
+    // Seeds 0 and 1 give the variance; seed 2 only a third time for the median.
+    for seed in [0, 1, 2] {
+        let cfg = SampleConfig {
+            spp,
+            max_depth: 5,
+            seed,
+            ndf_sampling,
+            ..SampleConfig::standard()
+        };
+        wf.clear(gpu);
+        ms.push(
+            integrator
+                .render_more(gpu, &mut wf, &camera, &cfg, &mut |_| {})?
+                .ms,
+        );
+        if seed < 2 {
+            images.push(wf.image(gpu)?);
+        }
+    }
+    let n = images[0].pixels.len() * 3;
+    let var = images[0]
+        .pixels
+        .iter()
+        .flatten()
+        .zip(images[1].pixels.iter().flatten())
+        .map(|(a, b)| 0.5 * (*a as f64 - *b as f64).powi(2))
+        .sum::<f64>()
+        / n as f64;
+    let ns = median(&mut ms) * 1e6 / (image.width as f64 * image.height as f64 * spp as f64);
+    let mean = images
+        .iter()
+        .flat_map(|im| im.pixels.iter().flatten())
+        .map(|v| *v as f64)
+        .sum::<f64>()
+        / (2 * n) as f64;
+    let [a, b]: [facet_render::Image; 2] = images.try_into().expect("two renders");
+    Ok(Measured {
+        var,
+        ns,
+        mean,
+        se2: var / (2 * n) as f64,
+        images: [a, b],
+    })
+}
+
 /// Noise at equal spp and time per sample, before (D cos θh sampling, selection by flux) and
 /// after (visible normals, robust selection), and each change alone, on the gold scene (GGX and
 /// the fit's tabulated NDF), the demo and a glossy (α = 0.05) sphere under the sky. The
@@ -746,62 +859,15 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     println!("\nnoise: variance per pixel at {spp} spp ({side} × {side}) and time per sample");
     let mut rows = Vec::new();
     for (name, (scene, env)) in &scenes {
-        let camera = CameraFrame::new(&scene.camera)?;
         let mut base: Option<(f64, f64, f64, f64)> = None;
         for (label, ndf_sampling, light_selection) in configs {
             let rc = ResourceConfig {
                 light_selection,
                 ..ResourceConfig::standard()
             };
-            let res = SceneResources::new(gpu, scene, Some(env), rc)?;
-            let integrator = Integrator::new(&gpu.device, &res)?;
-            let mut wf = integrator.wavefront(gpu, &res, square(side))?;
-            let mut images = Vec::new();
-            let mut ms = Vec::new();
-            // An untimed render first: the first dispatches of fresh pipelines are slower.
-            let warm = SampleConfig {
-                spp: 1,
-                ndf_sampling,
-                ..SampleConfig::standard()
-            };
-            integrator.render_more(gpu, &mut wf, &camera, &warm, &mut |_| {})?;
-            // Seeds 0 and 1 give the variance; seed 2 only a third time for the median.
-            for seed in [0, 1, 2] {
-                let cfg = SampleConfig {
-                    spp,
-                    max_depth: 5,
-                    seed,
-                    ndf_sampling,
-                    ..SampleConfig::standard()
-                };
-                wf.clear(gpu);
-                ms.push(
-                    integrator
-                        .render_more(gpu, &mut wf, &camera, &cfg, &mut |_| {})?
-                        .ms,
-                );
-                if seed < 2 {
-                    images.push(wf.image(gpu)?);
-                }
-            }
-            let n = images[0].pixels.len() * 3;
-            let var = images[0]
-                .pixels
-                .iter()
-                .flatten()
-                .zip(images[1].pixels.iter().flatten())
-                .map(|(a, b)| 0.5 * (*a as f64 - *b as f64).powi(2))
-                .sum::<f64>()
-                / n as f64;
-            let ns = median(&mut ms) * 1e6 / ((side * side) as f64 * spp as f64);
-            // The image mean of both renders and its standard error (pixels independent).
-            let mean = images
-                .iter()
-                .flat_map(|im| im.pixels.iter().flatten())
-                .map(|v| *v as f64)
-                .sum::<f64>()
-                / (2 * n) as f64;
-            let se2 = var / (2 * n) as f64;
+            let Measured {
+                var, ns, mean, se2, ..
+            } = measure_noise(gpu, scene, Some(env), rc, square(side), spp, ndf_sampling)?;
             let (v0, t0, m0, s0) = *base.get_or_insert((var, ns, mean, se2));
             // The expected image is the same: the means differ by a few standard errors at most.
             let z = (mean - m0) / (se2 + s0).sqrt().max(1e-30);

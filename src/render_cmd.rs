@@ -344,8 +344,18 @@ pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) ->
 
 pub fn print_timings(t: &Timings, triangles: usize) {
     let b = &t.built;
+    let tree = if b.light_tree_nodes > 0 {
+        format!(
+            " (light BVH {} nodes in {:.0} ms, asked {:.0} % of the time)",
+            b.light_tree_nodes,
+            b.light_tree_ms,
+            100.0 * b.light_tree_share
+        )
+    } else {
+        String::new()
+    };
     println!(
-        "scene: {} triangles, BVH {} nodes in {:.0} ms; classes {:?}; glint pyramids {:?} in {:.0} ms; {} lights",
+        "scene: {} triangles, BVH {} nodes in {:.0} ms; classes {:?}; glint pyramids {:?} in {:.0} ms; {} lights{tree}",
         triangles,
         b.bvh_nodes,
         b.bvh_build_ms,

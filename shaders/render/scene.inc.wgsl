@@ -364,7 +364,12 @@ fn triangle_light_pdf(prim: u32, p: vec3<f32>, sel: vec3<f32>, n: vec3<f32>, q: 
     if (l == NONE) {
         return 0.0;
     }
-    let pmf = light_select_pmf(l, sel, n);
+    return triangle_solid_angle_pdf(light_select_pmf(l, sel, n), p, q, nq, area);
+}
+
+// The solid-angle pdf at p of a uniform point q on a triangle (normal nq, area) picked with
+// probability pmf: pmf d² / (cos θq A).
+fn triangle_solid_angle_pdf(pmf: f32, p: vec3<f32>, q: vec3<f32>, nq: vec3<f32>, area: f32) -> f32 {
     let d = q - p;
     let d2 = dot(d, d);
     let cos_l = abs(dot(nq, normalize(d)));
@@ -435,7 +440,9 @@ fn sample_light(p: vec3<f32>, sel: vec3<f32>, n: vec3<f32>, u0_in: f32, u: vec2<
         let d = q - p;
         ls.dist = length(d);
         ls.wi = d / ls.dist;
-        ls.pdf = triangle_light_pdf(l.prim, p, sel, n, q, nq, area);
+        // The pmf it was picked with (the tree's from the top, equal within rounding to
+        // light_select_pmf's from its leaf, which MIS uses when a BSDF sample hits it).
+        ls.pdf = triangle_solid_angle_pdf(pmf, p, q, nq, area);
         let m = materials[tri.w];
         // One-sided emitters: only the front (counter-clockwise) side emits.
         var le = m.emissive.xyz;
