@@ -1108,6 +1108,77 @@ fn mis_with_the_light_bvh_matches_light_sampling_alone() {
     println!("MIS against light sampling, light BVH: worst / allowance {worst:.3}");
 }
 
+/// Every selection is unbiased: on the many-light rooms (`assets/many_lights/`: 100 point and
+/// spot lamps, some behind a partition; 100 emissive panels of 10⁴ triangles), full paths at
+/// depth 5, the image means of `bvh`, `robust` and `power` agree within 5 standard errors
+/// (from each render's two seeds, pixels independent).
+#[test]
+fn every_light_selection_renders_the_many_light_rooms_alike() {
+    let Some(gpu) = gpu_for_tests("every_light_selection_renders_the_many_light_rooms_alike")
+    else {
+        return;
+    };
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/many_lights");
+    for file in ["room_points.gltf", "room_panels.gltf"] {
+        let scene = facet_render::scene::load_gltf(&dir.join(file), &Default::default()).unwrap();
+        let mut c = direct_config(16, Strategy::Mis);
+        c.sampling.max_depth = 5;
+        let stats: Vec<(f64, f64)> = [
+            facet_render::LightSelection::Bvh,
+            facet_render::LightSelection::Robust,
+            facet_render::LightSelection::Power,
+        ]
+        .into_iter()
+        .map(|light_selection| {
+            let rc = ResourceConfig {
+                light_selection,
+                ..ResourceConfig::standard()
+            };
+            let res = SceneResources::new(&gpu, &scene, None, rc).unwrap();
+            let integrator = Integrator::new(&gpu.device, &res).unwrap();
+            let camera = CameraFrame::new(&scene.camera).unwrap();
+            let images: Vec<Image> = (0..2)
+                .map(|seed| {
+                    let mut c = c;
+                    c.sampling.seed = seed;
+                    integrator
+                        .render(&gpu, &res, &camera, &c, &mut |_| {})
+                        .unwrap()
+                        .0
+                })
+                .collect();
+            let n = (images[0].pixels.len() * 3) as f64;
+            let values = |im: &Image| {
+                im.pixels
+                    .iter()
+                    .flatten()
+                    .map(|v| *v as f64)
+                    .collect::<Vec<_>>()
+            };
+            let (a, b) = (values(&images[0]), values(&images[1]));
+            let mean = a.iter().chain(&b).sum::<f64>() / (2.0 * n);
+            let var = a
+                .iter()
+                .zip(&b)
+                .map(|(x, y)| 0.5 * (x - y).powi(2))
+                .sum::<f64>()
+                / n;
+            (mean, var / (2.0 * n))
+        })
+        .collect();
+        println!("{file}: (mean, squared standard error) of bvh, robust, power: {stats:?}");
+        for (k, name) in [(1, "robust"), (2, "power")] {
+            let z = (stats[0].0 - stats[k].0).abs() / (stats[0].1 + stats[k].1).sqrt();
+            assert!(
+                z <= Z,
+                "{file}: bvh's mean {:.5} and {name}'s {:.5} are {z:.1} σ apart",
+                stats[0].0,
+                stats[k].0
+            );
+        }
+    }
+}
+
 /// The gold scene of issue 12 (a GGX sphere on a Lambertian plane, a constant sky of 0.5 and a
 /// 40 W/sr point light): the robust selection gives the point light a fair share, where the
 /// flux-based one starved it.
