@@ -148,6 +148,13 @@ impl LightBounds {
 
 /// The smallest cone holding two cones (axis, cos of half-angle) (pbrt-v4's `Union`).
 fn cone_union(a: (Vec3, f32), b: (Vec3, f32)) -> (Vec3, f32) {
+    // The common cases first, without an acos: a whole sphere, or the same cone.
+    if a.1 <= -1.0 || a == b {
+        return a;
+    }
+    if b.1 <= -1.0 {
+        return b;
+    }
     let theta_a = a.1.clamp(-1.0, 1.0).acos();
     let theta_b = b.1.clamp(-1.0, 1.0).acos();
     let theta_d = a.0.angle_between(b.0);
@@ -270,45 +277,31 @@ pub struct LightBvh {
 
 impl LightBvh {
     /// The tree over `lights` (index in the scene's list of `n_lights`, bounds); lights of
-    /// φ = 0 are left out (they never reach anything).
+    /// φ = 0 are left out (they never reach anything). Subtrees of many lights are built in
+    /// parallel: a subtree of k lights takes the 2k − 1 nodes after its root's index, so each
+    /// knows where its nodes go.
     pub fn build(lights: &[(u32, LightBounds)], n_lights: usize) -> Self {
         let mut items: Vec<(u32, LightBounds)> = lights
             .iter()
             .copied()
             .filter(|(_, b)| b.phi > 0.0)
             .collect();
-        let mut tree = LightBvh {
-            nodes: Vec::with_capacity(2 * items.len()),
-            leaf_of: vec![NONE; n_lights],
-        };
+        let mut nodes = vec![GpuLightNode::default(); (2 * items.len()).saturating_sub(1)];
         if !items.is_empty() {
-            tree.build_node(&mut items, NONE);
+            build_subtree(&mut nodes, &mut items, 0, NONE);
         }
-        tree
+        let mut leaf_of = vec![NONE; n_lights];
+        for (i, node) in nodes.iter().enumerate() {
+            if node.leaf == 1 {
+                leaf_of[node.child as usize] = i as u32;
+            }
+        }
+        LightBvh { nodes, leaf_of }
     }
 
     /// Whether it holds no light.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
-    }
-
-    /// Appends the subtree of `items` under `parent`; returns its node and bounds.
-    fn build_node(&mut self, items: &mut [(u32, LightBounds)], parent: u32) -> (u32, LightBounds) {
-        let index = self.nodes.len() as u32;
-        if let [(light, b)] = items {
-            self.nodes.push(GpuLightNode::new(b, *light, parent, true));
-            self.leaf_of[*light as usize] = index;
-            return (index, *b);
-        }
-        // Placeholder until the children are known.
-        self.nodes.push(GpuLightNode::default());
-        let mid = split(items);
-        let (left, right) = items.split_at_mut(mid);
-        let (_, lb) = self.build_node(left, index);
-        let (second, rb) = self.build_node(right, index);
-        let bounds = lb.union(&rb);
-        self.nodes[index as usize] = GpuLightNode::new(&bounds, second, parent, false);
-        (index, bounds)
     }
 
     /// The importance of node `i` to (p, n).
@@ -377,6 +370,43 @@ impl LightBvh {
 /// The largest f32 below 1.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// Subtrees of fewer lights on either side are built on the calling thread.
+const PARALLEL_BELOW: usize = 4096;
+
+/// Writes the subtree of `items` into `nodes` (its 2k − 1 nodes, the root first, at global index
+/// `index`) under `parent`; returns the bounds of its lights.
+fn build_subtree(
+    nodes: &mut [GpuLightNode],
+    items: &mut [(u32, LightBounds)],
+    index: u32,
+    parent: u32,
+) -> LightBounds {
+    debug_assert_eq!(nodes.len(), 2 * items.len() - 1);
+    if let [(light, b)] = items {
+        nodes[0] = GpuLightNode::new(b, *light, parent, true);
+        return *b;
+    }
+    let mid = split(items);
+    let (left, right) = items.split_at_mut(mid);
+    let (root, rest) = nodes.split_first_mut().expect("a subtree has a root");
+    let (left_nodes, right_nodes) = rest.split_at_mut(2 * mid - 1);
+    let second = index + 2 * mid as u32;
+    let (lb, rb) = if mid.min(right.len()) >= PARALLEL_BELOW {
+        rayon::join(
+            || build_subtree(left_nodes, left, index + 1, index),
+            || build_subtree(right_nodes, right, second, index),
+        )
+    } else {
+        (
+            build_subtree(left_nodes, left, index + 1, index),
+            build_subtree(right_nodes, right, second, index),
+        )
+    };
+    let bounds = lb.union(&rb);
+    *root = GpuLightNode::new(&bounds, second, parent, false);
+    bounds
+}
+
 /// Reorders `items` into two non-empty groups by the cheapest bucket split over the three
 /// axes (pbrt-v4's `buildBVH`); returns the size of the first. Lights whose centroids coincide
 /// are halved in their order.
@@ -400,15 +430,21 @@ fn split(items: &mut [(u32, LightBounds)]) -> usize {
             let k = bucket(b);
             buckets[k] = Some(buckets[k].map_or(*b, |x| x.union(b)));
         }
+        // The union of the buckets below each cut and above it, each built once.
+        let join = |acc: &mut Option<LightBounds>, b: &Option<LightBounds>| {
+            if let Some(b) = b {
+                *acc = Some(acc.map_or(*b, |a| a.union(b)));
+            }
+            *acc
+        };
+        let mut acc = None;
+        let below: Vec<Option<LightBounds>> = buckets.iter().map(|b| join(&mut acc, b)).collect();
+        let mut acc = None;
+        let mut above: Vec<Option<LightBounds>> =
+            buckets.iter().rev().map(|b| join(&mut acc, b)).collect();
+        above.reverse();
         for cut in 1..BUCKETS {
-            let side = |r: std::ops::Range<usize>| {
-                buckets[r]
-                    .iter()
-                    .flatten()
-                    .copied()
-                    .reduce(|a, b| a.union(&b))
-            };
-            let (Some(l), Some(r)) = (side(0..cut), side(cut..BUCKETS)) else {
+            let (Some(l), Some(r)) = (below[cut - 1], above[cut]) else {
                 continue;
             };
             let cost = l.cost(axis) + r.cost(axis);
