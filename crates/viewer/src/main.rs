@@ -1,11 +1,12 @@
-//! `facet-viewer [--material SPEC] [--shown MODEL] [--scene PATH.gltf] [--screenshot PATH --frames N]`
+//! `facet-viewer [INPUT] [--shown MODEL] [--scene PATH.gltf] [--screenshot PATH.png --frames N]`
 //!
 //! Opens the window on eframe's wgpu backend with the device the renderer needs (the
 //! adapter's own limits); the preview shares that device. Where wgpu finds no adapter or
 //! cannot start, the window opens on the glow (OpenGL) backend instead and says so, with the
 //! preview off: the material panel, plots, fitting and saving still work.
 
-use anyhow::{Context, Result, bail};
+use anyhow::Result;
+use clap::Parser;
 use facet_viewer::ViewerApp;
 use facet_viewer::app::ScreenshotPlan;
 use facet_viewer::material::Shown;
@@ -15,56 +16,86 @@ use std::path::PathBuf;
 /// Preview resolution (the image is scaled to the panel).
 const PREVIEW: (u32, u32) = (256, 256);
 
-#[derive(Clone)]
+/// Facet's material viewer: a measured or fitted material on a live path-traced preview, its
+/// fit edited with sliders (α, rotation, ρd, Fresnel tint, glints) and saved for `facet render`.
+/// FACET_BACKEND and FACET_ADAPTER choose the adapter, as for `facet`.
+#[derive(Parser, Clone, Debug)]
+#[command(name = "facet-viewer", version)]
 struct Args {
-    screenshot: Option<PathBuf>,
-    frames: u32,
+    /// The material to open, as `facet fit` takes it: a MERL .binary, an RGL .bsdf,
+    /// `nbrdf:NAME`, `analytic:ggx?alpha=0.2&f0=0.04` or a fit .json (default: the embedded
+    /// gold GGX, fitted at start).
+    #[arg(value_name = "INPUT", conflicts_with = "material")]
+    input: Option<String>,
+    /// The same as INPUT.
+    #[arg(long, value_name = "SPEC")]
     material: Option<String>,
+    /// The model shown first: measured (the data), tabulated, ggx, beckmann or glint (default:
+    /// tabulated where the material has a fit).
+    #[arg(long, value_name = "MODEL", value_parser = parse_shown)]
     shown: Option<Shown>,
+    /// A glTF scene for the preview, its materials replaced by the edited one (default: a
+    /// sphere under the demo's sky).
+    #[arg(long, value_name = "PATH.gltf")]
     scene: Option<PathBuf>,
+    /// Save a screenshot of the window as PNG after --frames frames, then exit (the docs'
+    /// picture and the window test).
+    #[arg(long, value_name = "PATH.png")]
+    screenshot: Option<PathBuf>,
+    /// Frames of the preview before the screenshot.
+    #[arg(long, value_name = "N", default_value_t = 16, requires = "screenshot")]
+    frames: u32,
 }
 
-fn parse() -> Result<Option<Args>> {
-    let mut a = Args {
-        screenshot: None,
-        frames: 16,
-        material: None,
-        shown: None,
-        scene: None,
-    };
-    let mut args = std::env::args().skip(1);
-    while let Some(arg) = args.next() {
-        match arg.as_str() {
-            "--screenshot" => {
-                a.screenshot = Some(PathBuf::from(args.next().context("--screenshot PATH")?))
+impl Args {
+    /// INPUT as a glTF scene goes to --scene; a file INPUT (or --material) that cannot be read
+    /// is refused here, naming it, before a window opens.
+    fn checked(mut self) -> Result<Self> {
+        let is_scene = |s: &str| {
+            let ext = std::path::Path::new(s)
+                .extension()
+                .map(|e| e.to_ascii_lowercase());
+            matches!(ext.as_ref().and_then(|e| e.to_str()), Some("gltf" | "glb"))
+        };
+        if let Some(input) = self.input.take_if(|i| is_scene(i)) {
+            if self.scene.is_some() {
+                anyhow::bail!("{input}: a scene, and --scene gives another");
             }
-            "--frames" => a.frames = args.next().context("--frames N")?.parse()?,
-            "--material" => a.material = Some(args.next().context("--material SPEC")?),
-            "--scene" => a.scene = Some(PathBuf::from(args.next().context("--scene PATH.gltf")?)),
-            "--shown" => {
-                let name = args.next().context("--shown MODEL")?;
-                a.shown = Some(
-                    Shown::ALL
-                        .into_iter()
-                        .find(|s| {
-                            s.label().eq_ignore_ascii_case(&name)
-                                || format!("{s:?}").eq_ignore_ascii_case(&name)
-                        })
-                        .with_context(|| {
-                            format!("--shown {name}: measured, tabulated, ggx, beckmann or glint")
-                        })?,
-                );
-            }
-            "-h" | "--help" => {
-                println!(
-                    "facet-viewer [--material SPEC] [--shown MODEL] [--scene PATH.gltf] [--screenshot PATH.png --frames N]"
-                );
-                return Ok(None);
-            }
-            other => bail!("unknown argument {other}"),
+            self.scene = Some(PathBuf::from(input));
         }
+        let spec = self.input.as_ref().or(self.material.as_ref());
+        if let Some(spec) = spec
+            && let Some(path) = facet_fit::sources::InputSpec::parse(spec).path()
+        {
+            std::fs::metadata(path).map_err(|e| {
+                anyhow::anyhow!(
+                    "{}: {}",
+                    path.display(),
+                    facet_fit::io::input::io_problem(&e)
+                )
+            })?;
+        }
+        if let Some(scene) = &self.scene {
+            std::fs::metadata(scene).map_err(|e| {
+                anyhow::anyhow!(
+                    "--scene {}: {}",
+                    scene.display(),
+                    facet_fit::io::input::io_problem(&e)
+                )
+            })?;
+        }
+        Ok(self)
     }
-    Ok(Some(a))
+}
+
+/// A `--shown` value: a model's label or its name, any case.
+fn parse_shown(name: &str) -> Result<Shown, String> {
+    Shown::ALL
+        .into_iter()
+        .find(|s| {
+            s.label().eq_ignore_ascii_case(name) || format!("{s:?}").eq_ignore_ascii_case(name)
+        })
+        .ok_or_else(|| format!("{name}: measured, tabulated, ggx, beckmann or glint"))
 }
 
 fn options(renderer: eframe::Renderer, gpu: &facet_gpu::GpuOptions) -> eframe::NativeOptions {
@@ -122,7 +153,7 @@ fn run_with(
         Box::new(move |cc| {
             let mut app = ViewerApp::with_default_material()
                 .map_err(|e| format!("the default material: {e}"))?;
-            if let Some(spec) = &args.material {
+            if let Some(spec) = args.input.as_ref().or(args.material.as_ref()) {
                 app.open(spec);
             }
             if let Some(s) = args.shown
@@ -181,8 +212,12 @@ fn run_with(
 fn main() -> Result<()> {
     // SAFETY: first thing in main, before any thread exists.
     unsafe { facet_gpu::ensure_runtime_dir() };
-    let Some(args) = parse()? else {
-        return Ok(());
+    let args = match Args::parse().checked() {
+        Ok(args) => args,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::exit(2);
+        }
     };
     // FACET_BACKEND / FACET_ADAPTER as everywhere else; FACET_BACKEND=cpu means no GPU.
     let gpu_options = match facet_gpu::GpuOptions::from_env() {
