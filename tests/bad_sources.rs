@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::facet_in as facet;
 use common::scratch;
 use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
 use facet_fit::fitting::{FitConfig, fit_material};
@@ -23,18 +24,6 @@ use facet_fit::sources::rgl::tensor_file::{TensorFile, TensorWriter};
 use facet_fit::{Brdf, FitError, Rgb};
 use glam::DVec3;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-/// Runs `facet` in `cwd`: (success, stdout, stderr).
-fn facet(cwd: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_facet"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .unwrap();
-    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
-    (out.status.success(), text(&out.stdout), text(&out.stderr))
-}
 
 /// Asserts a refusal: the command failed, said `needles` and did not panic.
 fn refused(what: &str, (ok, stdout, stderr): (bool, String, String), needles: &[&str]) {

@@ -13,49 +13,17 @@ fn shaders_dir() -> &'static Path {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../../shaders"))
 }
 
+/// The committed file is the generated text, naga reads back the Rust values and nothing else,
+/// and no other shader file defines one of its constants (`facet_gpu::tags::check_generated`).
 #[test]
-fn the_committed_wgsl_tags_are_the_generated_ones() {
-    let path = shaders_dir().join(FILE);
-    let generated = facet_glint::tags::wgsl();
-    if std::env::var_os("FACET_REGENERATE").is_some() {
-        std::fs::write(&path, &generated).unwrap();
-    }
-    let committed = std::fs::read_to_string(&path).unwrap();
-    assert!(
-        committed == generated,
-        "{} is not what facet_glint::tags generates; rerun with FACET_REGENERATE=1",
-        path.display()
+fn the_generated_wgsl_holds_the_rust_tags() {
+    let problems = facet_gpu::tags::check_generated(
+        shaders_dir(),
+        FILE,
+        &facet_glint::tags::wgsl(),
+        &facet_glint::tags::all(),
     );
-}
-
-/// naga's view of the constants (the file as the GPU compiles it) against the Rust values.
-#[test]
-fn naga_reads_the_rust_values() {
-    let found = facet_gpu::tags::u32_constants(&facet_glint::tags::wgsl()).unwrap();
-    let mut n = 0;
-    for set in facet_glint::tags::all() {
-        for (name, value, _) in set.tags {
-            assert_eq!(found.get(name), Some(&value), "{}: {name}", set.rust);
-            n += 1;
-        }
-    }
-    assert_eq!(
-        found.len(),
-        n,
-        "constants in the file that no Rust tag has: {found:?}"
-    );
-}
-
-/// A second definition anywhere else could drift from Rust: there is none.
-#[test]
-fn no_other_wgsl_file_defines_a_tag() {
-    let prefixes: Vec<&str> = facet_glint::tags::all().iter().map(|t| t.prefix).collect();
-    let offenders = facet_gpu::tags::defined_elsewhere(FILE, &prefixes);
-    assert!(
-        offenders.is_empty(),
-        "tags defined outside {FILE}:\n{}",
-        offenders.join("\n")
-    );
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
 
 /// facet-fit's analytic kinds map to their tags, a table to `Tabulated`.

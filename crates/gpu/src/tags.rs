@@ -140,3 +140,59 @@ pub fn defined_elsewhere(file: &str, prefixes: &[&str]) -> Vec<String> {
     }
     offenders
 }
+
+/// The checks every generated tags file passes, for the `tags` test of the crate that owns it:
+/// `shaders_dir/file` is exactly `generated` (rewritten first under `FACET_REGENERATE=1`),
+/// naga reads back from it the values of `sets` and no other constant, and no other shader file
+/// defines a constant with one of the sets' prefixes (a second definition could drift from
+/// Rust). Returns the problems found, none when all hold.
+pub fn check_generated(
+    shaders_dir: &std::path::Path,
+    file: &str,
+    generated: &str,
+    sets: &[TagSet],
+) -> Vec<String> {
+    let mut problems = Vec::new();
+    let path = shaders_dir.join(file);
+    if std::env::var_os("FACET_REGENERATE").is_some()
+        && let Err(e) = std::fs::write(&path, generated)
+    {
+        problems.push(format!("{}: cannot rewrite it: {e}", path.display()));
+    }
+    match std::fs::read_to_string(&path) {
+        Ok(committed) if committed == generated => {}
+        Ok(_) => problems.push(format!(
+            "{} is not the generated text; rerun with FACET_REGENERATE=1",
+            path.display()
+        )),
+        Err(e) => problems.push(format!("{}: {e}", path.display())),
+    }
+    match u32_constants(generated) {
+        Ok(found) => {
+            let mut n = 0;
+            for set in sets {
+                for (name, value, _) in &set.tags {
+                    if found.get(*name) != Some(value) {
+                        problems.push(format!(
+                            "{}: {name} is {:?} in the WGSL, {value} in Rust",
+                            set.rust,
+                            found.get(*name)
+                        ));
+                    }
+                    n += 1;
+                }
+            }
+            if found.len() != n {
+                problems.push(format!(
+                    "constants in {file} that no Rust tag has: {found:?}"
+                ));
+            }
+        }
+        Err(e) => problems.push(e.to_string()),
+    }
+    let prefixes: Vec<&str> = sets.iter().map(|t| t.prefix).collect();
+    for offender in defined_elsewhere(file, &prefixes) {
+        problems.push(format!("a tag defined outside {file}: {offender}"));
+    }
+    problems
+}
