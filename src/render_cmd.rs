@@ -287,6 +287,9 @@ pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) ->
     let t = std::time::Instant::now();
     let res = SceneResources::new(gpu, &job.scene, job.environment.as_ref(), job.resources)?;
     let resources = t.elapsed().as_secs_f64() * 1e3;
+    if let Some(why) = &res.built.light_tree_fallback {
+        eprintln!("notice: {why}");
+    }
     let t = std::time::Instant::now();
     let integrator = Integrator::new(&gpu.device, &res)?;
     let pipelines = t.elapsed().as_secs_f64() * 1e3;

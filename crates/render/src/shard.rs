@@ -129,6 +129,15 @@ impl Image {
                 "{w} × {h} pixels: larger than a render can be"
             )));
         }
+        // Each chunk has an 8-byte entry in the offset table, which the decoder allocates from
+        // the header: more than the file can hold is a damaged (or hostile) header.
+        let bytes = std::fs::metadata(path).map_or(0, |m| m.len());
+        if (header.chunk_count as u64).saturating_mul(8) > bytes {
+            return Err(bad(format!(
+                "the header declares {} chunks, more than the file's {bytes} bytes can hold",
+                header.chunk_count
+            )));
+        }
         let pixels = crate::scene::gltf_file::guard(path, "the OpenEXR image", || {
             read_rgb(path, w).map_err(not_exr)
         })?;

@@ -148,3 +148,55 @@ fn over_the_device_limits_is_an_error_naming_the_input() {
         .unwrap();
     assert_eq!((image.width, image.height), (32, 32));
 }
+
+/// A light BVH over this device's storage binding limit (10 000 point lights: 1.28 MB of nodes
+/// against the 1 MiB cap, their 800 kB of light records within it) is not an error: the lights
+/// are picked by the robust selection, `built` says why, and the scene renders.
+#[test]
+fn a_light_bvh_over_the_limit_falls_back_to_the_robust_selection() {
+    let Some(gpu) = small_gpu("a_light_bvh_over_the_limit_falls_back_to_the_robust_selection")
+    else {
+        return;
+    };
+    let mut scene = sphere(16, 8);
+    scene.lights = (0..10_000)
+        .map(|k| facet_render::scene::Light::Point {
+            position: Vec3::new(
+                (k % 100) as f32 * 0.05 - 2.5,
+                2.0,
+                (k / 100) as f32 * 0.05 - 2.5,
+            ),
+            intensity: Vec3::splat(0.01),
+        })
+        .collect();
+    let res = SceneResources::new(&gpu, &scene, None, ResourceConfig::standard()).unwrap();
+    let why = res
+        .built
+        .light_tree_fallback
+        .clone()
+        .expect("the tree is over the cap");
+    println!("{why}");
+    assert!(
+        why.contains("the light BVH") && why.contains("robust"),
+        "{why}"
+    );
+    assert_eq!(res.built.light_tree_nodes, 0);
+    assert_eq!(res.built.light_pmf.len(), 10_000);
+    let integrator = Integrator::new(&gpu.device, &res).unwrap();
+    let camera = CameraFrame::new(&scene.camera).unwrap();
+    let config = RenderConfig {
+        image: ImageConfig {
+            width: 16,
+            height: 16,
+            wavefront: 256,
+        },
+        sampling: SampleConfig {
+            spp: 1,
+            ..SampleConfig::preview()
+        },
+    };
+    let (image, _) = integrator
+        .render(&gpu, &res, &camera, &config, &mut |_| {})
+        .unwrap();
+    assert!(image.mean()[0] > 0.0, "the lamps light the sphere");
+}

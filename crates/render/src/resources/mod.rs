@@ -64,6 +64,9 @@ pub struct Built {
     pub light_tree_nodes: usize,
     /// Time to build the light BVH, milliseconds.
     pub light_tree_ms: f64,
+    /// Why the light BVH asked for was not used (over the adapter's storage binding limit):
+    /// the lights are then picked by [`LightSelection::Robust`].
+    pub light_tree_fallback: Option<String>,
 }
 
 /// One glint material's GPU resources (bind group 2 of its shading stage).
@@ -189,8 +192,20 @@ impl SceneResources {
         let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
         built.environment_map = env.kind == crate::tags::EnvKind::Map;
         let t = std::time::Instant::now();
-        let selection = light_set.selection(config.light_selection);
+        let mut selection = light_set.selection(config.light_selection);
         built.light_tree_ms = t.elapsed().as_secs_f64() * 1e3;
+        let tree_bytes = product(&[
+            selection.tree.nodes.len() as u64,
+            std::mem::size_of::<GpuLightNode>() as u64,
+        ]);
+        if let Err(e) = limits.check(&[Planned::storage(
+            "the light BVH",
+            tree_bytes,
+            format!("the scene's {} lights", light_set.lights.len()),
+        )]) {
+            built.light_tree_fallback = Some(format!("{e}; lights picked by the robust selection"));
+            selection = light_set.selection(LightSelection::Robust);
+        }
         let light_cdf = LightSet::place_cdf(&selection.cdf_pmf, &mut tables);
         built.light_pmf = selection.cdf_pmf;
         built.light_tree_share = selection.tree_share;
