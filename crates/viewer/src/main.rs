@@ -67,25 +67,21 @@ impl Args {
         if let Some(spec) = spec
             && let Some(path) = facet_fit::sources::InputSpec::parse(spec).path()
         {
-            std::fs::metadata(path).map_err(|e| {
-                anyhow::anyhow!(
-                    "{}: {}",
-                    path.display(),
-                    facet_fit::io::input::io_problem(&e)
-                )
-            })?;
+            readable(path, "")?;
         }
         if let Some(scene) = &self.scene {
-            std::fs::metadata(scene).map_err(|e| {
-                anyhow::anyhow!(
-                    "--scene {}: {}",
-                    scene.display(),
-                    facet_fit::io::input::io_problem(&e)
-                )
-            })?;
+            readable(scene, "--scene ")?;
         }
         Ok(self)
     }
+}
+
+/// `Err` naming `flag` and `path` when the file cannot be read.
+fn readable(path: &std::path::Path, flag: &str) -> Result<()> {
+    std::fs::metadata(path).map(|_| ()).map_err(|e| {
+        let problem = facet_fit::io::input::io_problem(&e);
+        anyhow::anyhow!("{flag}{}: {problem}", path.display())
+    })
 }
 
 /// A `--shown` value: a model's label or its name, any case.

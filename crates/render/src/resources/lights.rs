@@ -134,10 +134,8 @@ impl LightSet {
             near: (1e-3 * radius).powi(2),
         };
         for l in &scene.lights {
-            let (g, p) = punctual_record(l, radius);
-            if set.push(g, p, probes.punctual_contribution(l)) {
-                *set.bounds.last_mut().expect("pushed") = punctual_bounds(l);
-            }
+            let (g, p, bounds) = punctual_record(l, radius);
+            set.push_bounded(g, p, probes.punctual_contribution(l), bounds);
         }
         set.add_emissive_triangles(scene, materials, &probes);
         if set.triangle_light.is_empty() {
@@ -188,16 +186,26 @@ impl LightSet {
         }
     }
 
-    /// Adds a light (with no bounds: outside the light BVH) if its power is positive; returns
-    /// whether it did.
-    pub fn push(&mut self, light: GpuLight, power: f32, contribution: f32) -> bool {
+    /// Adds a light outside the light BVH (the environment) if its power is positive.
+    pub fn push(&mut self, light: GpuLight, power: f32, contribution: f32) {
+        self.push_bounded(light, power, contribution, None);
+    }
+
+    /// Adds a light with its bounds for the light BVH (None: outside it) if its power is
+    /// positive.
+    fn push_bounded(
+        &mut self,
+        light: GpuLight,
+        power: f32,
+        contribution: f32,
+        bounds: Option<LightBounds>,
+    ) {
         if power > 0.0 {
             self.lights.push(light);
             self.power.push(power);
             self.contribution.push(contribution.max(0.0));
-            self.bounds.push(None);
+            self.bounds.push(bounds);
         }
-        power > 0.0
     }
 
     /// How `selection` picks the lights: the CDF, and for `Bvh` the tree over the lights with
@@ -346,33 +354,10 @@ impl ProbeMean {
     }
 }
 
-/// Punctual light `l`'s bounds for the light BVH (None for a directional light).
-fn punctual_bounds(l: &Light) -> Option<LightBounds> {
-    match *l {
-        Light::Point {
-            position,
-            intensity,
-        } => Some(LightBounds::point(position, luminance(intensity))),
-        Light::Spot {
-            position,
-            direction,
-            intensity,
-            inner_cone,
-            outer_cone,
-        } => Some(LightBounds::spot(
-            position,
-            direction,
-            luminance(intensity),
-            inner_cone,
-            outer_cone,
-        )),
-        Light::Directional { .. } => None,
-    }
-}
-
-/// Punctual light `l`'s record and power; `radius` bounds the scene (a directional light's
-/// power is its flux through that disc).
-fn punctual_record(l: &Light, radius: f32) -> (GpuLight, f32) {
+/// Punctual light `l`'s record, power and bounds for the light BVH (None for a directional
+/// light, which stays outside the tree); `radius` bounds the scene (a directional light's power
+/// is its flux through that disc).
+fn punctual_record(l: &Light, radius: f32) -> (GpuLight, f32, Option<LightBounds>) {
     match *l {
         Light::Point {
             position,
@@ -385,6 +370,7 @@ fn punctual_record(l: &Light, radius: f32) -> (GpuLight, f32) {
                 ..Default::default()
             },
             4.0 * PI * luminance(intensity),
+            Some(LightBounds::point(position, luminance(intensity))),
         ),
         Light::Spot {
             position,
@@ -403,6 +389,13 @@ fn punctual_record(l: &Light, radius: f32) -> (GpuLight, f32) {
                 ..Default::default()
             },
             2.0 * PI * (1.0 - outer_cone.cos()) * luminance(intensity),
+            Some(LightBounds::spot(
+                position,
+                direction,
+                luminance(intensity),
+                inner_cone,
+                outer_cone,
+            )),
         ),
         Light::Directional {
             direction,
@@ -415,6 +408,7 @@ fn punctual_record(l: &Light, radius: f32) -> (GpuLight, f32) {
                 ..Default::default()
             },
             PI * radius * radius * luminance(irradiance),
+            None,
         ),
     }
 }

@@ -191,41 +191,18 @@ impl SceneResources {
         built.emissive_triangles = light_set.emissive_triangles();
         let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
         built.environment_map = env.kind == crate::tags::EnvKind::Map;
-        let t = std::time::Instant::now();
-        let mut selection = light_set.selection(config.light_selection);
-        built.light_tree_ms = t.elapsed().as_secs_f64() * 1e3;
-        let tree_bytes = product(&[
-            selection.tree.nodes.len() as u64,
-            std::mem::size_of::<GpuLightNode>() as u64,
-        ]);
-        if let Err(e) = limits.check(&[Planned::storage(
-            "the light BVH",
-            tree_bytes,
-            format!("the scene's {} lights", light_set.lights.len()),
-        )]) {
-            built.light_tree_fallback = Some(format!("{e}; lights picked by the robust selection"));
-            selection = light_set.selection(LightSelection::Robust);
-        }
-        let light_cdf = LightSet::place_cdf(&selection.cdf_pmf, &mut tables);
-        built.light_pmf = selection.cdf_pmf;
-        built.light_tree_share = selection.tree_share;
-        built.light_tree_nodes = selection.tree.nodes.len();
-        let LightSet {
-            mut lights,
+        let PlacedLights {
+            lights,
             triangle_light,
-            ..
-        } = light_set;
-        for (l, leaf) in lights.iter_mut().zip(&selection.tree.leaf_of) {
-            l.leaf = *leaf;
-        }
-        built.lights = lights.len();
-        if lights.is_empty() {
-            lights.push(GpuLight::default());
-        }
-        let mut light_tree = selection.tree.nodes;
-        if light_tree.is_empty() {
-            light_tree.push(GpuLightNode::default());
-        }
+            light_tree,
+            light_cdf,
+        } = place_lights(
+            light_set,
+            config.light_selection,
+            &limits,
+            &mut tables,
+            &mut built,
+        );
         if tables.words.is_empty() {
             tables.words.push(0.0);
         }
@@ -276,6 +253,68 @@ impl SceneResources {
             built,
         })?;
         Ok(res)
+    }
+}
+
+/// The lights as uploaded: their records, the light of each triangle, the light BVH's nodes
+/// (one unused node without a tree) and the word offset of the selection CDF in the tables.
+struct PlacedLights {
+    lights: Vec<GpuLight>,
+    triangle_light: Vec<u32>,
+    light_tree: Vec<GpuLightNode>,
+    light_cdf: u32,
+}
+
+/// The lights of `light_set` picked by `selection`: its CDF placed in `tables`, the tree built
+/// (or, over the device's storage binding limit, the robust selection instead, said in
+/// `built`), every light's leaf recorded; never empty buffers.
+fn place_lights(
+    light_set: LightSet,
+    selection: LightSelection,
+    limits: &DeviceLimits,
+    tables: &mut Tables,
+    built: &mut Built,
+) -> PlacedLights {
+    let t = std::time::Instant::now();
+    let mut picked = light_set.selection(selection);
+    built.light_tree_ms = t.elapsed().as_secs_f64() * 1e3;
+    let tree_bytes = product(&[
+        picked.tree.nodes.len() as u64,
+        std::mem::size_of::<GpuLightNode>() as u64,
+    ]);
+    if let Err(e) = limits.check(&[Planned::storage(
+        "the light BVH",
+        tree_bytes,
+        format!("the scene's {} lights", light_set.lights.len()),
+    )]) {
+        built.light_tree_fallback = Some(format!("{e}; lights picked by the robust selection"));
+        picked = light_set.selection(LightSelection::Robust);
+    }
+    let light_cdf = LightSet::place_cdf(&picked.cdf_pmf, tables);
+    built.light_pmf = picked.cdf_pmf;
+    built.light_tree_share = picked.tree_share;
+    built.light_tree_nodes = picked.tree.nodes.len();
+    let LightSet {
+        mut lights,
+        triangle_light,
+        ..
+    } = light_set;
+    for (l, leaf) in lights.iter_mut().zip(&picked.tree.leaf_of) {
+        l.leaf = *leaf;
+    }
+    built.lights = lights.len();
+    if lights.is_empty() {
+        lights.push(GpuLight::default());
+    }
+    let mut light_tree = picked.tree.nodes;
+    if light_tree.is_empty() {
+        light_tree.push(GpuLightNode::default());
+    }
+    PlacedLights {
+        lights,
+        triangle_light,
+        light_tree,
+        light_cdf,
     }
 }
 
