@@ -31,6 +31,11 @@ struct Material {
     fresnel_count: u32,
     tab_offset: u32,
     queue: u32,
+    // a measured material's table: its MERL grid or its RGL block in `tables`
+    measured_offset: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 }
 
 // Rust: facet_render::gpu_types::GpuLight.

@@ -4,6 +4,8 @@
 // tables (TABULATED = 1), the correlated G2. Sampling, with probability p_spec: the normals
 // visible from ωo (by frame.ndf_sampling: analytic in closed form, tabulated by the table's
 // visible slices); else the cosine lobe when the fit has a diffuse term.
+// MEASURED = 1 (with TABULATED = 1): f is a measured MERL-grid table (render/merl.inc.wgsl),
+// sampled as its fit's tabulated model is.
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -11,9 +13,11 @@
 #include "render/scene.inc.wgsl"
 #include "render/shade.inc.wgsl"
 #include "render/tabulated.inc.wgsl"
+#include "render/merl.inc.wgsl"
 
 override Q_SHADE: u32;
 override TABULATED: bool;
+override MEASURED: bool;
 
 struct Bsdf {
     material: u32,
@@ -36,6 +40,9 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     let spec = luminance(fresnel_table(m, 1.0));
     let diff = luminance(b.diffuse);
     b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
+    if (frame.ndf_sampling == NDF_SAMPLING_COSINE) {
+        b.p_spec = 0.0;
+    }
     return b;
 }
 
@@ -77,6 +84,9 @@ fn mf_sample_h(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
 fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return vec3<f32>(0.0);
+    }
+    if (MEASURED) {
+        return merl_eval(materials[b.material].measured_offset, wi, wo);
     }
     let h = normalize(wi + wo);
     let f = fresnel_table(materials[b.material], dot(wi, h));

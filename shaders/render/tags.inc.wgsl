@@ -6,6 +6,7 @@ const MAT_GLTF: u32 = 0u; // a glTF metallic-roughness material
 const MAT_ANALYTIC: u32 = 1u; // a fit's GGX or Beckmann model
 const MAT_TABULATED: u32 = 2u; // a fit's tabulated NDF
 const MAT_GLINT: u32 = 3u; // a glint material
+const MAT_MEASURED: u32 = 4u; // a measurement: a MERL-grid table or an RGL `.bsdf`
 
 // facet_render::tags::LightKind
 const LIGHT_POINT: u32 = 0u; // KHR_lights_punctual point light
@@ -27,6 +28,7 @@ const STRATEGY_BSDF: u32 = 2u; // BSDF sampling alone: only delta lights (point,
 // facet_render::tags::NdfSampling
 const NDF_SAMPLING_VISIBLE: u32 = 0u; // the normals visible from ωo (Heitz 2018): the default
 const NDF_SAMPLING_D_COS: u32 = 1u; // D(h) cos θh, the older choice, kept to measure against
+const NDF_SAMPLING_COSINE: u32 = 2u; // the cosine lobe alone, in the microfacet and measured MERL stages: the reference
 
 // facet_render::tags::Region
 const R_ORIGIN: u32 = 0u; // xyz origin, w cone width at the origin

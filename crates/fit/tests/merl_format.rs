@@ -130,3 +130,58 @@ fn interpolated_lookup_beats_nearest_between_bins() {
     );
     assert!(e_interp < 0.25 * e_near);
 }
+
+/// `filled()` keeps every valid sample bit for bit and fills each missing one along θd
+/// between the valid samples of its (θh, φd) line: linearly inside the line, held past its
+/// ends. A sampled GGX table is missing below the horizon; knocking out interior samples of a
+/// line gives the linear case, whose answer is known exactly.
+#[test]
+fn filled_table_keeps_valid_samples_and_fills_missing_ones_along_theta_d() {
+    use facet_fit::model::merl_grid::{THETA_D_RES, THETA_H_RES, index};
+    let mut table = spec_table("ggx?alpha=0.3&f0=0.04");
+    let before = table.missing_count();
+    assert!(before > 0, "a sampled table misses its below-horizon bins");
+    let (i, k) = (30, 40);
+    let known: Vec<_> = (0..THETA_D_RES).map(|j| table.value(i, j, k)).collect();
+    for j in 11..14 {
+        table.mark_missing(index(i, j, k));
+    }
+    let filled = table.filled();
+    assert_eq!(
+        filled.missing_count(),
+        0,
+        "every line of a GGX table has valid samples"
+    );
+    for s in (0..SAMPLES).step_by(7) {
+        if let Some(v) = table.value_at(s) {
+            assert_eq!(filled.value_at(s), Some(v), "sample {s} changed");
+        }
+    }
+    let (a, b) = (known[10].unwrap(), known[14].unwrap());
+    for j in 11..14 {
+        let t = (j - 10) as f64 / 4.0;
+        let got = filled.value(i, j, k).unwrap();
+        for c in 0..3 {
+            let want = a[c] + t * (b[c] - a[c]);
+            assert!(
+                (got[c] - want).abs() <= 1e-12 * want.abs().max(1e-9),
+                "θd bin {j}"
+            );
+        }
+    }
+    // Past a line's last valid sample the value is held.
+    let (i, k) = (THETA_H_RES - 1, 0);
+    let last = (0..THETA_D_RES)
+        .rev()
+        .find(|&j| table.value(i, j, k).is_some())
+        .unwrap();
+    assert!(
+        last + 1 < THETA_D_RES,
+        "grazing half vectors miss their high θd bins"
+    );
+    let held = table.value(i, last, k).unwrap();
+    for j in last + 1..THETA_D_RES {
+        let got = filled.value(i, j, k).unwrap();
+        (0..3).for_each(|c| assert!((got[c] - held[c]).abs() <= 1e-12 * held[c].max(1e-9)));
+    }
+}

@@ -104,6 +104,11 @@ pub struct GpuMaterial {
     pub tab_offset: u32,
     /// The shading queue its hits go to.
     pub queue: u32,
+    /// A measured material's table (its MERL grid or its RGL block) in the scene tables.
+    pub measured_offset: u32,
+    pub pad0: u32,
+    pub pad1: u32,
+    pub pad2: u32,
 }
 
 /// WGSL `Light`.

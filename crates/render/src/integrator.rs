@@ -63,6 +63,25 @@ pub enum StageClock {
     Wall,
 }
 
+/// The override constants of the microfacet stage serving `q`: its queue, whether its NDF is
+/// tabulated, whether f is a measured MERL table (sampled by its fit's tabulated NDF), and the
+/// MERL grid's sizes.
+fn microfacet_constants(q: Queue) -> [(&'static str, f64); 6] {
+    use facet_fit::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES};
+    let flag = |b: bool| b as u32 as f64;
+    [
+        ("Q_SHADE", q.index() as f64),
+        (
+            "TABULATED",
+            flag(matches!(q, Queue::Tabulated | Queue::Merl)),
+        ),
+        ("MEASURED", flag(q == Queue::Merl)),
+        ("MERL_THETA_H", THETA_H_RES as f64),
+        ("MERL_THETA_D", THETA_D_RES as f64),
+        ("MERL_PHI_D", PHI_D_RES as f64),
+    ]
+}
+
 /// The stage pipelines for one scene: only the shading stages of the classes it uses.
 pub struct Integrator {
     layouts: Layouts,
@@ -98,14 +117,11 @@ impl Integrator {
                     Some(q),
                     &q_shade,
                 )?,
-                Queue::Analytic | Queue::Tabulated => stage(
+                Queue::Analytic | Queue::Tabulated | Queue::Merl => stage(
                     "render/shade_microfacet.wgsl",
                     "shade_microfacet",
                     Some(q),
-                    &[
-                        q_shade[0],
-                        ("TABULATED", (q == Queue::Tabulated) as u32 as f64),
-                    ],
+                    &microfacet_constants(q),
                 )?,
                 Queue::Glint(_) => {
                     let mut c = facet_glint::gpu::flake_constants();

@@ -19,6 +19,10 @@ pub enum Queue {
     Analytic,
     /// Hits on fitted materials with their tabulated NDF.
     Tabulated,
+    /// Hits on measured MERL-grid tables.
+    Merl,
+    /// Hits on measured RGL `.bsdf` files.
+    Rgl,
     /// Hits on glint material k.
     Glint(u32),
 }
@@ -32,7 +36,9 @@ impl Queue {
             Queue::Diffuse => 3,
             Queue::Analytic => 4,
             Queue::Tabulated => 5,
-            Queue::Glint(k) => 6 + k,
+            Queue::Merl => 6,
+            Queue::Rgl => 7,
+            Queue::Glint(k) => 8 + k,
         }
     }
 
@@ -42,6 +48,8 @@ impl Queue {
             Queue::Diffuse => "diffuse",
             Queue::Analytic => "analytic",
             Queue::Tabulated => "tabulated",
+            Queue::Merl => "measured MERL",
+            Queue::Rgl => "measured RGL",
             Queue::Glint(_) => "glint",
             _ => "none",
         }
@@ -49,7 +57,7 @@ impl Queue {
 
     /// Number of queues for a scene with `glints` glint materials.
     pub const fn count(glints: u32) -> u32 {
-        6 + glints
+        8 + glints
     }
 
     /// Override constants naming the fixed queues in WGSL.

@@ -20,6 +20,8 @@ tags!(
         Tabulated = 2 => "TABULATED",
         /// a glint material
         Glint = 3 => "GLINT",
+        /// a measurement: a MERL-grid table or an RGL `.bsdf`
+        Measured = 4 => "MEASURED",
     }
 );
 
@@ -79,6 +81,9 @@ tags!(
         Visible = 0 => "VISIBLE",
         /// D(h) cos θh, the older choice, kept to measure against
         DCos = 1 => "D_COS",
+        /// the cosine lobe alone, in the microfacet and measured MERL stages: the reference
+        /// that tests compare an importance sampling against
+        Cosine = 2 => "COSINE",
     }
 );
 

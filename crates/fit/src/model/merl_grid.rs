@@ -218,6 +218,41 @@ impl MerlTable {
         (0..SAMPLES).filter(|&s| self.value_at(s).is_none()).count()
     }
 
+    /// The table a renderer reads: each missing sample takes the value interpolated along θd
+    /// between the valid samples of its (θh, φd) line, held constant past the first and last
+    /// of them — the rule the fit fills its Fresnel curve by — so that an interpolated lookup
+    /// near the horizon or a gap blends measured values instead of dropping corners. A line with
+    /// no valid sample stays missing.
+    pub fn filled(&self) -> MerlTable {
+        let mut out = self.clone();
+        if self.missing_count() == 0 {
+            return out;
+        }
+        let raw = out.values_mut();
+        for i in 0..THETA_H_RES {
+            for k in 0..PHI_D_RES {
+                let line: Vec<Option<Rgb>> =
+                    (0..THETA_D_RES).map(|j| self.value(i, j, k)).collect();
+                if line.iter().all(Option::is_some) {
+                    continue;
+                }
+                let Some(filled) = crate::numerics::interp::fill_missing(&line) else {
+                    continue;
+                };
+                for (j, v) in filled
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| line[*j].is_none())
+                {
+                    for c in 0..3 {
+                        raw[c * SAMPLES + index(i, j, k)] = (v[c] / SCALE[c]).to_le_bytes();
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// MERL's own lookup: the bin containing the angles (sqrt mapping on θh, φd folded by
     /// reciprocity), indices clamped to the table.
     pub fn lookup_nearest(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {

@@ -5,10 +5,13 @@ use super::tables::Tables;
 use crate::error::RenderError;
 use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
-use crate::scene::{GlintParams, Material};
-use facet_fit::model::microfacet::{Ndf, NdfKind};
+use crate::scene::{GlintParams, Material, MeasuredMaterial, Measurement};
+use facet_fit::model::material::FittedMaterial;
+use facet_fit::model::merl_grid::{MerlTable, SAMPLES};
+use facet_fit::model::microfacet::{MicrofacetBrdf, Ndf, NdfKind};
 use facet_fit::model::tabulated::TabulatedNdf;
 use facet_glint::tags::NdfTag;
+use std::sync::Arc;
 
 /// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
 pub const FRESNEL_NODES: usize = 91;
@@ -58,6 +61,11 @@ impl MaterialSlot {
         self.queue
     }
 
+    /// Points the record at its measured table in `tables`.
+    pub(crate) fn set_measured_offset(&mut self, offset: u32) {
+        self.gpu.measured_offset = offset;
+    }
+
     /// Routes the material's hits to `queue`.
     pub(crate) fn set_queue(&mut self, queue: Queue) {
         self.queue = queue;
@@ -91,6 +99,8 @@ pub struct MaterialPlan<'a> {
     pub tabulated: Option<&'a TabulatedNdf>,
     /// A glint material's NDF and parameters.
     pub glint: Option<(Ndf, GlintParams)>,
+    /// A measured material's data, placed once per scene however many materials share it.
+    pub measured: Option<&'a Arc<Measurement>>,
 }
 
 impl MaterialPlan<'_> {
@@ -99,6 +109,9 @@ impl MaterialPlan<'_> {
     pub fn fits_in_place_of(&self, old: &MaterialSlot) -> Result<(), &'static str> {
         if self.glint.is_some() || old.kind == MaterialKind::Glint {
             return Err("glint materials are rebuilt");
+        }
+        if self.measured.is_some() || old.kind == MaterialKind::Measured {
+            return Err("measured materials are rebuilt");
         }
         if self.slot.kind != old.kind || self.slot.ndf != old.ndf {
             return Err("the material class changed");
@@ -145,14 +158,34 @@ pub fn tabulated_block(tab: &TabulatedNdf) -> Vec<f32> {
     block
 }
 
+/// A MERL-grid table as shaders/render/merl.inc.wgsl reads it: f_r per sample, RGB
+/// interleaved, −1 where missing.
+pub fn merl_block(table: &MerlTable) -> Vec<f32> {
+    (0..SAMPLES)
+        .flat_map(|s| match table.value_at(s) {
+            Some(v) => v.map(|x| x as f32),
+            None => [-1.0; 3],
+        })
+        .collect()
+}
+
+/// A measurement's block in the `tables` buffer: a MERL grid ([`merl_block`]) or an RGL file.
+pub fn measured_block(data: &Measurement) -> Vec<f32> {
+    match data {
+        Measurement::Merl(table) => merl_block(table),
+        Measurement::Rgl(_) => todo!("RGL on the GPU"),
+    }
+}
+
 fn texture(t: Option<u32>) -> u32 {
     t.unwrap_or(NONE)
 }
 
 /// The plan of material `m`. A fitted material takes its model's NDF, Fresnel and diffuse term;
-/// a glint material renders that model's NDF (analytic or tabulated) as flakes.
+/// a glint material renders that model's NDF (analytic or tabulated) as flakes; a measured
+/// material is evaluated from its table, a MERL-grid one sampled by its fit's tabulated model.
 pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
-    let mut gpu = GpuMaterial {
+    let gpu = GpuMaterial {
         base_color: m.base_color.to_array(),
         emissive: m.emissive.extend(m.specular).to_array(),
         alpha_x: 1.0,
@@ -166,12 +199,16 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
         tex_emissive: texture(m.emissive_texture),
         ..Default::default()
     };
+    if let Some(measured) = &m.measured {
+        return plan_measured(gpu, m, measured);
+    }
     let Some(f) = &m.facet else {
         return Ok(MaterialPlan {
             slot: MaterialSlot::new(gpu, MaterialKind::Gltf, None, Queue::Diffuse),
             fresnel: None,
             tabulated: None,
             glint: None,
+            measured: None,
         });
     };
     let brdf = f.fit.model(f.model).ok_or_else(|| {
@@ -180,6 +217,23 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
             format!("material {:?}: the fit has no {:?} model", m.name, f.model),
         )
     })?;
+    let mut plan = plan_model(gpu, brdf, &f.fit);
+    // A glint material keeps its NDF's parameters (and a tabulated one its tables) for the
+    // glint stage's D, Λ and sampling.
+    plan.glint = f.glint.map(|g| {
+        plan.slot.kind = MaterialKind::Glint;
+        plan.slot.gpu.kind = MaterialKind::Glint as u32;
+        (brdf.ndf.clone(), g)
+    });
+    Ok(plan)
+}
+
+/// The plan of a fitted model `brdf` (of `fit`): its Fresnel table, diffuse term and NDF.
+fn plan_model<'a>(
+    mut gpu: GpuMaterial,
+    brdf: &'a MicrofacetBrdf,
+    fit: &FittedMaterial,
+) -> MaterialPlan<'a> {
     let fresnel: Vec<f32> = (0..FRESNEL_NODES)
         .flat_map(|j| {
             let theta_d = j as f64 / (FRESNEL_NODES - 1) as f64 * std::f64::consts::FRAC_PI_2;
@@ -193,7 +247,7 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
         0.0,
     ];
     let mut tabulated = None;
-    let (mut kind, ndf, queue) = match &brdf.ndf {
+    let (kind, ndf, queue) = match &brdf.ndf {
         Ndf::Analytic(a) => {
             gpu.ndf_kind = NdfTag::from(a.kind) as u32;
             (gpu.alpha_x, gpu.alpha_y) = (a.alpha_x as f32, a.alpha_y as f32);
@@ -203,8 +257,7 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
         }
         Ndf::Tabulated(tab) => {
             // The ray cone widens by the fit's GGX α where there is one.
-            let cone_alpha = f
-                .fit
+            let cone_alpha = fit
                 .record
                 .ggx
                 .as_ref()
@@ -217,16 +270,51 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
             (MaterialKind::Tabulated, None, Queue::Tabulated)
         }
     };
-    // A glint material keeps its NDF's parameters (and a tabulated one its tables) for the
-    // glint stage's D, Λ and sampling.
-    let glint = f.glint.map(|g| {
-        kind = MaterialKind::Glint;
-        (brdf.ndf.clone(), g)
-    });
-    Ok(MaterialPlan {
+    MaterialPlan {
         slot: MaterialSlot::new(gpu, kind, ndf, queue),
         fresnel: Some(fresnel),
         tabulated,
-        glint,
-    })
+        glint: None,
+        measured: None,
+    }
+}
+
+/// The plan of a measured material: a MERL-grid table with its fit's tabulated model (for
+/// sampling and the lobe choice), or an RGL file alone. The table's offset is set when it is
+/// placed.
+fn plan_measured<'a>(
+    gpu: GpuMaterial,
+    m: &Material,
+    measured: &'a MeasuredMaterial,
+) -> Result<MaterialPlan<'a>, RenderError> {
+    let mut plan = match (&*measured.data, &measured.fit) {
+        (Measurement::Merl(_), None) => {
+            return Err(RenderError::Scene(format!(
+                "material `{}`: the MERL-grid measurement {} has no fit to be sampled by \
+                 (MeasuredMaterial::open fits one)",
+                m.name, measured.source
+            )));
+        }
+        (Measurement::Merl(_), Some(fit)) => {
+            let mut plan = plan_model(gpu, &fit.tabulated, fit);
+            plan.slot = MaterialSlot::new(plan.slot.gpu, MaterialKind::Measured, None, Queue::Merl);
+            plan
+        }
+        (Measurement::Rgl(_), _) => {
+            // The ray cone widens as for a moderately rough lobe: the file states no α.
+            let gpu = GpuMaterial {
+                roughness: 0.3,
+                ..gpu
+            };
+            MaterialPlan {
+                slot: MaterialSlot::new(gpu, MaterialKind::Measured, None, Queue::Rgl),
+                fresnel: None,
+                tabulated: None,
+                glint: None,
+                measured: None,
+            }
+        }
+    };
+    plan.measured = Some(&measured.data);
+    Ok(plan)
 }

@@ -20,7 +20,7 @@ use crate::error::RenderError;
 use crate::gpu_types::{GpuLight, GpuMaterial, GpuSceneInfo};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
-use crate::scene::{Environment, GlintParams, Scene};
+use crate::scene::{Environment, GlintParams, Measurement, Scene};
 use facet_fit::model::microfacet::Ndf;
 use facet_glint::dpf::DpfConfig;
 use facet_glint::gpu::GpuDpf;
@@ -28,6 +28,7 @@ use facet_gpu::{Gpu, buffer};
 use light_bvh::GpuLightNode;
 pub use lights::LightSelection;
 use lights::LightSet;
+use std::sync::Arc;
 use tables::Tables;
 
 /// The record of what was built for a scene.
@@ -44,6 +45,8 @@ pub struct Built {
     pub environment_map: bool,
     /// Tabulated NDFs uploaded.
     pub tabulated_tables: usize,
+    /// Measured tables uploaded (one per measurement, however many materials share it).
+    pub measured_tables: usize,
     /// Triangles with emission.
     pub emissive_triangles: usize,
     /// Lights of every kind.
@@ -380,13 +383,28 @@ fn plan_materials(
 ) -> Result<(Vec<MaterialSlot>, Vec<GlintSpec>), RenderError> {
     let mut slots = Vec::with_capacity(scene.materials.len());
     let mut glint_specs = Vec::new();
+    // Each measurement's table once, however many materials render it.
+    let mut measured_at: Vec<(*const Measurement, u32)> = Vec::new();
     for (mi, m) in scene.materials.iter().enumerate() {
         let mut plan = materials::plan(m)?;
-        if let Some(f) = &m.facet {
-            plan.place_tables(
-                tables,
-                &format!("the fit {} of material `{}`", f.source.display(), m.name),
-            );
+        let what = match (&m.measured, &m.facet) {
+            (Some(mm), _) => format!("the measurement {} of material `{}`", mm.source, m.name),
+            (None, Some(f)) => format!("the fit {} of material `{}`", f.source.display(), m.name),
+            (None, None) => String::new(),
+        };
+        plan.place_tables(tables, &what);
+        if let Some(data) = plan.measured {
+            let key = Arc::as_ptr(data);
+            let offset = match measured_at.iter().find(|(k, _)| *k == key) {
+                Some(&(_, at)) => at,
+                None => {
+                    let at = tables.push(&what, materials::measured_block(data));
+                    built.measured_tables += 1;
+                    measured_at.push((key, at));
+                    at
+                }
+            };
+            plan.slot.set_measured_offset(offset);
         }
         if plan.tabulated.is_some() {
             built.tabulated_tables += 1;

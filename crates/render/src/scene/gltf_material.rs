@@ -4,10 +4,14 @@
 //! ```json
 //! "extras": {"facet": {"fit": "path/to/fit.json", "model": "tabulated|ggx|beckmann",
 //!                      "glint": {"density": 1e6, "gamma_deg": 2.0, "threshold": 50.0}}}
+//! "extras": {"facet": {"model": "measured", "source": "gold-paint.binary|nbrdf:NAME|x.bsdf",
+//!                      "fit": "optional/fit.json"}}
 //! ```
 //!
-//! The fit path is relative to the glTF file's folder; `model` defaults to `tabulated`;
-//! `glint.density` is required, `gamma_deg` defaults to 2 and `threshold` to 50.
+//! Paths are relative to the glTF file's folder; `model` defaults to `tabulated`;
+//! `glint.density` is required, `gamma_deg` defaults to 2 and `threshold` to 50. A `measured`
+//! material renders its `source` ([`MeasuredMaterial`]); its `fit`, optional, is the NDF that
+//! samples a MERL-grid table (one is fitted on load without it).
 //! Images are decoded here, one at a time, so that a missing or broken image only costs its
 //! texture (a warning naming the image, its file and the problem, and the material), never the
 //! whole scene. An image file is read through [`facet_fit::io::input`] ([`Cap::TEXTURE`]); its header
@@ -17,7 +21,7 @@
 
 use super::gltf_buffers::Buffers;
 use super::uri::{UriTarget, resolve};
-use super::{FacetMaterial, GlintParams, Material, Texture};
+use super::{FacetMaterial, GlintParams, Material, MeasuredMaterial, Texture};
 use crate::error::RenderError;
 use facet_fit::io::input::{self, Cap};
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
@@ -36,6 +40,9 @@ pub struct FacetExtras {
     pub model: ModelChoice,
     /// Glint parameters, for a glint material.
     pub glint: Option<GlintParams>,
+    /// `model: "measured"`: the measurement named by `source`, as written (a path relative to
+    /// the glTF's folder, or `nbrdf:NAME`).
+    pub measured: Option<String>,
 }
 
 /// Parses `extras` (the whole object) of material `material`. `Ok(None)` when it has no `facet`.
@@ -57,20 +64,54 @@ pub fn parse_facet_extras(
         Some(Value::String(s)) => Some(base.join(s)),
         Some(other) => return Err(bad(format!("extras.facet.fit is not a string: {other}"))),
     };
-    let model = match facet.get("model") {
-        None => ModelChoice::Tabulated,
-        Some(Value::String(s)) => ModelChoice::parse(s).ok_or_else(|| {
-            bad(format!(
-                "unknown extras.facet.model `{s}` (tabulated, ggx or beckmann)"
-            ))
-        })?,
+    let (model, is_measured) = match facet.get("model") {
+        None => (ModelChoice::Tabulated, false),
+        Some(Value::String(s)) if s == "measured" => (ModelChoice::Tabulated, true),
+        Some(Value::String(s)) => (
+            ModelChoice::parse(s).ok_or_else(|| {
+                bad(format!(
+                    "unknown extras.facet.model `{s}` (tabulated, ggx, beckmann or measured)"
+                ))
+            })?,
+            false,
+        ),
         Some(other) => return Err(bad(format!("extras.facet.model is not a string: {other}"))),
+    };
+    let measured = match (facet.get("source"), is_measured) {
+        (Some(Value::String(s)), true) => Some(s.clone()),
+        (None, true) => {
+            return Err(bad(
+                "extras.facet.model is \"measured\" but no `source` names the measurement".into(),
+            ));
+        }
+        (Some(Value::String(_)), false) => {
+            return Err(bad(
+                "extras.facet.source names a measurement, which only model \"measured\" renders"
+                    .into(),
+            ));
+        }
+        (Some(other), _) => {
+            return Err(bad(format!("extras.facet.source is not a string: {other}")));
+        }
+        (None, false) => None,
     };
     let glint = match facet.get("glint") {
         None => None,
+        Some(_) if is_measured => {
+            return Err(bad(
+                "extras.facet.glint: glints render a model's NDF as flakes; a measured material \
+                 has no model"
+                    .into(),
+            ));
+        }
         Some(g) => Some(parse_glint(g).map_err(|m| bad(format!("extras.facet.glint: {m}")))?),
     };
-    Ok(Some(FacetExtras { fit, model, glint }))
+    Ok(Some(FacetExtras {
+        fit,
+        model,
+        glint,
+        measured,
+    }))
 }
 
 /// Validates glint parameters: density > 0, 0 < γ ≤ 90°, threshold ≥ 0.
@@ -136,6 +177,8 @@ pub(crate) struct MaterialLoader<'a> {
     /// Scene texture index by (image index, sRGB).
     textures: HashMap<(usize, bool), u32>,
     fits: HashMap<PathBuf, Arc<FittedMaterial>>,
+    /// Measured materials by source (resolved) and sampling fit.
+    measurements: HashMap<(PathBuf, Option<*const FittedMaterial>), MeasuredMaterial>,
 }
 
 impl<'a> MaterialLoader<'a> {
@@ -152,16 +195,18 @@ impl<'a> MaterialLoader<'a> {
             texels: 0,
             textures: HashMap::new(),
             fits: HashMap::new(),
+            measurements: HashMap::new(),
         }
     }
 
-    /// Every file read (or tried) so far: image files and fits.
+    /// Every file read (or tried) so far: image files, fits and measurements.
     pub fn files(&self) -> impl Iterator<Item = &PathBuf> {
         let images = self.images.keys().filter_map(|k| match k {
             ImageKey::File(f) => Some(f),
             ImageKey::Image(_) => None,
         });
-        images.chain(self.fits.keys())
+        let measured = self.measurements.values().filter_map(|m| m.path.as_ref());
+        images.chain(self.fits.keys()).chain(measured)
     }
 
     /// All materials of `doc`, textures appended to `textures`, warnings to `warnings`.
@@ -206,6 +251,7 @@ impl<'a> MaterialLoader<'a> {
         let emissive = Vec3::from(m.emissive_factor()) * m.emissive_strength().unwrap_or(1.0);
         let finite_or = |x: f32, d: f32| if x.is_finite() { x } else { d };
         let base_color = Vec4::from(pbr.base_color_factor());
+        let (facet, measured) = self.facet(m, &name)?;
         Ok(Material {
             base_color: if base_color.is_finite() {
                 base_color
@@ -226,18 +272,21 @@ impl<'a> MaterialLoader<'a> {
                 Vec3::ZERO
             },
             emissive_texture,
-            facet: self.facet(m, &name)?,
+            facet,
+            measured,
             name,
         })
     }
 
-    /// The Facet material from extras and/or an override; the override's file wins, the
-    /// extras' model and glint stay.
+    /// The Facet material from extras and/or an override: a fitted model, or a measurement.
+    /// An override naming a fit JSON replaces the extras' fit (a measured material's sampling
+    /// fit included); one naming a measurement makes the material measured, with a fit made
+    /// from that measurement.
     fn facet(
         &mut self,
         m: &gltf::Material,
         name: &str,
-    ) -> Result<Option<FacetMaterial>, RenderError> {
+    ) -> Result<(Option<FacetMaterial>, Option<MeasuredMaterial>), RenderError> {
         let extras = match m.extras() {
             Some(raw) => {
                 let v: Value = serde_json::from_str(raw.get()).map_err(|e| {
@@ -251,10 +300,34 @@ impl<'a> MaterialLoader<'a> {
         let (model, glint) = extras
             .as_ref()
             .map_or((ModelChoice::Tabulated, None), |e| (e.model, e.glint));
-        let source = match (overridden, extras.as_ref().and_then(|e| e.fit.clone())) {
-            (Some((_, file)), _) => file.clone(),
-            (None, Some(fit)) => fit,
-            (None, None) if extras.is_some() => {
+        if let Some((_, file)) = overridden.filter(|(_, f)| !is_fit_file(f)) {
+            if glint.is_some() {
+                return Err(RenderError::input(
+                    self.gltf_path,
+                    format!(
+                        "--material {name}={}: a measurement cannot replace a glint material's \
+                         fit (glints render a model's NDF)",
+                        file.display()
+                    ),
+                ));
+            }
+            let source = file.to_string_lossy().into_owned();
+            return Ok((
+                None,
+                Some(self.measured(name, &source, Path::new(""), None)?),
+            ));
+        }
+        let fit_file = overridden
+            .map(|(_, f)| f.clone())
+            .or_else(|| extras.as_ref().and_then(|e| e.fit.clone()));
+        if let Some(source) = extras.as_ref().and_then(|e| e.measured.clone()) {
+            let fit = fit_file.map(|f| self.fit(name, &f)).transpose()?;
+            let base = self.gltf_path.parent().unwrap_or(Path::new("")).to_owned();
+            return Ok((None, Some(self.measured(name, &source, &base, fit)?)));
+        }
+        let source = match fit_file {
+            Some(fit) => fit,
+            None if extras.is_some() => {
                 return Err(RenderError::input(
                     self.gltf_path,
                     format!(
@@ -262,32 +335,56 @@ impl<'a> MaterialLoader<'a> {
                     ),
                 ));
             }
-            (None, None) => return Ok(None),
+            None => return Ok((None, None)),
         };
-        let fit = match self.fits.get(&source) {
-            Some(f) => f.clone(),
-            None => {
-                // The glTF, then the fit's own error, which names the fit file.
-                let f = FittedMaterial::load(&source).map_err(|e| {
-                    RenderError::input(self.gltf_path, format!("material `{name}`: {e}"))
-                })?;
-                let f = Arc::new(f);
-                self.fits.insert(source.clone(), f.clone());
-                f
-            }
-        };
+        let fit = self.fit(name, &source)?;
         if fit.model(model).is_none() {
             return Err(RenderError::input(
                 &source,
                 format!("material `{name}` asks for model {model:?}, which this fit does not have"),
             ));
         }
-        Ok(Some(FacetMaterial {
-            source,
-            fit,
-            model,
-            glint,
-        }))
+        Ok((
+            Some(FacetMaterial {
+                source,
+                fit,
+                model,
+                glint,
+            }),
+            None,
+        ))
+    }
+
+    /// The fit JSON at `source`, loaded once however many materials name it.
+    fn fit(&mut self, name: &str, source: &Path) -> Result<Arc<FittedMaterial>, RenderError> {
+        if let Some(f) = self.fits.get(source) {
+            return Ok(f.clone());
+        }
+        // The glTF, then the fit's own error, which names the fit file.
+        let f = FittedMaterial::load(source)
+            .map_err(|e| RenderError::input(self.gltf_path, format!("material `{name}`: {e}")))?;
+        let f = Arc::new(f);
+        self.fits.insert(source.to_owned(), f.clone());
+        Ok(f)
+    }
+
+    /// The measurement `source` (relative to `base`) with its sampling fit, opened once per
+    /// source and fit however many materials name them.
+    fn measured(
+        &mut self,
+        name: &str,
+        source: &str,
+        base: &Path,
+        fit: Option<Arc<FittedMaterial>>,
+    ) -> Result<MeasuredMaterial, RenderError> {
+        let key = (base.join(source), fit.as_ref().map(Arc::as_ptr));
+        if let Some(m) = self.measurements.get(&key) {
+            return Ok(m.clone());
+        }
+        let m = MeasuredMaterial::open(source, base, fit)
+            .map_err(|e| RenderError::input(self.gltf_path, format!("material `{name}`: {e}")))?;
+        self.measurements.insert(key, m.clone());
+        Ok(m)
     }
 
     /// The scene texture of `image` in the given encoding, decoding the image on first use.
@@ -353,6 +450,14 @@ impl<'a> MaterialLoader<'a> {
             }
         }
     }
+}
+
+/// Whether an override names a fit JSON (else a measurement).
+fn is_fit_file(file: &Path) -> bool {
+    matches!(
+        facet_fit::sources::InputSpec::parse(&file.to_string_lossy()),
+        facet_fit::sources::InputSpec::Fit(_)
+    )
 }
 
 /// A material's name, or `material N` when it has none.

@@ -15,12 +15,14 @@ pub(crate) mod gltf_buffers;
 pub mod gltf_check;
 pub mod gltf_file;
 pub mod gltf_material;
+pub mod measured;
 pub mod mesh;
 pub mod shapes;
 pub mod uri;
 
 pub use environment::{Environment, EnvironmentMap};
 pub use gltf_file::{LoadOptions, load_gltf, load_gltf_bytes};
+pub use measured::{MeasuredMaterial, Measurement};
 
 /// A whole scene in world space.
 #[derive(Clone, Debug, Default)]
@@ -106,6 +108,9 @@ pub struct Material {
     pub emissive_texture: Option<u32>,
     /// A fitted material from `extras.facet` or `--material NAME=FILE`.
     pub facet: Option<FacetMaterial>,
+    /// A measured material (`extras.facet.model: "measured"`, or `--material NAME=FILE` naming
+    /// a measurement); it takes the place of `facet`.
+    pub measured: Option<MeasuredMaterial>,
 }
 
 impl Default for Material {
@@ -123,6 +128,7 @@ impl Default for Material {
             emissive: Vec3::ZERO,
             emissive_texture: None,
             facet: None,
+            measured: None,
         }
     }
 }
