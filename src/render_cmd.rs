@@ -59,7 +59,9 @@ pub struct RenderArgs {
     /// Camera by index or name (default: the first perspective camera).
     #[arg(long)]
     pub camera: Option<String>,
-    /// Attach a fit JSON to the glTF material NAME (repeatable): NAME=FILE.
+    /// Give the glTF material NAME a fit or a measurement (repeatable): NAME=FILE. A fit
+    /// `.json` is rendered by its model; a measurement (a MERL `.binary`, an RGL `.bsdf`,
+    /// `nbrdf:NAME`) is rendered as measured, a MERL-grid one sampled by a fit made on load.
     #[arg(long = "material", value_name = "NAME=FILE")]
     pub materials: Vec<String>,
     /// Paths in flight at once, 64 to 2^24.

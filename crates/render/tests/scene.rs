@@ -542,3 +542,94 @@ fn regenerate_demo_assets() {
     }
     println!("sun radiance {sun}");
 }
+
+/// `model: "measured"` renders the measurement named by `source` (relative to the glTF), with
+/// the optional `fit` as its sampling fit; `--material NAME=FILE` naming a measurement makes a
+/// material measured (its fit made on load), sharing the table with the other; the files are
+/// the scene's inputs; what cannot work is an error naming the material.
+#[test]
+fn measured_extras_and_overrides_name_a_measurement() {
+    use facet_fit::model::merl_grid::MerlTable;
+    let dir = temp_dir("measured");
+    std::fs::create_dir_all(dir.join("fits")).unwrap();
+    std::fs::copy(small_fit(), dir.join("fits/m.json")).unwrap();
+    let ggx = facet_fit::model::analytic::parse_analytic("ggx?alpha=0.3&f0=0.04").unwrap();
+    MerlTable::sample(&ggx)
+        .write(&dir.join("m.binary"))
+        .unwrap();
+    let path = facet_scene(
+        &dir,
+        json!({"model": "measured", "source": "m.binary", "fit": "fits/m.json"}),
+    );
+    let o = LoadOptions {
+        materials: vec![("plain".into(), dir.join("m.binary"))],
+        ..Default::default()
+    };
+    let s = load_gltf(&path, &o).unwrap();
+    let (metal, plain) = (&s.materials[0], &s.materials[1]);
+    assert!(metal.facet.is_none() && plain.facet.is_none());
+    let (a, b) = (
+        metal.measured.as_ref().unwrap(),
+        plain.measured.as_ref().unwrap(),
+    );
+    assert_eq!(a.source, "m.binary");
+    assert_eq!(a.path.as_deref(), Some(dir.join("m.binary").as_path()));
+    let given = a.fit.as_ref().unwrap();
+    assert_eq!(given.record.source, "test ggx 0.3", "the extras' fit");
+    assert_ne!(
+        b.fit.as_ref().unwrap().record.source,
+        "test ggx 0.3",
+        "fitted on load"
+    );
+    assert!(
+        std::sync::Arc::ptr_eq(&a.data, &b.data),
+        "one table for both"
+    );
+    assert!(s.inputs.contains(&dir.join("m.binary")), "{:?}", s.inputs);
+    // The embedded proxies need no file.
+    let path = facet_scene(
+        &dir,
+        json!({"model": "measured", "source": "nbrdf:alum-bronze"}),
+    );
+    let m = load(&path).materials[0].measured.clone().unwrap();
+    assert_eq!((m.path, m.source.as_str()), (None, "nbrdf:alum-bronze"));
+
+    for (extras, words) in [
+        (json!({"model": "measured"}), vec!["source", "metal"]),
+        (
+            json!({"source": "m.binary"}),
+            vec!["source", "measured", "metal"],
+        ),
+        (
+            json!({"model": "measured", "source": 3}),
+            vec!["source", "string"],
+        ),
+        (
+            json!({"model": "measured", "source": "absent.binary"}),
+            vec!["absent.binary", "metal"],
+        ),
+        (
+            json!({"model": "measured", "source": "nbrdf:no-such"}),
+            vec!["no-such", "metal"],
+        ),
+        (
+            json!({"model": "measured", "source": "m.binary", "glint": {"density": 1e6}}),
+            vec!["glint", "metal"],
+        ),
+    ] {
+        let path = facet_scene(&dir, extras.clone());
+        let e = load_err(&path, &LoadOptions::default());
+        assert!(words.iter().all(|w| e.contains(w)), "{extras}: {e}");
+    }
+    // A measurement cannot take a glint material's place.
+    let path = facet_scene(
+        &dir,
+        json!({"fit": "fits/m.json", "glint": {"density": 1e6}}),
+    );
+    let o = LoadOptions {
+        materials: vec![("metal".into(), dir.join("m.binary"))],
+        ..Default::default()
+    };
+    let e = load_err(&path, &o);
+    assert!(e.contains("glint") && e.contains("m.binary"), "{e}");
+}

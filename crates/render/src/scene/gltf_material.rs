@@ -381,8 +381,12 @@ impl<'a> MaterialLoader<'a> {
         if let Some(m) = self.measurements.get(&key) {
             return Ok(m.clone());
         }
-        let m = MeasuredMaterial::open(source, base, fit)
+        let mut m = MeasuredMaterial::open(source, base, fit)
             .map_err(|e| RenderError::input(self.gltf_path, format!("material `{name}`: {e}")))?;
+        // The same measurement with another fit: one table on the GPU for both.
+        if let Some(same) = self.measurements.iter().find(|(k, _)| k.0 == key.0) {
+            m.data = same.1.data.clone();
+        }
         self.measurements.insert(key, m.clone());
         Ok(m)
     }
