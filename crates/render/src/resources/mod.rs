@@ -10,6 +10,7 @@ mod glints;
 pub mod light_bvh;
 mod lights;
 pub mod materials;
+pub mod rgl_table;
 mod tables;
 mod textures;
 

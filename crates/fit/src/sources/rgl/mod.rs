@@ -32,6 +32,7 @@
 //! sampling proportional to f cos θo.
 
 pub mod cie;
+mod sample;
 pub mod tensor_file;
 pub mod warp2d;
 
@@ -89,6 +90,17 @@ pub(crate) fn elevation(d: DVec3) -> f64 {
 /// a with the sign flipped unless b < 0 (drjit's `mulsign_neg`).
 fn mulsign_neg(a: f64, b: f64) -> f64 {
     if b >= 0.0 { -a } else { a }
+}
+
+/// `d` with its x and y signs flipped as the fold of `wi` flips them (an involution: the same
+/// call undoes it).
+fn fold_like(d: DVec3, wi: DVec3, reduction: i32) -> DVec3 {
+    if reduction < 2 {
+        return d;
+    }
+    let sy = wi.y;
+    let sx = if reduction == 4 { wi.x } else { sy };
+    DVec3::new(mulsign_neg(d.x, sx), mulsign_neg(d.y, sy), d.z)
 }
 
 impl RglBsdf {
@@ -244,6 +256,42 @@ impl RglBsdf {
         self.spectral
     }
 
+    /// Whether the data holds f cos θo · 4σ / D (the `jacobian` field) rather than f cos θo.
+    pub fn has_jacobian(&self) -> bool {
+        self.jacobian
+    }
+
+    /// The symmetry fold of an anisotropic file whose `phi_i` spans 2π / k: k = 2 or 4, else 1.
+    pub fn reduction(&self) -> i32 {
+        self.reduction
+    }
+
+    /// D(m) on u = (√(θ / (π/2)), (φ + π) / 2π): an interpolant without parameters.
+    pub fn ndf(&self) -> &Warp2D {
+        &self.ndf
+    }
+
+    /// The projected area σ(ωi) on the same u as [`RglBsdf::ndf`]: an interpolant.
+    pub fn sigma(&self) -> &Warp2D {
+        &self.sigma
+    }
+
+    /// The visible normals over u(m), a distribution with parameters (φi, θi).
+    pub fn vndf(&self) -> &Warp2D {
+        &self.vndf
+    }
+
+    /// The sampling density over the sample space, a distribution with parameters (φi, θi).
+    pub fn luminance(&self) -> &Warp2D {
+        &self.luminance
+    }
+
+    /// The red, green and blue data over the sample space, interpolants with parameters
+    /// (φi, θi) (already Rec.709 when the file was spectral).
+    pub fn rgb(&self) -> &[Warp2D; 3] {
+        &self.rgb
+    }
+
     /// The density of the format's importance sampling at (ωi, ωo), solid-angle measure:
     /// luminance(s) · vndf(u(m)) / (2π² u sin θm · 4 ⟨ωi, m⟩), as the format's readers compute
     /// it (`pdf()` of measured.cpp). Zero below the horizon.
@@ -261,15 +309,11 @@ impl RglBsdf {
 
     /// The folded directions and the coordinates every lookup of (ωi, ωo) takes.
     fn query(&self, wi: DVec3, wo: DVec3) -> Query {
-        let (mut wi, mut wo) = (wi, wo);
-        if self.reduction >= 2 {
-            let sy = wi.y;
-            let sx = if self.reduction == 4 { wi.x } else { sy };
-            wi.x = mulsign_neg(wi.x, sx);
-            wi.y = mulsign_neg(wi.y, sy);
-            wo.x = mulsign_neg(wo.x, sx);
-            wo.y = mulsign_neg(wo.y, sy);
-        }
+        // Both folded by wi's signs: wi lands in the quadrant (or half) the file holds.
+        let (wi, wo) = (
+            fold_like(wi, wi, self.reduction),
+            fold_like(wo, wi, self.reduction),
+        );
         let m = (wi + wo).normalize();
         let (theta_i, phi_i) = (elevation(wi), wi.y.atan2(wi.x));
         let (theta_m, phi_m) = (elevation(m), m.y.atan2(m.x));

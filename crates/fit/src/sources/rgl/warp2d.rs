@@ -140,6 +140,33 @@ impl Warp2D {
         self.size
     }
 
+    /// The nodes of each parameter (the first varies slowest in [`Warp2D::data`]).
+    pub fn params(&self) -> &[Vec<f64>] {
+        &self.params
+    }
+
+    /// The values, `n0 × n1 × … × ny × nx` with the last extent fastest: raw for an
+    /// interpolant, normalised per slice (densities over index units) for a distribution.
+    pub fn data(&self) -> &[f64] {
+        &self.data
+    }
+
+    /// Per parameter slice, the CDF over rows at the `ny` row nodes (empty for an interpolant).
+    pub fn marginal(&self) -> &[f64] {
+        &self.marginal
+    }
+
+    /// Per parameter slice and row, the CDF over columns at the `nx` column nodes, each row
+    /// ending at that row's mass (empty for an interpolant).
+    pub fn conditional(&self) -> &[f64] {
+        &self.conditional
+    }
+
+    /// Whether this is a distribution (it can be sampled and inverted).
+    pub fn is_distribution(&self) -> bool {
+        !self.marginal.is_empty()
+    }
+
     fn corners(&self, param: &[f64]) -> Corners {
         debug_assert_eq!(param.len(), self.params.len());
         let mut c = Corners {
