@@ -148,6 +148,7 @@ pub const PIPELINES: &[(&str, &[Group])] = &[
     ("render/extend.wgsl", STAGE),
     ("render/shade_diffuse.wgsl", STAGE),
     ("render/shade_microfacet.wgsl", STAGE),
+    ("render/shade_rgl.wgsl", STAGE),
     (
         "render/shade_glint.wgsl",
         &[Group::Frame, Group::Scene, Group::Glint],

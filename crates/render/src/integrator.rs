@@ -123,6 +123,7 @@ impl Integrator {
                     Some(q),
                     &microfacet_constants(q),
                 )?,
+                Queue::Rgl => stage("render/shade_rgl.wgsl", "shade_rgl", Some(q), &q_shade)?,
                 Queue::Glint(_) => {
                     let mut c = facet_glint::gpu::flake_constants();
                     c.push(q_shade[0]);

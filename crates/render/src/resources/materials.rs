@@ -173,7 +173,7 @@ pub fn merl_block(table: &MerlTable) -> Vec<f32> {
 pub fn measured_block(data: &Measurement) -> Vec<f32> {
     match data {
         Measurement::Merl(table) => merl_block(table),
-        Measurement::Rgl(_) => todo!("RGL on the GPU"),
+        Measurement::Rgl(bsdf) => super::rgl_table::rgl_block(bsdf),
     }
 }
 
