@@ -2,10 +2,11 @@
 //! live in [`crate::preview`]'s worker; this holds only its handle. The window drawn over this
 //! state (`ViewerApp::show`, the eframe app) is in `panels`.
 
-use crate::material::{EditedMaterial, MaterialKey};
+use crate::material::{EditedMaterial, MaterialKey, Shown};
 use crate::preview::{Command, Orbit, Preview, PreviewScene};
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::model::material::FittedMaterial;
+use facet_render::scene::Measurement;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::Receiver;
 use std::time::Instant;
@@ -18,8 +19,12 @@ pub struct FitJob {
     pub started: Instant,
     /// The phase the fit is in, for the status line.
     pub stage: std::sync::Arc<std::sync::Mutex<String>>,
-    rx: Receiver<Result<FittedMaterial, String>>,
+    rx: Receiver<Result<Fitted, String>>,
 }
+
+/// A fit job's answer: the fit, and the measurement it was made from (`None` where the source
+/// has no MERL table: an anisotropic one).
+type Fitted = (FittedMaterial, Option<Measurement>);
 
 /// What a screenshot run (`--screenshot PATH --frames N`) does.
 #[derive(Clone, Debug)]
@@ -78,6 +83,14 @@ pub struct ViewerApp {
     pub proxy_names: Option<Result<Vec<String>, String>>,
     /// The screenshot run, under `--screenshot`.
     pub screenshot: Option<ScreenshotPlan>,
+    /// Show the measurement on the sphere's −x half beside the edited model.
+    pub split: bool,
+    /// The split last sent to the preview: the measurement's address when split, else `None`.
+    pub sent_split: Option<usize>,
+    /// The glTF scene in the preview (the split applies to the sphere only).
+    pub gltf: Option<PathBuf>,
+    /// The model asked for on the command line, shown once the input's fit arrives.
+    pub wanted: Option<Shown>,
 }
 
 impl ViewerApp {
@@ -104,6 +117,10 @@ impl ViewerApp {
             nbrdf: facet_fit::sources::nbrdf::NbrdfLibrary::override_path(None),
             proxy_names: None,
             screenshot: None,
+            split: false,
+            sent_split: None,
+            gltf: None,
+            wanted: None,
         }
     }
 
@@ -181,7 +198,10 @@ impl ViewerApp {
                     )
                     .map_err(|e| e.to_string())?;
                 *st.lock().unwrap() = "extracting the NDF and fitting".into();
-                fit_material(&*src, &spec, &FitConfig::isotropic()).map_err(|e| e.to_string())
+                let fit = fit_material(&*src, &spec, &FitConfig::isotropic())
+                    .map_err(|e| e.to_string())?;
+                *st.lock().unwrap() = "tabulating the measurement".into();
+                Ok((fit, Measurement::of(&input, &*src).ok()))
             })();
             let _ = tx.send(r);
         });
@@ -193,12 +213,49 @@ impl ViewerApp {
         });
     }
 
-    /// The preview scene for a glTF file (else the sphere) with the current material.
+    /// The preview scene for a glTF file (else the sphere, split when asked) with the current
+    /// material.
     pub fn preview_scene(&self, gltf: Option<&Path>) -> Result<PreviewScene, String> {
         let material = self.material.render_material()?;
-        match gltf {
-            Some(p) => PreviewScene::gltf(p, material),
-            None => Ok(PreviewScene::sphere(material)),
+        match (gltf, self.split_measurement()) {
+            (Some(p), _) => PreviewScene::gltf(p, material),
+            (None, Some(measured)) => Ok(PreviewScene::sphere_split(material, measured)),
+            (None, None) => Ok(PreviewScene::sphere(material)),
+        }
+    }
+
+    /// The measurement's material when the split is on and can be shown: a measurement, the
+    /// sphere (not a glTF scene) and a model (not the measurement itself) on the other half.
+    fn split_measurement(&self) -> Option<facet_render::scene::Material> {
+        let shows_model = self.material.shown != Shown::Measured;
+        (self.split && self.gltf.is_none() && shows_model)
+            .then(|| self.material.measured_material())
+            .flatten()
+    }
+
+    /// Rebuilds the sphere scene when the split (or the measurement it shows) changed; true if
+    /// it did.
+    pub fn sync_split(&mut self) -> bool {
+        let key = self
+            .split_measurement()
+            .and(self.material.measurement.as_ref())
+            .map(|m| std::sync::Arc::as_ptr(m) as usize);
+        if key == self.sent_split || self.gltf.is_some() {
+            return false;
+        }
+        self.sent_split = key;
+        match self.preview_scene(None) {
+            Ok(mut ps) => {
+                ps.orbit = self.orbit;
+                if let Some(p) = &self.preview {
+                    p.send(Command::Scene(Box::new(ps)));
+                }
+                true
+            }
+            Err(e) => {
+                self.error = Some(format!("the split preview: {e}"));
+                false
+            }
         }
     }
 
@@ -206,6 +263,7 @@ impl ViewerApp {
     pub fn open_scene(&mut self, path: &Path) {
         match self.preview_scene(Some(path)) {
             Ok(ps) => {
+                self.gltf = Some(path.to_owned());
                 self.orbit = ps.orbit;
                 self.status = format!(
                     "scene {}: material {:?} is edited",
@@ -242,11 +300,17 @@ impl ViewerApp {
             return false;
         };
         match job.rx.try_recv() {
-            Ok(Ok(fit)) => {
+            Ok(Ok((fit, measurement))) => {
                 let label = job.label.clone();
                 let secs = job.started.elapsed().as_secs_f64();
                 self.fit_job = None;
-                self.set_material(EditedMaterial::new(fit, label.clone()));
+                self.set_material(match measurement {
+                    Some(m) => EditedMaterial::with_measurement(fit, label.clone(), m),
+                    None => EditedMaterial::new(fit, label.clone()),
+                });
+                if let Some(s) = self.wanted.take().filter(|&s| self.material.available(s)) {
+                    self.material.shown = s;
+                }
                 self.status = format!("fitted {label} in {secs:.1} s");
                 false
             }

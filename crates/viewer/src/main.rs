@@ -152,10 +152,11 @@ fn run_with(
             if let Some(spec) = args.input.as_ref().or(args.material.as_ref()) {
                 app.open(spec);
             }
-            if let Some(s) = args.shown
-                && app.material.available(s)
-            {
-                app.material.shown = s;
+            match args.shown {
+                Some(s) if app.material.available(s) => app.material.shown = s,
+                // The input's fit (and measurement) comes later, from a background job.
+                Some(s) => app.wanted = Some(s),
+                None => {}
             }
             match (&cc.wgpu_render_state, no_gpu) {
                 (Some(rs), _) => {

@@ -1,14 +1,15 @@
 //! The edited material: a fit record, the model shown, and the edits applied on top of it.
 
 use facet_fit::model::material::{FitRecord, FittedMaterial, ModelChoice};
-use facet_render::scene::{FacetMaterial, GlintParams, Material};
+use facet_render::scene::{FacetMaterial, GlintParams, Material, MeasuredMaterial, Measurement};
 use std::path::PathBuf;
 use std::sync::Arc;
 
 /// What the preview shows on the sphere.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shown {
-    /// The measured data's own NDF: the tabulated fit as extracted, without edits.
+    /// The measurement itself (a MERL-grid table or an RGL file, on the GPU), sampled by the
+    /// unedited fit; only when the input was a measurement.
     Measured,
     /// The tabulated fit with the edited stretch.
     Tabulated,
@@ -84,6 +85,8 @@ pub struct EditedMaterial {
     pub glint: GlintEdit,
     /// αx and αy move together (their ratio kept).
     pub lock: bool,
+    /// The measurement the fit was made from (`None` for a fit JSON).
+    pub measurement: Option<Arc<Measurement>>,
 }
 
 impl EditedMaterial {
@@ -103,6 +106,19 @@ impl EditedMaterial {
             tint: [1.0; 3],
             glint: GlintEdit::default(),
             lock: true,
+            measurement: None,
+        }
+    }
+
+    /// The edit of `base`, fitted from `measurement` (which "measured data" renders).
+    pub fn with_measurement(
+        base: FittedMaterial,
+        source: String,
+        measurement: Measurement,
+    ) -> Self {
+        EditedMaterial {
+            measurement: Some(Arc::new(measurement)),
+            ..Self::new(base, source)
         }
     }
 
@@ -128,7 +144,8 @@ impl EditedMaterial {
     /// Whether the shown model exists in the fit (GGX/Beckmann may be absent).
     pub fn available(&self, shown: Shown) -> bool {
         match shown {
-            Shown::Measured | Shown::Tabulated | Shown::Glint => true,
+            Shown::Measured => self.measurement.is_some(),
+            Shown::Tabulated | Shown::Glint => true,
             Shown::Ggx => self.record.ggx.is_some(),
             Shown::Beckmann => self.record.beckmann.is_some(),
         }
@@ -243,8 +260,28 @@ impl EditedMaterial {
         FittedMaterial::from_record(self.edited_record()).map(Arc::new)
     }
 
+    /// The measurement as a scene material, sampled by the unedited fit (`None` without one).
+    pub fn measured_material(&self) -> Option<Material> {
+        let data = self.measurement.clone()?;
+        Some(Material {
+            name: "measured".into(),
+            measured: Some(MeasuredMaterial {
+                source: self.source.clone(),
+                path: None,
+                data,
+                fit: Some(self.base.clone()),
+            }),
+            ..Material::default()
+        })
+    }
+
     /// The scene material of the sphere.
     pub fn render_material(&self) -> Result<Material, String> {
+        if self.shown == Shown::Measured {
+            return self
+                .measured_material()
+                .ok_or_else(|| format!("{} is a fit, not a measurement", self.source));
+        }
         let fit = self.fitted()?;
         let glint = (self.shown == Shown::Glint).then_some(GlintParams {
             density: self.glint.density,
@@ -280,6 +317,7 @@ impl EditedMaterial {
         let s = self.record.tabulated.stretch;
         MaterialKey {
             base: Arc::as_ptr(&self.base) as usize,
+            measurement: self.measurement.as_ref().map(|m| Arc::as_ptr(m) as usize),
             shown: self.shown,
             stretch: [s.alpha_x, s.alpha_y, s.rotation],
             tabulated_diffuse: self.record.tabulated.diffuse,
@@ -296,6 +334,8 @@ impl EditedMaterial {
 pub struct MaterialKey {
     /// Address of the base fit (a new fit is a new key).
     pub base: usize,
+    /// Address of the measurement.
+    pub measurement: Option<usize>,
     /// The model shown.
     pub shown: Shown,
     /// αx, αy, rotation of the tabulated stretch.

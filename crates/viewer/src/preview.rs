@@ -22,6 +22,8 @@ use std::time::Instant;
 
 /// Index of the sphere's material in the sphere scene.
 pub const SPHERE: usize = 1;
+/// Index of the measurement's material in the split sphere scene (the sphere's −x half).
+pub const SPLIT: usize = 2;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
 pub use facet_render::pacing::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
@@ -105,6 +107,24 @@ impl PreviewScene {
     pub fn sphere(material: Material) -> Self {
         PreviewScene {
             scene: preview_scene(material),
+            edited: SPHERE,
+            orbit: Orbit::default(),
+        }
+    }
+
+    /// The sphere split at x = 0: its −x half the measurement (`measured`, fixed), its +x half
+    /// the edited material, so that an edit is judged against the data beside it.
+    pub fn sphere_split(material: Material, measured: Material) -> Self {
+        let mut scene = preview_scene(material);
+        scene.materials.push(measured);
+        for (t, tri) in scene.indices.iter().enumerate() {
+            let x: f32 = tri.iter().map(|&v| scene.positions[v as usize].x).sum();
+            if scene.triangle_material[t] == SPHERE as u32 && x < 0.0 {
+                scene.triangle_material[t] = SPLIT as u32;
+            }
+        }
+        PreviewScene {
+            scene,
             edited: SPHERE,
             orbit: Orbit::default(),
         }

@@ -78,3 +78,86 @@ fn preview_accumulates_and_restarts_on_an_edit() {
         latencies.iter().map(|l| l.round()).collect::<Vec<_>>()
     );
 }
+
+/// A measured input: "measured data" renders the measurement itself, and the split puts it on
+/// the sphere's −x half (the triangles whose centroid has x < 0, half of the sphere's) beside
+/// the edited model; the worker renders the split scene and an edit of the model is written in
+/// place while the measurement stays.
+#[test]
+fn split_preview_shows_the_measurement_beside_the_model() {
+    use facet_fit::sources::InputSpec;
+    use facet_viewer::material::{EditedMaterial, Shown};
+    use facet_viewer::preview::{SPHERE, SPLIT};
+    let Some(gpu) =
+        facet_gpu::gpu_for_tests("split_preview_shows_the_measurement_beside_the_model")
+    else {
+        return;
+    };
+    let spec = InputSpec::parse("nbrdf:gold-metallic-paint");
+    let src = facet_fit::sources::nbrdf::NbrdfLibrary::embedded()
+        .get("gold-metallic-paint")
+        .unwrap();
+    let fit = facet_fit::fit_material(&src, "gold", &facet_fit::FitConfig::isotropic()).unwrap();
+    let measurement = facet_render::scene::Measurement::of(&spec, &src).unwrap();
+    let mut app = ViewerApp::with_default_material().unwrap();
+    assert!(
+        !app.material.available(Shown::Measured),
+        "a fit JSON has no measurement"
+    );
+    app.material =
+        EditedMaterial::with_measurement(fit, "nbrdf:gold-metallic-paint".into(), measurement);
+    app.material.shown = Shown::Measured;
+    let m = app.material.render_material().unwrap();
+    assert!(
+        m.measured.is_some() && m.facet.is_none(),
+        "the measurement itself"
+    );
+
+    app.material.shown = Shown::Ggx;
+    app.split = true;
+    let ps = app.preview_scene(None).unwrap();
+    let count = |k: usize| {
+        ps.scene
+            .triangle_material
+            .iter()
+            .filter(|&&t| t == k as u32)
+            .count()
+    };
+    let (model, data) = (count(SPHERE), count(SPLIT));
+    assert!(
+        model > 1000 && model.abs_diff(data) <= model / 50,
+        "{model} / {data} triangles"
+    );
+    assert!(ps.scene.materials[SPLIT].measured.is_some());
+    assert!(ps.scene.materials[SPHERE].facet.is_some());
+
+    let p = Preview::start(gpu, ps, (128, 128), || {});
+    wait(&p, "4 samples of the split sphere", |s| s.samples >= 4);
+    let (ax, ay, rot) = app.material.alpha().unwrap();
+    app.material.set_alpha(ax * 1.5, ay * 1.5, rot);
+    p.send(Command::Material {
+        generation: 1,
+        material: Box::new(app.material.render_material().unwrap()),
+        sent: Instant::now(),
+    });
+    wait(&p, "the edit's first frame", |s| s.generation == 1);
+    let s = p.shared.lock().unwrap().clone();
+    assert!(
+        !s.last_rebuilt,
+        "the model's α is written in place beside the measurement"
+    );
+    // Both halves of the sphere are lit: the image's middle row left and right of the centre.
+    let row = &s.rgba[(s.height / 2 * s.width) as usize..((s.height / 2 + 1) * s.width) as usize];
+    let half = |r: std::ops::Range<u32>| -> u64 {
+        r.map(|x| {
+            row[x as usize]
+                .iter()
+                .take(3)
+                .map(|&c| c as u64)
+                .sum::<u64>()
+        })
+        .sum()
+    };
+    let w = s.width;
+    assert!(half(w / 2 - 20..w / 2 - 2) > 0 && half(w / 2 + 2..w / 2 + 20) > 0);
+}

@@ -28,6 +28,24 @@ pub enum Measurement {
     Rgl(RglBsdf),
 }
 
+impl Measurement {
+    /// The measurement of an opened source: an RGL file as itself (read again from its path),
+    /// any other isotropic source sampled onto the MERL grid and [filled](MerlTable::filled).
+    pub fn of(spec: &InputSpec, src: &dyn Brdf) -> Result<Self, String> {
+        if let InputSpec::Rgl(p) = spec {
+            return RglBsdf::open(p)
+                .map(Measurement::Rgl)
+                .map_err(|e| e.to_string());
+        }
+        if !src.is_isotropic() {
+            return Err(
+                "an anisotropic source has no MERL table (the MERL grid is isotropic)".into(),
+            );
+        }
+        Ok(Measurement::Merl(src.merl_table().filled()))
+    }
+}
+
 impl std::fmt::Debug for Measurement {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
@@ -79,26 +97,21 @@ impl MeasuredMaterial {
             });
         }
         let mut library: Option<NbrdfLibrary> = None;
-        let brdf = spec
+        let src = spec
             .open(None, &mut library, Residence::Read)
             .map_err(|e| fail(&e))?;
-        if !brdf.is_isotropic() {
-            return Err(fail(
-                &"an anisotropic source has no MERL table (the MERL grid is isotropic)",
-            ));
-        }
+        let data = Measurement::of(&spec, &*src).map_err(|e| fail(&e))?;
         let fit = match fit {
             Some(f) => f,
             None => Arc::new(
-                facet_fit::fit_material(&*brdf, source, &FitConfig::isotropic())
+                facet_fit::fit_material(&*src, source, &FitConfig::isotropic())
                     .map_err(|e| fail(&format!("fitting its sampling NDF: {e}")))?,
             ),
         };
-        let table = brdf.merl_table().filled();
         Ok(MeasuredMaterial {
             source: source.to_owned(),
             path,
-            data: Arc::new(Measurement::Merl(table)),
+            data: Arc::new(data),
             fit: Some(fit),
         })
     }

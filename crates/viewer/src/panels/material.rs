@@ -24,6 +24,14 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
             ui.radio_value(&mut m.shown, s, s.label());
         });
     }
+    let can_split = m.available(Shown::Measured) && app.gltf.is_none();
+    ui.add_enabled_ui(can_split, |ui| {
+        ui.checkbox(
+            &mut app.split,
+            "split: the measured data on the sphere's left half",
+        )
+        .on_disabled_hover_text("needs a measurement (not a fit JSON) and the sphere preview");
+    });
     alpha_sliders(m, ui);
     diffuse_edit(m, ui);
     tint_edit(m, ui);
@@ -135,7 +143,7 @@ fn alpha_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
             m.set_alpha(ax, ay, rot);
         }
     } else {
-        ui.label("The measured data are shown as extracted (no edits).");
+        ui.label("The measurement itself is shown (no edits): its table on the GPU.");
     }
 }
 

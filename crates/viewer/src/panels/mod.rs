@@ -21,6 +21,7 @@ impl ViewerApp {
         plots_panel(self, ui);
         preview_panel(self, ui);
         self.sync_material();
+        self.sync_split();
     }
 }
 
