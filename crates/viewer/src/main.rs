@@ -30,10 +30,14 @@ struct Args {
     /// The same as INPUT.
     #[arg(long, value_name = "SPEC")]
     material: Option<String>,
-    /// The model shown first: measured (the data), tabulated, ggx, beckmann or glint (default:
-    /// tabulated where the material has a fit).
+    /// The model shown first: measured (the measurement itself, for a measured INPUT),
+    /// tabulated, ggx, beckmann or glint (default: GGX where the material has one).
     #[arg(long, value_name = "MODEL", value_parser = parse_shown)]
     shown: Option<Shown>,
+    /// Split the sphere: the measurement on its left half, the edited model on its right (a
+    /// measured INPUT; not with --scene).
+    #[arg(long, conflicts_with = "scene")]
+    split: bool,
     /// A glTF scene for the preview, its materials replaced by the edited one (default: a
     /// sphere under the demo's sky).
     #[arg(long, value_name = "PATH.gltf")]
@@ -152,6 +156,7 @@ fn run_with(
             if let Some(spec) = args.input.as_ref().or(args.material.as_ref()) {
                 app.open(spec);
             }
+            app.split = args.split;
             match args.shown {
                 Some(s) if app.material.available(s) => app.material.shown = s,
                 // The input's fit (and measurement) comes later, from a background job.
