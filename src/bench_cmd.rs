@@ -29,6 +29,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 mod lights;
+mod measured;
 mod shard;
 
 #[derive(Parser, Clone, Debug)]
@@ -67,6 +68,8 @@ pub enum Section {
     /// Light selection (bvh, robust, power) on the many-light rooms, the gold scene and the
     /// demo; the light BVH's build.
     Lights,
+    /// A measured material (MERL table, RGL file) against its tabulated fit at equal spp.
+    Measured,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -274,6 +277,9 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         }
         if on(Section::Lights) {
             report["lights"] = lights::lights(g, &sizes)?;
+        }
+        if on(Section::Measured) {
+            report["measured"] = measured::measured(g, sizes.noise.0, sizes.noise.1)?;
         }
         if on(Section::Shard) {
             report["shard"] = shard::shards(sizes.runs, sizes.shard.0, sizes.shard.1)?;
