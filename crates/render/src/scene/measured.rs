@@ -86,7 +86,12 @@ impl MeasuredMaterial {
         };
         let path = spec.path().map(Path::to_path_buf);
         let named = path.clone().unwrap_or_else(|| PathBuf::from(source));
-        let fail = |e: &dyn std::fmt::Display| RenderError::input(&named, e);
+        // An error that names the file already (the readers' do) is not prefixed twice.
+        let fail = |e: &dyn std::fmt::Display| {
+            let message = e.to_string();
+            let prefix = format!("{}: ", named.display());
+            RenderError::input(&named, message.strip_prefix(&prefix).unwrap_or(&message))
+        };
         if let InputSpec::Rgl(p) = &spec {
             let bsdf = RglBsdf::open(p).map_err(|e| fail(&e))?;
             return Ok(MeasuredMaterial {
