@@ -52,7 +52,7 @@ fn materials() -> Result<[(&'static str, Material); 3]> {
     Ok([
         ("tabulated fit", fitted),
         ("MERL table", measured(table)),
-        ("RGL .bsdf", measured(Measurement::Rgl(bsdf))),
+        ("RGL .bsdf", measured(Measurement::Rgl(Box::new(bsdf)))),
     ])
 }
 

@@ -1,9 +1,11 @@
 //! Inputs that the tests of several crates build: analytic BRDFs as MERL sources, spectral
 //! `.bsdf` files made from RGB ones, scratch folders.
 
+use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
 use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::sources::merl::MerlBrdf;
+use facet_fit::sources::rgl::RglBsdf;
 use facet_fit::sources::rgl::tensor_file::{TensorFile, TensorWriter};
 use std::path::{Path, PathBuf};
 
@@ -65,4 +67,70 @@ pub fn spectral_from_rgb(rgb_file: &[u8]) -> Vec<u8> {
         }
     }
     w.to_bytes()
+}
+
+/// The `.bsdf` bytes Facet writes for the analytic `spec` on its own NDF: `theta_i` θi slices,
+/// `phi_i` φi slices (anisotropic specs), 32² sample space and VNDF, 64 NDF nodes.
+pub fn rgl_written(spec: &str, theta_i: usize, phi_i: usize) -> Vec<u8> {
+    let src = parse_analytic(spec).unwrap();
+    let res = BsdfResolution {
+        theta_i,
+        phi_i,
+        sample: 32,
+        vndf: 32,
+        ndf: 64,
+    };
+    rgl_tensor(&src, &src.ndf, res, "").unwrap().0.to_bytes()
+}
+
+/// A written anisotropic file cut to its first `keep` φi slices (from −π): of 9 slices, 5
+/// span π (the format's fold by 2), 3 span π/2 (its fold by 4).
+pub fn rgl_cut_phi(bytes: Vec<u8>, keep: usize) -> Vec<u8> {
+    let tf = TensorFile::parse(bytes).unwrap();
+    let mut w = TensorWriter::default();
+    for name in ["description", "jacobian"] {
+        w.u8s(name, tf.u8s(name).unwrap());
+    }
+    let fields = [
+        "theta_i",
+        "phi_i",
+        "ndf",
+        "sigma",
+        "vndf",
+        "luminance",
+        "rgb",
+    ];
+    for name in fields {
+        let (v, shape) = tf.floats(name).unwrap();
+        let mut shape = shape.to_vec();
+        let mut v: Vec<f32> = v.iter().map(|&x| x as f32).collect();
+        if ["phi_i", "vndf", "luminance", "rgb"].contains(&name) {
+            v.truncate(v.len() / shape[0] * keep);
+            shape[0] = keep;
+        }
+        w.f32s(name, &shape, &v);
+    }
+    w.to_bytes()
+}
+
+/// Four `.bsdf` files written from GGX with `theta_i` θi slices: isotropic (with a diffuse
+/// term), anisotropic and rotated, and anisotropic folded by 2 and by 4
+/// ([`RglBsdf::reduction`] 1, 1, 2, 4).
+pub fn rgl_test_files(theta_i: usize) -> Vec<(&'static str, RglBsdf)> {
+    let aniso = "ggx?alpha_x=0.12&alpha_y=0.35&f0=0.9";
+    let rotated = "ggx?alpha_x=0.12&alpha_y=0.35&rotation=30&f0=0.9";
+    let parse = |b: Vec<u8>| RglBsdf::parse("t", b).unwrap();
+    let isotropic = "ggx?alpha=0.2&f0=0.04&kd=0.3,0.1,0.05";
+    vec![
+        ("isotropic", parse(rgl_written(isotropic, theta_i, 2))),
+        ("anisotropic", parse(rgl_written(rotated, theta_i, 9))),
+        (
+            "folded by 2",
+            parse(rgl_cut_phi(rgl_written(rotated, theta_i, 9), 5)),
+        ),
+        (
+            "folded by 4",
+            parse(rgl_cut_phi(rgl_written(aniso, theta_i, 9), 3)),
+        ),
+    ]
 }

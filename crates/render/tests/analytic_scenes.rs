@@ -1008,7 +1008,7 @@ fn measured_sampling_by_the_fit_is_unbiased_and_lowers_the_variance() {
     assert_sum_of_parts(
         "visible normals against cosine",
         &visible,
-        &[cosine.clone()],
+        std::slice::from_ref(&cosine),
     );
     let variance =
         |imgs: &[Image; 2]| -> f64 { block_stats(imgs).iter().map(|(_, v)| v.element_sum()).sum() };
@@ -1033,7 +1033,9 @@ fn rgl_material(spec: &str) -> (Material, Arc<RglBsdf>, MicrofacetBrdf) {
         measured: Some(MeasuredMaterial {
             source: "ggx.bsdf".into(),
             path: None,
-            data: Arc::new(Measurement::Rgl(RglBsdf::parse("ggx", bytes).unwrap())),
+            data: Arc::new(Measurement::Rgl(Box::new(
+                RglBsdf::parse("ggx", bytes).unwrap(),
+            ))),
             fit: None,
         }),
         ..Default::default()

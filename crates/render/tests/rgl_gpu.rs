@@ -5,74 +5,16 @@
 //! quarter of φi (the format's folds by 2 and 4). The repository holds no measured `.bsdf`.
 
 use facet_fit::Brdf;
-use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
-use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::geometry::spherical;
 use facet_fit::numerics::chi2::uniforms;
 use facet_fit::sources::rgl::RglBsdf;
-use facet_fit::sources::rgl::tensor_file::{TensorFile, TensorWriter};
 use facet_gpu::{Gpu, buffer, dispatch, shader};
+use facet_oracles::fixtures::rgl_test_files;
 use facet_render::resources::rgl_table::rgl_block;
 use glam::{DVec3, Vec3};
 
-fn res(phi_i: usize) -> BsdfResolution {
-    BsdfResolution {
-        theta_i: 12,
-        phi_i,
-        sample: 32,
-        vndf: 32,
-        ndf: 64,
-    }
-}
-
-/// The `.bsdf` bytes Facet writes for the analytic `spec` on its own NDF.
-fn written(spec: &str, res: BsdfResolution) -> Vec<u8> {
-    let src = parse_analytic(spec).unwrap();
-    rgl_tensor(&src, &src.ndf, res, "").unwrap().0.to_bytes()
-}
-
-/// A written anisotropic file cut to its first `keep` φi slices (from −π): of 9 slices, 5
-/// span π (folded by 2), 3 span π/2 (folded by 4).
-fn cut_phi(bytes: Vec<u8>, keep: usize) -> Vec<u8> {
-    let tf = TensorFile::parse(bytes).unwrap();
-    let mut w = TensorWriter::default();
-    for name in ["description", "jacobian"] {
-        w.u8s(name, tf.u8s(name).unwrap());
-    }
-    for name in [
-        "theta_i",
-        "phi_i",
-        "ndf",
-        "sigma",
-        "vndf",
-        "luminance",
-        "rgb",
-    ] {
-        let (v, shape) = tf.floats(name).unwrap();
-        let mut shape = shape.to_vec();
-        let mut v: Vec<f32> = v.iter().map(|&x| x as f32).collect();
-        if ["phi_i", "vndf", "luminance", "rgb"].contains(&name) {
-            v.truncate(v.len() / shape[0] * keep);
-            shape[0] = keep;
-        }
-        w.f32s(name, &shape, &v);
-    }
-    w.to_bytes()
-}
-
 fn files() -> Vec<(&'static str, RglBsdf)> {
-    let aniso = "ggx?alpha_x=0.12&alpha_y=0.35&f0=0.9";
-    let rotated = "ggx?alpha_x=0.12&alpha_y=0.35&rotation=30&f0=0.9";
-    let parse = |b: Vec<u8>| RglBsdf::parse("t", b).unwrap();
-    let files = vec![
-        (
-            "isotropic",
-            parse(written("ggx?alpha=0.2&f0=0.04&kd=0.3,0.1,0.05", res(2))),
-        ),
-        ("anisotropic", parse(written(rotated, res(9)))),
-        ("folded by 2", parse(cut_phi(written(rotated, res(9)), 5))),
-        ("folded by 4", parse(cut_phi(written(aniso, res(9)), 3))),
-    ];
+    let files = rgl_test_files(12);
     let folds: Vec<i32> = files.iter().map(|(_, f)| f.reduction()).collect();
     assert_eq!(folds, [1, 1, 2, 4]);
     assert!(files[0].1.is_isotropic());

@@ -25,7 +25,7 @@ pub enum Measurement {
     /// A table on the MERL grid, its missing samples filled ([`MerlTable::filled`]).
     Merl(MerlTable),
     /// An RGL `.bsdf` file.
-    Rgl(RglBsdf),
+    Rgl(Box<RglBsdf>),
 }
 
 impl Measurement {
@@ -34,7 +34,7 @@ impl Measurement {
     pub fn of(spec: &InputSpec, src: &dyn Brdf) -> Result<Self, String> {
         if let InputSpec::Rgl(p) = spec {
             return RglBsdf::open(p)
-                .map(Measurement::Rgl)
+                .map(|b| Measurement::Rgl(Box::new(b)))
                 .map_err(|e| e.to_string());
         }
         if !src.is_isotropic() {
@@ -97,7 +97,7 @@ impl MeasuredMaterial {
             return Ok(MeasuredMaterial {
                 source: source.to_owned(),
                 path,
-                data: Arc::new(Measurement::Rgl(bsdf)),
+                data: Arc::new(Measurement::Rgl(Box::new(bsdf))),
                 fit: None,
             });
         }
