@@ -53,8 +53,8 @@ pub struct ReportArgs {
     #[arg(long, default_value_t = 90, value_parser = crate::args::resolution)]
     fit_resolution: usize,
     /// Fit the first K inputs again at N = 32, 64, 90 and 128 for the plot of run time against
-    /// error (0: no sweep). Four more fits per input: about 6 s each on two CPU cores, so the
-    /// default sweeps only the first two inputs.
+    /// error (0: no sweep). Four more fits per input, about 6 s in all on two CPU cores, so the
+    /// default sweeps only the first two inputs (the 10-minute budget of the 100 proxies).
     #[arg(long, default_value_t = 2, value_name = "K")]
     sweep: usize,
     /// Equirectangular environment map (EXR, Y up) of the environment renders (default: the

@@ -210,8 +210,13 @@ fn sweep_section(points: &[SweepPoint]) -> String {
             p.resolution,
             p.seconds
         );
+        // Six significant digits: the errors may differ in the fourth.
         for e in p.errors {
-            let _ = write!(s, "<td>{}</td>", fmt_opt(e, 4));
+            let _ = write!(
+                s,
+                "<td>{}</td>",
+                e.map_or("–".into(), |e| format!("{e:.5e}"))
+            );
         }
         s += "</tr>\n";
     }
