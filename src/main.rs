@@ -11,6 +11,7 @@ mod merge_cmd;
 mod output;
 mod render_cmd;
 mod render_digest;
+mod report_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -45,6 +46,10 @@ enum Command {
     Demo(demo_cmd::DemoArgs),
     /// Measure the fitter, ray tracing, the integrator, glints and the preview on this adapter.
     Bench(bench_cmd::BenchArgs),
+    /// One HTML page comparing measurements with their fits: spheres under a point light and an
+    /// environment, ΔE2000 images, NDF and Fresnel plots, a sortable table over the set, run
+    /// time against error.
+    Report(report_cmd::ReportArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -60,6 +65,7 @@ fn main() -> std::process::ExitCode {
         Some(Command::Merge(args)) => merge_cmd::run(&args),
         Some(Command::Demo(args)) => demo_cmd::run(&args),
         Some(Command::Bench(args)) => bench_cmd::run(&args),
+        Some(Command::Report(args)) => report_cmd::run(&args),
         None => demo_cmd::run(&demo_cmd::DemoArgs::defaults()),
     };
     match result {

@@ -1,0 +1,232 @@
+//! `facet report`: one HTML page, for a paper's supplement, comparing measured materials with
+//! their fits — per material, spheres of the measurement and of each model under a point light
+//! and an environment, ΔE2000 images, NDF and Fresnel plots, errors and times; a database
+//! summary (sortable table, mean ΔE per model, mean ΔE images over the set); run time against
+//! error over N = 32, 64, 90, 128 ([`sweep`]).
+
+mod delta_e;
+mod false_colour;
+mod html;
+mod material;
+mod plots;
+mod scenes;
+mod subject;
+mod sweep;
+
+use self::material::{IMG, MaterialReport, report_material};
+use self::scenes::{Lighting, SphereRenderer};
+use anyhow::{Context, Result, bail};
+use clap::Args;
+use facet_fit::FitConfig;
+use facet_fit::sources::nbrdf::NbrdfLibrary;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+#[derive(Args)]
+pub struct ReportArgs {
+    /// What `facet fit` takes (MERL .binary, RGL .bsdf, `nbrdf:NAME`, `analytic:SPEC`) or a fit
+    /// .json (rendered by its models only: ΔE against its tabulated model).
+    #[arg(required_unless_present = "all_proxies")]
+    inputs: Vec<String>,
+    /// Add the 100 MERL proxies embedded in Facet (`nbrdf:NAME`) to the inputs.
+    #[arg(long)]
+    all_proxies: bool,
+    /// Output folder: index.html and img/. Refused when it exists and is not empty, unless
+    /// --force.
+    #[arg(long, default_value = "report")]
+    out: PathBuf,
+    /// Write into a non-empty --out (files of the same names are replaced).
+    #[arg(long)]
+    force: bool,
+    /// Side of each sphere image, pixels, 1 to 16384 (128: the 100 proxies in about 10 minutes
+    /// on two CPU cores with lavapipe).
+    #[arg(long, default_value_t = 128, value_parser = crate::args::side)]
+    resolution: u32,
+    /// Samples per pixel of the environment renders, 1 to 2^20 (the point-light renders take 4:
+    /// only their pixel positions vary).
+    #[arg(long, default_value_t = 16, value_parser = crate::args::spp)]
+    spp: u32,
+    /// Polar nodes N of the fits, 2 to 4096.
+    #[arg(long, default_value_t = 90, value_parser = crate::args::resolution)]
+    fit_resolution: usize,
+    /// Fit the first K inputs again at N = 32, 64, 90 and 128 for the plot of run time against
+    /// error (0: no sweep). Four more fits per input, about 6 s in all on two CPU cores, so the
+    /// default sweeps only the first two inputs (the 10-minute budget of the 100 proxies).
+    #[arg(long, default_value_t = 2, value_name = "K")]
+    sweep: usize,
+    /// Equirectangular environment map (EXR, Y up) of the environment renders (default: the
+    /// demo's sky, embedded in Facet).
+    #[arg(long, value_name = "FILE")]
+    env: Option<PathBuf>,
+}
+
+/// `--out` made, or refused when it holds anything and `--force` is not given; `img/` in it.
+fn prepare_out(out: &Path, force: bool) -> Result<()> {
+    if out.is_dir() && !force {
+        let mut entries = std::fs::read_dir(out)
+            .with_context(|| format!("--out {}: cannot read the folder", out.display()))?;
+        if entries.next().is_some() {
+            bail!(
+                "--out {}: the folder is not empty; choose another or add --force",
+                out.display()
+            );
+        }
+    }
+    crate::output::folder(out, "--out")?;
+    crate::output::folder(&out.join(IMG), "--out")
+}
+
+/// The inputs: as given, then the embedded proxies with --all-proxies.
+fn inputs(args: &ReportArgs) -> Vec<String> {
+    let mut v = args.inputs.clone();
+    if args.all_proxies {
+        let lib = NbrdfLibrary::embedded();
+        v.extend(lib.names().map(|n| format!("nbrdf:{n}")));
+    }
+    v
+}
+
+/// A file stem for `name`, unique among `taken` (-2, -3, ... on a repeat).
+fn unique_stem(name: &str, taken: &mut HashSet<String>) -> String {
+    let base = facet_fit::io::input::safe_file_stem(name);
+    let mut stem = base.clone();
+    for k in 2.. {
+        if taken.insert(stem.clone()) {
+            break;
+        }
+        stem = format!("{base}-{k}");
+    }
+    stem
+}
+
+fn progress_bar(n: usize) -> ProgressBar {
+    let bar = ProgressBar::new(n as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed} < {eta}]")
+            .expect("a valid template"),
+    );
+    bar
+}
+
+pub fn run(args: &ReportArgs) -> Result<ExitCode> {
+    let started = Instant::now();
+    let inputs = inputs(args);
+    prepare_out(&args.out, args.force)?;
+    let gpu = crate::render_cmd::open_gpu()?;
+    let mut renderer = SphereRenderer::new(&gpu, args.resolution, args.spp, args.env.as_deref())?;
+    let mut cfg = FitConfig::isotropic();
+    cfg.extract.resolution = args.fit_resolution;
+    let mut library = None;
+    let bar = progress_bar(inputs.len());
+    let (mut reports, mut stems, mut failed) = (Vec::new(), HashSet::new(), 0);
+    for input in &inputs {
+        bar.set_message(input.clone());
+        let done = subject::open(input, &cfg, &mut library).and_then(|s| {
+            let stem = unique_stem(&s.fit.record.name, &mut stems);
+            report_material(&mut renderer, &s, &stem, &args.out)
+        });
+        match done {
+            Ok(r) => reports.push(r),
+            Err(e) => {
+                failed += 1;
+                bar.suspend(|| eprintln!("error: {input}: {e:#}"));
+            }
+        }
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let sweep = run_sweep(&inputs, args.sweep, &cfg, &mut library)?;
+    write_page(args, &gpu, &reports, &sweep, started)?;
+    print_means(&reports, started);
+    Ok(if failed > 0 {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+/// The N sweep of the first `k` inputs, with its own progress bar.
+fn run_sweep(
+    inputs: &[String],
+    k: usize,
+    cfg: &FitConfig,
+    library: &mut Option<NbrdfLibrary>,
+) -> Result<Vec<sweep::SweepPoint>> {
+    let chosen = &inputs[..k.min(inputs.len())];
+    let bar = progress_bar(chosen.len());
+    let mut points = Vec::new();
+    for input in chosen {
+        bar.set_message(format!("N sweep: {input}"));
+        points.extend(sweep::sweep_input(input, cfg, library)?);
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    Ok(points)
+}
+
+/// The database's mean ΔE images, the scale, the sweep plot and index.html.
+fn write_page(
+    args: &ReportArgs,
+    gpu: &facet_gpu::Gpu,
+    reports: &[MaterialReport],
+    sweep: &[sweep::SweepPoint],
+    started: Instant,
+) -> Result<()> {
+    let out = &args.out;
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        for k in 0..3 {
+            let images: Vec<_> = reports.iter().filter_map(|r| r.de[l][k].as_ref()).collect();
+            if let Some(mean) = delta_e::DeltaE::mean_of(&images) {
+                false_colour::write_png(&mean, &out.join(html::mean_de_file(*lighting, k)))?;
+            }
+        }
+    }
+    plots::write_scale(&out.join(plots::SCALE_FILE))?;
+    if !sweep.is_empty() {
+        plots::write_sweep_plot(sweep, &out.join(plots::SWEEP_FILE))?;
+    }
+    let info = html::PageInfo {
+        adapter: gpu.describe(),
+        side: args.resolution,
+        env_spp: args.spp,
+        resolution: args.fit_resolution,
+        env: args
+            .env
+            .as_ref()
+            .map_or("the demo's sky".into(), |p| p.display().to_string()),
+        seconds: started.elapsed().as_secs_f64(),
+        version: env!("CARGO_PKG_VERSION"),
+    };
+    let page = html::page(&info, reports, sweep);
+    let index = out.join("index.html");
+    std::fs::write(&index, page).with_context(|| format!("writing {}", index.display()))?;
+    println!("wrote {}", index.display());
+    Ok(())
+}
+
+/// The mean ΔE per model over the set, and the wall time.
+fn print_means(reports: &[MaterialReport], started: Instant) {
+    let means = html::set_means(reports);
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        let v: Vec<String> = scenes::Variant::MODELS
+            .iter()
+            .zip(means[l])
+            .map(|(m, v)| {
+                format!(
+                    "{} {}",
+                    scenes::model_key(*m),
+                    v.map_or("–".into(), |v| format!("{v:.3}"))
+                )
+            })
+            .collect();
+        println!("mean ΔE ({}): {}", lighting.key(), v.join(", "));
+    }
+    println!(
+        "{} material(s) in {:.1} s",
+        reports.len(),
+        started.elapsed().as_secs_f64()
+    );
+}

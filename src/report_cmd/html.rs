@@ -1,0 +1,291 @@
+//! The page: one self-contained `index.html` (inline CSS and a few lines of inline JS to sort
+//! the table), its images as PNG and SVG files in `img/` beside it.
+
+use super::false_colour::DE_MAX;
+use super::material::{MaterialReport, de_file, render_file, variants};
+use super::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
+use super::scenes::{ENV_DEPTH, Lighting, POINT_SPP, Variant, model_key};
+use super::sweep::SweepPoint;
+use std::fmt::Write;
+
+/// What the page says about the run.
+pub struct PageInfo {
+    pub adapter: String,
+    pub side: u32,
+    pub env_spp: u32,
+    pub resolution: usize,
+    pub env: String,
+    pub seconds: f64,
+    pub version: &'static str,
+}
+
+/// The page-relative path of the database's mean ΔE image of one lighting and model.
+pub fn mean_de_file(lighting: Lighting, model: usize) -> String {
+    format!(
+        "img/mean-{}-de-{}.png",
+        lighting.key(),
+        model_key(Variant::MODELS[model])
+    )
+}
+
+const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;max-width:1400px}\
+table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #ccc;padding:2px 6px;\
+text-align:right}th{background:#eee;cursor:pointer}td:first-child{text-align:left}\
+figure{display:inline-block;margin:4px;text-align:center;font-size:12px}\
+figure img{display:block}section{border-top:1px solid #999;margin-top:1.5em}";
+
+/// Sorts the table by the clicked column: numbers as numbers, the rest as text; a second
+/// click reverses.
+const SORT_JS: &str = "document.querySelectorAll('table.sortable th').forEach((th,i)=>{\
+th.onclick=()=>{const b=th.closest('table').tBodies[0];const rows=[...b.rows];\
+const asc=th.dataset.asc!=='1';th.dataset.asc=asc?'1':'0';\
+const v=r=>{const t=r.cells[i].textContent;const n=parseFloat(t);return isNaN(n)?t:n};\
+rows.sort((x,y)=>{const a=v(x),c=v(y);return (a<c?-1:a>c?1:0)*(asc?1:-1)});\
+rows.forEach(r=>b.appendChild(r));}});";
+
+/// `<`, `>`, `&` and `"` escaped.
+pub fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn fmt_opt(v: Option<f64>, digits: usize) -> String {
+    v.map_or("–".into(), |v| format!("{v:.digits$}"))
+}
+
+/// The mean over the set of each lighting's and model's mean ΔE (`None` where no material has
+/// one).
+pub fn set_means(materials: &[MaterialReport]) -> [[Option<f64>; 3]; 2] {
+    std::array::from_fn(|l| {
+        std::array::from_fn(|m| {
+            let v: Vec<f64> = materials.iter().filter_map(|r| r.mean_de[l][m]).collect();
+            (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        })
+    })
+}
+
+/// The whole page.
+pub fn page(info: &PageInfo, materials: &[MaterialReport], sweep: &[SweepPoint]) -> String {
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\
+         <title>Facet report</title><style>{STYLE}</style></head><body>\n"
+    );
+    s += &header(info, materials.len());
+    s += &summary(materials);
+    if !sweep.is_empty() {
+        s += &sweep_section(sweep);
+    }
+    for m in materials {
+        s += &material_section(m);
+    }
+    let _ = write!(s, "<script>{SORT_JS}</script>\n</body></html>\n");
+    s
+}
+
+fn header(info: &PageInfo, n: usize) -> String {
+    format!(
+        "<h1>Facet report: {n} material(s)</h1>\n<p>Facet {}; adapter {}; {:.1} s in all. \
+         Fits: isotropic, N = {} polar nodes, a diffuse lobe with every model. Spheres {side}×{side} \
+         pixels: (a) one point light, no environment, depth 1, {POINT_SPP} spp (only the pixel \
+         positions vary: each pixel is f cos θ I / r²); (b) the environment {}, depth {ENV_DEPTH}, \
+         {} spp.</p>\n<p>ΔE: CIEDE2000 per pixel on the sphere (silhouette excluded) of each \
+         model against the measurement (or, for a fit JSON, against its tabulated model), on \
+         the colours the PNGs show: the tone map 1 − exp(−L) at exposure 0 read as linear \
+         sRGB, to CIELAB (D65), by the <code>palette</code> crate. False colour: viridis from 0 \
+         to {DE_MAX} (and above).</p>\n<img src=\"{SCALE_FILE}\" alt=\"ΔE colour scale\">\n",
+        info.version,
+        escape(&info.adapter),
+        info.seconds,
+        info.resolution,
+        escape(&info.env),
+        info.env_spp,
+        side = info.side,
+    )
+}
+
+fn summary(materials: &[MaterialReport]) -> String {
+    let means = set_means(materials);
+    let mut s = String::from("<section><h2>Database summary</h2>\n<p>Mean ΔE over the set: ");
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        let _ = write!(s, "<b>{}</b>: ", lighting_name(*lighting));
+        for (m, model) in Variant::MODELS.iter().enumerate() {
+            let _ = write!(s, "{} {}; ", model_key(*model), fmt_opt(means[l][m], 2));
+        }
+    }
+    s += "</p>\n<table class=\"sortable\"><thead><tr><th>material</th>";
+    for h in [
+        "ΔE tab (point)",
+        "ΔE GGX (point)",
+        "ΔE Beck (point)",
+        "ΔE tab (env)",
+        "ΔE GGX (env)",
+        "ΔE Beck (env)",
+        "error tab",
+        "error GGX",
+        "error Beck",
+        "fit (s)",
+        "render (s)",
+    ] {
+        let _ = write!(s, "<th>{h}</th>");
+    }
+    s += "</tr></thead><tbody>\n";
+    for m in materials {
+        let _ = write!(
+            s,
+            "<tr><td><a href=\"#{}\">{}</a></td>",
+            escape(&m.stem),
+            escape(&m.name)
+        );
+        for l in 0..2 {
+            for v in m.mean_de[l] {
+                let _ = write!(s, "<td>{}</td>", fmt_opt(v, 2));
+            }
+        }
+        for e in errors(m) {
+            let _ = write!(s, "<td>{}</td>", fmt_opt(e, 4));
+        }
+        let _ = writeln!(
+            s,
+            "<td>{:.2}</td><td>{:.2}</td></tr>",
+            m.fit_ms / 1e3,
+            m.render_ms / 1e3
+        );
+    }
+    s += "</tbody></table>\n<h3>Mean ΔE image over the set</h3>\n";
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        for (k, model) in Variant::MODELS.iter().enumerate() {
+            if means[l][k].is_some() {
+                s += &figure(
+                    &mean_de_file(*lighting, k),
+                    &format!("{} {}", model_key(*model), lighting.key()),
+                );
+            }
+        }
+        s += "<br>\n";
+    }
+    s + "</section>\n"
+}
+
+fn lighting_name(l: Lighting) -> &'static str {
+    match l {
+        Lighting::Point => "point light",
+        Lighting::Environment => "environment",
+    }
+}
+
+/// The error metric of the tabulated, GGX and Beckmann models.
+fn errors(m: &MaterialReport) -> [Option<f64>; 3] {
+    let r = &m.record;
+    [
+        r.tabulated.error,
+        r.ggx.as_ref().map(|p| p.error),
+        r.beckmann.as_ref().map(|p| p.error),
+    ]
+}
+
+fn figure(src: &str, caption: &str) -> String {
+    format!(
+        "<figure><img src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>\n",
+        escape(src),
+        escape(caption),
+        escape(caption)
+    )
+}
+
+fn sweep_section(points: &[SweepPoint]) -> String {
+    let mut s = format!(
+        "<section><h2>Run time against error</h2>\n<img src=\"{SWEEP_FILE}\" alt=\"sweep\">\n\
+         <table><thead><tr><th>material</th><th>N</th><th>time (s)</th><th>error tab</th>\
+         <th>error GGX</th><th>error Beck</th></tr></thead><tbody>\n"
+    );
+    for p in points {
+        let _ = write!(
+            s,
+            "<tr><td>{}</td><td>{}</td><td>{:.2}</td>",
+            escape(&p.material),
+            p.resolution,
+            p.seconds
+        );
+        // Six significant digits: the errors may differ in the fourth.
+        for e in p.errors {
+            let _ = write!(
+                s,
+                "<td>{}</td>",
+                e.map_or("–".into(), |e| format!("{e:.5e}"))
+            );
+        }
+        s += "</tr>\n";
+    }
+    s + "</tbody></table></section>\n"
+}
+
+fn material_section(m: &MaterialReport) -> String {
+    let reference = if m.measured {
+        "the measurement"
+    } else {
+        "the tabulated model (a fit JSON: no measurement to render)"
+    };
+    let mut s = format!(
+        "<section id=\"{}\"><h2>{}</h2>\n<p>Input <code>{}</code>; ΔE against {reference}.</p>\n",
+        escape(&m.stem),
+        escape(&m.name),
+        escape(&m.input)
+    );
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        let _ = writeln!(s, "<h3>{}</h3>", lighting_name(*lighting));
+        for v in variants(m.measured) {
+            s += &figure(&render_file(&m.stem, *lighting, v), v.key());
+        }
+        s += "<br>\n";
+        for (k, model) in Variant::MODELS.iter().enumerate() {
+            if let Some(mean) = m.mean_de[l][k] {
+                s += &figure(
+                    &de_file(&m.stem, *lighting, *model),
+                    &format!("ΔE {} (mean {mean:.2})", model_key(*model)),
+                );
+            }
+        }
+        s += "<br>\n";
+    }
+    s += &figure(&ndf_file(&m.stem), "NDF (log scale)");
+    s += &figure(&fresnel_file(&m.stem), "Fresnel");
+    s += &record_table(m);
+    s + "</section>\n"
+}
+
+/// The fit's errors, parameters and times.
+fn record_table(m: &MaterialReport) -> String {
+    let r = &m.record;
+    let t = &r.timings_ms;
+    let e = errors(m);
+    let alpha = |p: &Option<facet_fit::model::material::ParamRecord>| {
+        p.as_ref()
+            .map_or("–".into(), |p| format!("α {:.4}", p.alpha_x))
+    };
+    format!(
+        "<table><tr><th>model</th><th>error metric</th><th>parameters</th></tr>\
+         <tr><td>tabulated</td><td>{}</td><td>N = {}, {} iterations</td></tr>\
+         <tr><td>GGX</td><td>{}</td><td>{}</td></tr>\
+         <tr><td>Beckmann</td><td>{}</td><td>{}</td></tr></table>\n\
+         <p>Fit times (ms): load {:.0}, extract {:.0}, Fresnel and diffuse {:.0}, fits {:.0}, \
+         total {:.0}; fit here {:.0} ms, renders {:.0} ms.</p>\n",
+        fmt_opt(e[0], 4),
+        r.resolution,
+        r.iterations,
+        fmt_opt(e[1], 4),
+        alpha(&r.ggx),
+        fmt_opt(e[2], 4),
+        alpha(&r.beckmann),
+        t.load,
+        t.extract,
+        t.fresnel,
+        t.fit,
+        t.total,
+        m.fit_ms,
+        m.render_ms
+    )
+}

@@ -1,0 +1,139 @@
+//! One material's part of the report: its spheres (the measurement and each model, under the
+//! point light and the environment), the ΔE images of each model against the reference (the
+//! measurement, or the tabulated model when there is none), and the plots of its NDF and F.
+
+use super::delta_e::{DeltaE, delta_e_image};
+use super::scenes::{Lighting, SphereRenderer, Variant, material, model_key, on_sphere};
+use super::subject::Subject;
+use super::{false_colour, plots};
+use anyhow::{Context, Result};
+use facet_fit::model::material::ModelChoice;
+use facet_render::Image;
+use std::path::Path;
+
+/// Subfolder of the report's images.
+pub const IMG: &str = "img";
+
+/// What the page says of one material.
+pub struct MaterialReport {
+    /// The fit's name.
+    pub name: String,
+    /// The input as given.
+    pub input: String,
+    /// The file stem of its images (unique in the report).
+    pub stem: String,
+    /// Whether the reference is the measurement (else the tabulated model).
+    pub measured: bool,
+    /// The fit's record (errors, times).
+    pub record: facet_fit::model::material::FitRecord,
+    /// The fit's wall time here (or as recorded in a fit JSON), ms.
+    pub fit_ms: f64,
+    /// The renders' wall time, ms.
+    pub render_ms: f64,
+    /// Mean ΔE per lighting ([`Lighting::ALL`] order) and model ([`Variant::MODELS`] order);
+    /// `None` for the reference itself.
+    pub mean_de: [[Option<f64>; 3]; 2],
+    /// The ΔE images in the same order (kept for the database means).
+    pub de: [[Option<DeltaE>; 3]; 2],
+}
+
+/// The page-relative path of one render.
+pub fn render_file(stem: &str, lighting: Lighting, variant: Variant) -> String {
+    format!("{IMG}/{stem}-{}-{}.png", lighting.key(), variant.key())
+}
+
+/// The page-relative path of one ΔE image.
+pub fn de_file(stem: &str, lighting: Lighting, model: ModelChoice) -> String {
+    format!(
+        "{IMG}/{stem}-{}-de-{}.png",
+        lighting.key(),
+        model_key(model)
+    )
+}
+
+/// The variants rendered for a subject: the measurement when there is one, and every model.
+pub fn variants(measured: bool) -> Vec<Variant> {
+    let models = Variant::MODELS.iter().map(|&m| Variant::Model(m));
+    measured
+        .then_some(Variant::Measured)
+        .into_iter()
+        .chain(models)
+        .collect()
+}
+
+/// The variant ΔE is measured against.
+fn reference(measured: bool) -> Variant {
+    if measured {
+        Variant::Measured
+    } else {
+        Variant::Model(ModelChoice::Tabulated)
+    }
+}
+
+/// Renders, compares and plots `subject` into `out`, its files named after `stem`.
+pub fn report_material(
+    renderer: &mut SphereRenderer,
+    subject: &Subject,
+    stem: &str,
+    out: &Path,
+) -> Result<MaterialReport> {
+    let t = std::time::Instant::now();
+    let side = renderer.side();
+    let mask = |x, y| on_sphere(side, x, y);
+    let mut mean_de = [[None; 3]; 2];
+    let mut de: [[Option<DeltaE>; 3]; 2] = Default::default();
+    let source = &subject.fit.record.source;
+    // Each material once (a measurement is opened once), cloned per lighting.
+    let materials = variants(subject.measured)
+        .into_iter()
+        .map(|v| Ok((v, material(v, source, &subject.fit)?)))
+        .collect::<Result<Vec<_>>>()?;
+    for (li, &lighting) in Lighting::ALL.iter().enumerate() {
+        let mut images: Vec<(Variant, Image)> = Vec::new();
+        for (variant, m) in &materials {
+            let variant = *variant;
+            let image = renderer
+                .render(m.clone(), lighting)
+                .with_context(|| format!("{}: rendering {}", subject.input, variant.key()))?;
+            let path = out.join(render_file(stem, lighting, variant));
+            image
+                .write_png(&path, 0.0)
+                .with_context(|| format!("writing {}", path.display()))?;
+            images.push((variant, image));
+        }
+        let reference_variant = reference(subject.measured);
+        let reference = &images
+            .iter()
+            .find(|(v, _)| *v == reference_variant)
+            .expect("the reference is rendered")
+            .1;
+        for (mi, &model) in Variant::MODELS.iter().enumerate() {
+            if Variant::Model(model) == reference_variant {
+                continue;
+            }
+            let image = &images
+                .iter()
+                .find(|(v, _)| *v == Variant::Model(model))
+                .expect("every model is rendered")
+                .1;
+            let d = delta_e_image(reference, image, &mask);
+            false_colour::write_png(&d, &out.join(de_file(stem, lighting, model)))?;
+            mean_de[li][mi] = Some(d.mean());
+            de[li][mi] = Some(d);
+        }
+    }
+    let render_ms = t.elapsed().as_secs_f64() * 1e3;
+    plots::write_ndf_plot(&subject.fit, &out.join(plots::ndf_file(stem)))?;
+    plots::write_fresnel_plot(&subject.fit, &out.join(plots::fresnel_file(stem)))?;
+    Ok(MaterialReport {
+        name: subject.fit.record.name.clone(),
+        input: subject.input.clone(),
+        stem: stem.to_owned(),
+        measured: subject.measured,
+        record: subject.fit.record.clone(),
+        fit_ms: subject.fit_ms,
+        render_ms,
+        mean_de,
+        de,
+    })
+}

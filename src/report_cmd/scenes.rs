@@ -1,0 +1,238 @@
+//! The report's two sphere scenes and their renders: a unit sphere seen from +z under (a) one
+//! point light with no environment, depth 1 — every pixel is then f(ωi, ωo) cos θi I / r²,
+//! with only the pixel positions random, so two materials differ by their BRDFs alone — and
+//! (b) an environment map, paths of up to [`ENV_DEPTH`] bounces.
+//!
+//! Pipelines cost about half a second each on lavapipe: one [`Integrator`] is built per set of
+//! shading classes a scene needs and reused for every scene with the same set (an integrator's
+//! pipelines depend only on those classes; each render gets its own wavefront bound to its own
+//! scene's resources).
+
+use anyhow::{Context, Result};
+use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_gpu::Gpu;
+use facet_render::camera::CameraFrame;
+use facet_render::scene::{
+    Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, MeasuredMaterial, Scene,
+};
+use facet_render::{
+    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
+    Strategy,
+};
+use glam::Vec3;
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The demo's sky, embedded so that the report needs no file beside the binary.
+const SKY_EXR: &[u8] = include_bytes!("../../assets/demo/sky.exr");
+/// The camera's distance from the sphere's centre.
+const CAMERA_Z: f32 = 3.0;
+/// The camera's vertical field of view, degrees: the unit sphere fills most of the frame.
+const YFOV_DEG: f32 = 45.0;
+/// The point light: upper left, in front of the sphere, at distance ≈ 3.9 from its centre.
+const LIGHT_POSITION: Vec3 = Vec3::new(-1.6, 1.8, 3.0);
+/// Its radiant intensity: a white Lambertian facing it gives L = I/(π r²) ≈ 1.5 (r ≈ 2.9 at
+/// the nearest point), shown as 1 − e^−1.5 = 0.78 — most MERL materials are darker.
+const LIGHT_INTENSITY: f32 = 40.0;
+/// Bounces of the environment renders (the sphere sees only the sky: 3 is plenty).
+pub const ENV_DEPTH: u32 = 3;
+/// Samples per pixel of the point-light renders: only the pixel positions vary (anti-aliasing).
+pub const POINT_SPP: u32 = 4;
+
+/// The two lightings of every material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lighting {
+    /// One point light, no environment, depth 1.
+    Point,
+    /// The environment map, depth [`ENV_DEPTH`].
+    Environment,
+}
+
+impl Lighting {
+    pub const ALL: [Lighting; 2] = [Lighting::Point, Lighting::Environment];
+
+    /// A short name for file names and the page.
+    pub fn key(self) -> &'static str {
+        match self {
+            Lighting::Point => "point",
+            Lighting::Environment => "env",
+        }
+    }
+}
+
+/// What one sphere is made of.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Variant {
+    /// The measurement itself (a MERL-grid table sampled by the fit's tabulated NDF, or an RGL
+    /// file by its own warps).
+    Measured,
+    /// One of the fit's models, each with its diffuse lobe.
+    Model(ModelChoice),
+}
+
+impl Variant {
+    pub const MODELS: [ModelChoice; 3] = [
+        ModelChoice::Tabulated,
+        ModelChoice::Ggx,
+        ModelChoice::Beckmann,
+    ];
+
+    /// A short name for file names and the page.
+    pub fn key(self) -> &'static str {
+        match self {
+            Variant::Measured => "measured",
+            Variant::Model(m) => model_key(m),
+        }
+    }
+}
+
+/// `tabulated`, `ggx` or `beckmann`.
+pub fn model_key(m: ModelChoice) -> &'static str {
+    match m {
+        ModelChoice::Tabulated => "tabulated",
+        ModelChoice::Ggx => "ggx",
+        ModelChoice::Beckmann => "beckmann",
+    }
+}
+
+/// The scene material of `variant`: the measurement `source` (opened again, sampled by `fit`)
+/// or a model of `fit`.
+pub fn material(variant: Variant, source: &str, fit: &Arc<FittedMaterial>) -> Result<Material> {
+    Ok(match variant {
+        Variant::Measured => Material {
+            name: "measured".into(),
+            measured: Some(
+                MeasuredMaterial::open(source, Path::new(""), Some(fit.clone()))
+                    .with_context(|| format!("{source}: opening the measurement to render"))?,
+            ),
+            ..Default::default()
+        },
+        Variant::Model(model) => Material {
+            name: model_key(model).into(),
+            facet: Some(FacetMaterial {
+                source: source.into(),
+                fit: fit.clone(),
+                model,
+                glint: None,
+            }),
+            ..Default::default()
+        },
+    })
+}
+
+/// The unit sphere at the origin made of `material`, the camera on +z, the point light for
+/// [`Lighting::Point`].
+fn sphere_scene(material: Material, lighting: Lighting) -> Scene {
+    let mut s = Scene {
+        materials: vec![material],
+        camera: camera(),
+        ..Default::default()
+    };
+    s.add_uv_sphere(Vec3::ZERO, 1.0, 192, 96, 0);
+    if lighting == Lighting::Point {
+        s.lights.push(Light::Point {
+            position: LIGHT_POSITION,
+            intensity: Vec3::splat(LIGHT_INTENSITY),
+        });
+    }
+    s
+}
+
+fn camera() -> Camera {
+    Camera {
+        position: Vec3::new(0.0, 0.0, CAMERA_Z),
+        forward: Vec3::NEG_Z,
+        up: Vec3::Y,
+        yfov: YFOV_DEG.to_radians(),
+    }
+}
+
+/// Whether the centre of pixel (x, y) of a `side`² image sees the sphere, away from its
+/// silhouette (within radius 0.98, where the tessellation and anti-aliasing decide coverage).
+pub fn on_sphere(side: u32, x: u32, y: u32) -> bool {
+    let tan_half = (0.5 * YFOV_DEG.to_radians()).tan();
+    let ndc = |p: u32| 2.0 * (p as f32 + 0.5) / side as f32 - 1.0;
+    // The ray o + t d from o = (0, 0, z) meets |p| = r where b² > c, b = o·d, c = |o|² − r².
+    let d = Vec3::new(ndc(x) * tan_half, -ndc(y) * tan_half, -1.0).normalize();
+    let o = Vec3::new(0.0, 0.0, CAMERA_Z);
+    let b = o.dot(d);
+    b * b > o.length_squared() - 0.98f32.powi(2)
+}
+
+/// Renders the sphere scenes on one adapter, its integrators shared between scenes.
+pub struct SphereRenderer<'g> {
+    gpu: &'g Gpu,
+    environment: Environment,
+    /// The image side, pixels.
+    side: u32,
+    /// Samples per pixel of the environment renders.
+    env_spp: u32,
+    integrators: HashMap<Vec<&'static str>, Integrator>,
+}
+
+impl<'g> SphereRenderer<'g> {
+    /// A renderer of `side`² images with `env_spp` samples in the environment `env` (an EXR
+    /// file; `None`: the embedded sky).
+    pub fn new(gpu: &'g Gpu, side: u32, env_spp: u32, env: Option<&Path>) -> Result<Self> {
+        let (map, warnings) = match env {
+            Some(path) => EnvironmentMap::load(path)?,
+            None => EnvironmentMap::from_exr_bytes(Path::new("embedded sky.exr"), SKY_EXR)?,
+        };
+        for w in warnings {
+            eprintln!("warning: {w}");
+        }
+        Ok(SphereRenderer {
+            gpu,
+            environment: Environment::Map(Arc::new(map)),
+            side,
+            env_spp,
+            integrators: HashMap::new(),
+        })
+    }
+
+    /// The image side, pixels.
+    pub fn side(&self) -> u32 {
+        self.side
+    }
+
+    /// `material` on the sphere under `lighting`.
+    pub fn render(&mut self, material: Material, lighting: Lighting) -> Result<Image> {
+        let scene = sphere_scene(material, lighting);
+        let env = (lighting == Lighting::Environment).then_some(&self.environment);
+        let res = SceneResources::new(self.gpu, &scene, env, ResourceConfig::standard())?;
+        let key = res.built.classes.clone();
+        let integrator = match self.integrators.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(Integrator::new(&self.gpu.device, &res)?)
+            }
+        };
+        let camera = CameraFrame::new(&scene.camera)?;
+        let sampling = match lighting {
+            // Next-event estimation only reaches a point light: with depth 1 and no
+            // environment, each sample is exact for its pixel position.
+            Lighting::Point => SampleConfig {
+                spp: POINT_SPP,
+                max_depth: 1,
+                strategy: Strategy::Mis,
+                ..SampleConfig::preview()
+            },
+            Lighting::Environment => SampleConfig {
+                spp: self.env_spp,
+                max_depth: ENV_DEPTH,
+                ..SampleConfig::preview()
+            },
+        };
+        let config = RenderConfig {
+            image: ImageConfig {
+                width: self.side,
+                height: self.side,
+                wavefront: 1 << 18,
+            },
+            sampling,
+        };
+        let (image, _) = integrator.render(self.gpu, &res, &camera, &config, &mut |_| {})?;
+        Ok(image)
+    }
+}

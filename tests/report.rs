@@ -1,0 +1,271 @@
+//! `facet report`: the page on three proxies, every image it names present and decodable, the
+//! page loaded in a real browser (headless Chromium) with every image loaded; the ΔE path
+//! (palette's CIEDE2000 on the displayed colours) against Sharma, Wu & Dalal's test data.
+
+mod common;
+
+// The report's ΔE module itself (it needs only facet-render's Image and palette).
+#[path = "../src/report_cmd/delta_e.rs"]
+#[allow(dead_code)]
+mod delta_e;
+
+use common::{facet_in, scratch};
+use delta_e::{ciede2000, delta_e_image, displayed, lab};
+use facet_render::Image;
+use palette::Lab;
+use std::path::Path;
+use std::process::Command;
+
+/// Every `src="…"` of the page, in order.
+fn image_sources(html: &str) -> Vec<String> {
+    html.split("src=\"")
+        .skip(1)
+        .map(|rest| rest.split('"').next().unwrap().to_owned())
+        .collect()
+}
+
+/// Three proxies at 24×24 pixels, 2 spp, no sweep but of the first: index.html names every
+/// render, ΔE image, plot and mean image, and each exists and decodes (PNG by `image`, SVG as
+/// an `<svg` document).
+#[test]
+fn report_on_three_proxies_writes_every_image() {
+    if facet_gpu::gpu_for_tests("report_on_three_proxies_writes_every_image").is_none() {
+        return;
+    }
+    let dir = scratch("report_three");
+    let out = dir.join("page");
+    let (ok, stdout, stderr) = facet_in(
+        &dir,
+        &[
+            "report",
+            "nbrdf:gold-metallic-paint",
+            "nbrdf:blue-acrylic",
+            "nbrdf:alum-bronze",
+            "--out",
+            "page",
+            "--resolution",
+            "24",
+            "--spp",
+            "2",
+            "--fit-resolution",
+            "32",
+            "--sweep",
+            "1",
+        ],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    assert!(stdout.contains("mean ΔE (point)"), "{stdout}");
+    let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+    let sources = image_sources(&html);
+    // Per material 8 renders, 6 ΔE images, 2 plots; the scale, the sweep, 6 mean images.
+    assert_eq!(sources.len(), 3 * 16 + 1 + 1 + 6, "{sources:?}");
+    for src in &sources {
+        check_image(&out.join(src));
+    }
+    for name in ["gold-metallic-paint", "blue-acrylic", "alum-bronze"] {
+        assert!(
+            html.contains(&format!("id=\"{name}\"")),
+            "{name} has no section"
+        );
+    }
+    // A second run into the same folder is refused without --force.
+    let (ok, _, stderr) = facet_in(&dir, &["report", "nbrdf:blue-acrylic", "--out", "page"]);
+    assert!(!ok && stderr.contains("not empty"), "{stderr}");
+}
+
+/// A PNG decodes to a non-empty image; an SVG is an `<svg …>` document.
+fn check_image(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("png") => {
+            let im = image::load_from_memory(&bytes)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(im.width() > 0 && im.height() > 0, "{}", path.display());
+        }
+        Some("svg") => {
+            let text = String::from_utf8(bytes).unwrap();
+            assert!(
+                text.contains("<svg") && text.trim_end().ends_with("</svg>"),
+                "{}",
+                path.display()
+            );
+        }
+        other => panic!("{}: unexpected image type {other:?}", path.display()),
+    }
+}
+
+/// The first of chromium, chromium-browser, google-chrome that runs; without one the test is
+/// reported skipped (or fails under `FACET_REQUIRE_CHROMIUM=1`, as `.ci/run` sets).
+fn chromium_for_tests(test: &str) -> Option<&'static str> {
+    for name in ["chromium", "chromium-browser", "google-chrome"] {
+        if Command::new(name)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+        {
+            return Some(name);
+        }
+    }
+    let why = "no chromium, chromium-browser or google-chrome on PATH (apt-get install chromium)";
+    if std::env::var("FACET_REQUIRE_CHROMIUM").is_ok_and(|v| v == "1") {
+        panic!("{test}: FACET_REQUIRE_CHROMIUM=1 but {why}");
+    }
+    facet_gpu::report_skip(test, why);
+    None
+}
+
+/// The page of one proxy, with a script appended that marks the document once every `<img>`
+/// is `complete` with a `naturalWidth` above 0, loaded by headless Chromium: its DOM carries
+/// the mark (and a failing image would have left it out).
+#[test]
+fn report_page_loads_in_a_browser_with_every_image() {
+    const TEST: &str = "report_page_loads_in_a_browser_with_every_image";
+    let Some(browser) = chromium_for_tests(TEST) else {
+        return;
+    };
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_browser");
+    let (ok, stdout, stderr) = facet_in(
+        &dir,
+        &[
+            "report",
+            "nbrdf:gold-metallic-paint",
+            "--out",
+            "page",
+            "--resolution",
+            "16",
+            "--spp",
+            "1",
+            "--fit-resolution",
+            "32",
+            "--sweep",
+            "0",
+        ],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    let page = dir.join("page");
+    let html = std::fs::read_to_string(page.join("index.html")).unwrap();
+    let n = image_sources(&html).len();
+    let mark = "<script>window.addEventListener('load',()=>{const i=[...document.images];\
+        const good=i.filter(x=>x.complete&&x.naturalWidth>0).length;\
+        document.body.setAttribute('data-images',good+'/'+i.length);});</script>";
+    let checked = page.join("browser-check.html");
+    std::fs::write(&checked, html.replace("</body>", &format!("{mark}</body>"))).unwrap();
+    let out = Command::new(browser)
+        .args([
+            "--headless",
+            "--disable-gpu",
+            "--no-sandbox",
+            "--allow-file-access-from-files",
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+        ])
+        .arg(format!(
+            "file://{}",
+            checked.canonicalize().unwrap().display()
+        ))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&out.stdout);
+    let want = format!("data-images=\"{n}/{n}\"");
+    assert!(
+        dom.contains(&want),
+        "expected {want} in the DOM; stderr:\n{}\nDOM head:\n{}",
+        String::from_utf8_lossy(&out.stderr),
+        &dom[..dom.len().min(2000)]
+    );
+}
+
+/// Sharma, Wu & Dalal (2005), "The CIEDE2000 color-difference formula: implementation notes,
+/// supplementary test data and mathematical observations", Table 1: pairs (L*, a*, b*) and
+/// ΔE00, typed from the paper (pairs 1–4, 7, 13, 17–20, 25 and 34).
+const SHARMA: [([f32; 3], [f32; 3], f32); 12] = [
+    ([50.0, 2.6772, -79.7751], [50.0, 0.0, -82.7485], 2.0425),
+    ([50.0, 3.1571, -77.2803], [50.0, 0.0, -82.7485], 2.8615),
+    ([50.0, 2.8361, -74.0200], [50.0, 0.0, -82.7485], 3.4412),
+    ([50.0, -1.3802, -84.2814], [50.0, 0.0, -82.7485], 1.0000),
+    ([50.0, 0.0, 0.0], [50.0, -1.0, 2.0], 2.3669),
+    ([50.0, 2.4900, -0.0010], [50.0, -2.4900, 0.0009], 7.1792),
+    ([50.0, 2.5, 0.0], [73.0, 25.0, -18.0], 27.1492),
+    ([50.0, 2.5, 0.0], [61.0, -5.0, 29.0], 22.8977),
+    ([50.0, 2.5, 0.0], [56.0, -27.0, -3.0], 31.9030),
+    ([50.0, 2.5, 0.0], [58.0, 24.0, 15.0], 19.4535),
+    (
+        [60.2574, -34.0099, 36.2677],
+        [60.4626, -34.1751, 39.4387],
+        1.2644,
+    ),
+    (
+        [2.0776, 0.0795, -1.1350],
+        [0.9033, -0.0636, -0.5514],
+        0.9082,
+    ),
+];
+
+/// The paper's ΔE00 to its 4 decimals: within 5·10⁻⁵ (its rounding) plus 2·10⁻⁴ for palette's
+/// f32 arithmetic (ΔE of a few tens carries about 10⁻⁶ relative per operation).
+#[test]
+fn ciede2000_matches_sharma_wu_dalal_test_data() {
+    for (a, b, want) in SHARMA {
+        let lab_of = |v: [f32; 3]| Lab::new(v[0], v[1], v[2]);
+        let got = ciede2000(lab_of(a), lab_of(b));
+        assert!(
+            (got - want).abs() < 2.5e-4,
+            "{a:?} {b:?}: {got} against {want}"
+        );
+        // Symmetric, as the formula is.
+        let back = ciede2000(lab_of(b), lab_of(a));
+        assert!(
+            (back - want).abs() < 2.5e-4,
+            "{b:?} {a:?}: {back} against {want}"
+        );
+    }
+}
+
+/// The colour path: the tone map d = 1 − e^−L, then linear sRGB to CIELAB (D65). L = ∞ shows
+/// white, L* = 100; L = ln 2 shows d = ½, L* = 116·(½)^⅓ − 16 = 76.069 (the CIE cube root, as
+/// ½ > (6/29)³); linear sRGB red (1, 0, 0) is CIELAB (53.24, 80.09, 67.20) (its XYZ
+/// (0.4124, 0.2126, 0.0193) over the D65 white (0.9505, 1, 1.089)).
+#[test]
+fn displayed_colours_have_the_expected_lab() {
+    let white = lab(displayed([f32::INFINITY; 3]));
+    assert!((white.l - 100.0).abs() < 1e-3 && white.a.abs() < 1e-3 && white.b.abs() < 1e-3);
+    let grey = lab(displayed([std::f32::consts::LN_2; 3]));
+    let l_half = 116.0 * 0.5f32.cbrt() - 16.0;
+    assert!((grey.l - l_half).abs() < 1e-3, "{grey:?} against {l_half}");
+    let red = lab(palette::LinSrgb::new(1.0, 0.0, 0.0));
+    for (got, want) in [(red.l, 53.24), (red.a, 80.09), (red.b, 67.20)] {
+        // The published values to 2 decimals (±0.005), and the primaries' own 4 digits.
+        assert!((got - want).abs() < 0.02, "{red:?}");
+    }
+}
+
+/// An image against itself: ΔE 0 at every masked pixel, none elsewhere; against a copy with
+/// one pixel changed, ΔE > 0 there alone (a ΔE that is always 0 would fail here).
+#[test]
+fn delta_e_of_an_image_against_itself_is_zero() {
+    let pixels: Vec<[f32; 3]> = (0..64)
+        .map(|i| [0.01 * i as f32, 0.3, 2.0 - 0.02 * i as f32])
+        .collect();
+    let image = Image {
+        width: 8,
+        height: 8,
+        pixels,
+        samples: vec![1; 64],
+    };
+    let mask = |x: u32, _y: u32| x < 6;
+    let same = delta_e_image(&image, &image, &mask);
+    assert_eq!(same.values.iter().flatten().count(), 48);
+    assert!(same.values.iter().flatten().all(|&v| v == 0.0));
+    assert_eq!(same.mean(), 0.0);
+    let mut other = image.clone();
+    other.pixels[9] = [0.5, 0.1, 0.1];
+    let diff = delta_e_image(&image, &other, &mask);
+    assert!(diff.values[9].unwrap() > 1.0);
+    assert_eq!(
+        diff.values.iter().flatten().filter(|&&v| v > 0.0).count(),
+        1
+    );
+}
