@@ -83,10 +83,16 @@ pub fn report_material(
     let mut mean_de = [[None; 3]; 2];
     let mut de: [[Option<DeltaE>; 3]; 2] = Default::default();
     let source = &subject.fit.record.source;
-    // Each material once (a measurement is opened once), cloned per lighting.
-    let materials = variants(subject.measured)
+    let measured = subject.measurement.is_some();
+    // Each material once, cloned per lighting.
+    let materials = variants(measured)
         .into_iter()
-        .map(|v| Ok((v, material(v, source, &subject.fit)?)))
+        .map(|v| {
+            Ok((
+                v,
+                material(v, source, &subject.fit, subject.measurement.as_ref())?,
+            ))
+        })
         .collect::<Result<Vec<_>>>()?;
     for (li, &lighting) in Lighting::ALL.iter().enumerate() {
         let mut images: Vec<(Variant, Image)> = Vec::new();
@@ -101,7 +107,7 @@ pub fn report_material(
                 .with_context(|| format!("writing {}", path.display()))?;
             images.push((variant, image));
         }
-        let reference_variant = reference(subject.measured);
+        let reference_variant = reference(measured);
         let reference = &images
             .iter()
             .find(|(v, _)| *v == reference_variant)
@@ -129,7 +135,7 @@ pub fn report_material(
         name: subject.fit.record.name.clone(),
         input: subject.input.clone(),
         stem: stem.to_owned(),
-        measured: subject.measured,
+        measured,
         record: subject.fit.record.clone(),
         fit_ms: subject.fit_ms,
         render_ms,

@@ -8,12 +8,13 @@
 //! pipelines depend only on those classes; each render gets its own wavefront bound to its own
 //! scene's resources).
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{
-    Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, MeasuredMaterial, Scene,
+    Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, MeasuredMaterial,
+    Measurement, Scene,
 };
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
@@ -96,19 +97,27 @@ pub fn model_key(m: ModelChoice) -> &'static str {
     }
 }
 
-/// The scene material of `variant`: the measurement `source` (opened again, sampled by `fit`)
-/// or a model of `fit`.
-pub fn material(variant: Variant, source: &str, fit: &Arc<FittedMaterial>) -> Result<Material> {
-    Ok(match variant {
-        Variant::Measured => Material {
+/// The scene material of `variant`: the `measurement` of `source` (sampled by `fit`) or a model
+/// of `fit`.
+pub fn material(
+    variant: Variant,
+    source: &str,
+    fit: &Arc<FittedMaterial>,
+    measurement: Option<&Arc<Measurement>>,
+) -> Result<Material> {
+    Ok(match (variant, measurement) {
+        (Variant::Measured, Some(data)) => Material {
             name: "measured".into(),
-            measured: Some(
-                MeasuredMaterial::open(source, Path::new(""), Some(fit.clone()))
-                    .with_context(|| format!("{source}: opening the measurement to render"))?,
-            ),
+            measured: Some(MeasuredMaterial {
+                source: source.into(),
+                path: None,
+                data: data.clone(),
+                fit: Some(fit.clone()),
+            }),
             ..Default::default()
         },
-        Variant::Model(model) => Material {
+        (Variant::Measured, None) => anyhow::bail!("{source}: no measurement to render"),
+        (Variant::Model(model), _) => Material {
             name: model_key(model).into(),
             facet: Some(FacetMaterial {
                 source: source.into(),

@@ -1,11 +1,14 @@
 //! One input of the report, opened and fitted: a measurement (everything `facet fit` takes) is
-//! fitted here; a fit JSON is read, and has no measurement to render.
+//! tabulated and fitted here; a fit JSON is read, and has no measurement to render.
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, anyhow};
+use facet_fit::Brdf;
 use facet_fit::FitConfig;
 use facet_fit::model::material::FittedMaterial;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::{InputSpec, Residence};
+use facet_render::scene::Measurement;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -15,15 +18,18 @@ pub struct Subject {
     pub input: String,
     /// The fit (made here, or read from the JSON).
     pub fit: Arc<FittedMaterial>,
-    /// Whether there is a measurement to render and compare against (false for a fit JSON:
-    /// its models are compared with its tabulated model).
-    pub measured: bool,
-    /// Wall time of the fit made here (opening the source included), ms; a fit JSON's
-    /// recorded total.
+    /// The measurement to render and compare against (`None` for a fit JSON, whose models are
+    /// compared with its tabulated model, and for an anisotropic source).
+    pub measurement: Option<Arc<Measurement>>,
+    /// Wall time of the fit made here (opening and tabulating the source excluded), ms; a fit
+    /// JSON's recorded total.
     pub fit_ms: f64,
 }
 
-/// Opens `input` and fits it with `cfg` (a fit JSON is read instead).
+/// Opens `input` and fits it with `cfg` (a fit JSON is read instead). An isotropic source is
+/// tabulated on the MERL grid once: the fit is made from that table and the table, filled, is
+/// the measurement rendered, so that a neural proxy is evaluated once, not twice. An RGL file
+/// is fitted and rendered as itself; an anisotropic source has no table and is not rendered.
 pub fn open(input: &str, cfg: &FitConfig, library: &mut Option<NbrdfLibrary>) -> Result<Subject> {
     let spec = InputSpec::parse(input);
     if let InputSpec::Fit(path) = &spec {
@@ -32,29 +38,31 @@ pub fn open(input: &str, cfg: &FitConfig, library: &mut Option<NbrdfLibrary>) ->
         return Ok(Subject {
             input: input.to_owned(),
             fit: Arc::new(fit),
-            measured: false,
+            measurement: None,
             fit_ms,
         });
     }
-    let t = Instant::now();
-    let fit = fit_input(&spec, input, cfg, library)?;
-    Ok(Subject {
-        input: input.to_owned(),
-        fit: Arc::new(fit),
-        measured: true,
-        fit_ms: t.elapsed().as_secs_f64() * 1e3,
-    })
-}
-
-/// The fit of the source `spec` (`input` as given) with `cfg`.
-pub fn fit_input(
-    spec: &InputSpec,
-    input: &str,
-    cfg: &FitConfig,
-    library: &mut Option<NbrdfLibrary>,
-) -> Result<FittedMaterial> {
     let src = spec
         .open(None, library, Residence::Read)
         .with_context(|| input.to_owned())?;
-    facet_fit::fit_material(&*src, input, cfg).with_context(|| format!("fitting {input}"))
+    let fitted = |src: &dyn Brdf| -> Result<(FittedMaterial, f64)> {
+        let t = Instant::now();
+        let fit =
+            facet_fit::fit_material(src, input, cfg).with_context(|| format!("fitting {input}"))?;
+        Ok((fit, t.elapsed().as_secs_f64() * 1e3))
+    };
+    let ((fit, fit_ms), measurement) = if matches!(spec, InputSpec::Rgl(_)) || !src.is_isotropic() {
+        (fitted(&*src)?, Measurement::of(&spec, &*src).ok())
+    } else {
+        let table = src.merl_table().into_owned();
+        let tabulated =
+            MerlBrdf::from_table(src.name(), table.clone()).map_err(|e| anyhow!("{input}: {e}"))?;
+        (fitted(&tabulated)?, Some(Measurement::Merl(table.filled())))
+    };
+    Ok(Subject {
+        input: input.to_owned(),
+        fit: Arc::new(fit),
+        measurement: measurement.map(Arc::new),
+        fit_ms,
+    })
 }
