@@ -919,6 +919,38 @@ fn lookup(table: &MerlTable, wi: DVec3, wo: DVec3, broken: bool) -> DVec3 {
     }
 }
 
+/// The point light of the measured-material tests.
+const MEASURED_LIGHT: (DVec3, DVec3) = (DVec3::new(-1.2, 1.5, 2.5), DVec3::new(6.0, 5.0, 4.0));
+
+/// The unit sphere of `material` under [`MEASURED_LIGHT`], no environment, rendered at depth 1
+/// with seeds 0 and 1.
+fn point_lit_sphere(gpu: &Gpu, material: Material) -> (Scene, [Image; 2]) {
+    let mut scene = sphere_scene(material);
+    let (position, intensity) = MEASURED_LIGHT;
+    scene.lights.push(Light::Point {
+        position: position.as_vec3(),
+        intensity: intensity.as_vec3(),
+    });
+    let images = render_twice(gpu, &scene, None, direct_config(16, Strategy::Mis));
+    (scene, images)
+}
+
+/// Per pixel of [`point_lit_sphere`]'s scene, f(ωi, ωo) cos θi I / r² in the sphere's frame.
+fn point_light_reference(scene: &Scene, f: &dyn Fn(DVec3, DVec3) -> DVec3) -> Vec<Option<DVec3>> {
+    let (position, intensity) = MEASURED_LIGHT;
+    reference(scene, |o, d| {
+        let n = hit_unit_sphere(o, d, 70.0)?;
+        let frame = sphere_frame(n);
+        let to_light = position - n;
+        let r2 = to_light.length_squared();
+        let (wi, wo) = (local(frame, to_light.normalize()), local(frame, -d));
+        if wi.z <= 0.0 {
+            return Some(DVec3::ZERO);
+        }
+        Some(f(wi, wo) * wi.z * intensity / r2)
+    })
+}
+
 /// A measured sphere under one point light, no environment, depth 1: every pixel is
 /// f(ωi, ωo) cos θi I / r², f the CPU's interpolated lookup of the same filled table.
 #[test]
@@ -927,26 +959,9 @@ fn measured_sphere_under_a_point_light_is_f_cos_i_over_r2() {
         return;
     };
     let (material, table) = measured_proxy("gold-metallic-paint");
-    let mut scene = sphere_scene(material);
-    let (position, intensity) = (DVec3::new(-1.2, 1.5, 2.5), DVec3::new(6.0, 5.0, 4.0));
-    scene.lights.push(Light::Point {
-        position: position.as_vec3(),
-        intensity: intensity.as_vec3(),
-    });
-    let images = render_twice(&gpu, &scene, None, direct_config(16, Strategy::Mis));
-    let expect = |broken: bool| {
-        reference(&scene, |o, d| {
-            let n = hit_unit_sphere(o, d, 70.0)?;
-            let frame = sphere_frame(n);
-            let to_light = position - n;
-            let r2 = to_light.length_squared();
-            let (wi, wo) = (local(frame, to_light.normalize()), local(frame, -d));
-            if wi.z <= 0.0 {
-                return Some(DVec3::ZERO);
-            }
-            Some(lookup(&table, wi, wo, broken) * wi.z * intensity / r2)
-        })
-    };
+    let (scene, images) = point_lit_sphere(&gpu, material);
+    let expect =
+        |broken: bool| point_light_reference(&scene, &|wi, wo| lookup(&table, wi, wo, broken));
     check_with_power(
         "measured gold-metallic-paint, point light",
         &images,
@@ -1053,26 +1068,8 @@ fn rgl_sphere_under_a_point_light_renders_like_its_ggx() {
         return;
     };
     let (material, file, ggx) = rgl_material("ggx?alpha=0.25&f0=0.9");
-    let mut scene = sphere_scene(material);
-    let (position, intensity) = (DVec3::new(-1.2, 1.5, 2.5), DVec3::new(6.0, 5.0, 4.0));
-    scene.lights.push(Light::Point {
-        position: position.as_vec3(),
-        intensity: intensity.as_vec3(),
-    });
-    let images = render_twice(&gpu, &scene, None, direct_config(16, Strategy::Mis));
-    let expect = |f: &dyn Fn(DVec3, DVec3) -> DVec3| {
-        reference(&scene, |o, d| {
-            let n = hit_unit_sphere(o, d, 70.0)?;
-            let frame = sphere_frame(n);
-            let to_light = position - n;
-            let r2 = to_light.length_squared();
-            let (wi, wo) = (local(frame, to_light.normalize()), local(frame, -d));
-            if wi.z <= 0.0 {
-                return Some(DVec3::ZERO);
-            }
-            Some(f(wi, wo) * wi.z * intensity / r2)
-        })
-    };
+    let (scene, images) = point_lit_sphere(&gpu, material);
+    let expect = |f: &dyn Fn(DVec3, DVec3) -> DVec3| point_light_reference(&scene, f);
     let read = |wi: DVec3, wo: DVec3| viewed(&*file, wi, wo);
     // Broken: the blue channel halved.
     check_with_power(
