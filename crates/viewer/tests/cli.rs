@@ -26,7 +26,8 @@ fn help_describes_each_option() {
     for (option, text) in [
         ("[INPUT]", "as `facet fit` takes it"),
         ("--material <SPEC>", "The same as INPUT"),
-        ("--shown <MODEL>", "measured (the data)"),
+        ("--shown <MODEL>", "measured (the measurement itself"),
+        ("--split", "Split the sphere"),
         ("--scene <PATH.gltf>", "A glTF scene for the preview"),
         ("--screenshot <PATH.png>", "Save a screenshot"),
         ("--frames <N>", "Frames of the preview"),
