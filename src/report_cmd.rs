@@ -130,15 +130,25 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode> {
         });
         match done {
             Ok(r) => reports.push(r),
+            // The readers' and the steps' errors name the input; the others still go on.
             Err(e) => {
                 failed += 1;
-                bar.suspend(|| eprintln!("error: {input}: {e:#}"));
+                bar.suspend(|| eprintln!("error: {e:#}"));
             }
         }
         bar.inc(1);
     }
     bar.finish_and_clear();
-    let sweep = run_sweep(&inputs, args.sweep, &cfg, &mut library)?;
+    if reports.is_empty() {
+        // Nothing to show: the folders made above go again (only if empty: nothing else is
+        // removed).
+        let _ = std::fs::remove_dir(args.out.join(IMG));
+        let _ = std::fs::remove_dir(&args.out);
+        bail!("no input could be reported ({failed} failed)");
+    }
+    // The sweep fits again only inputs that were reported.
+    let reported: Vec<String> = reports.iter().map(|r| r.input.clone()).collect();
+    let sweep = run_sweep(&reported, args.sweep, &cfg, &mut library)?;
     write_page(args, &gpu, &reports, &sweep, started)?;
     print_means(&reports, started);
     Ok(if failed > 0 {

@@ -33,7 +33,7 @@ pub struct Subject {
 pub fn open(input: &str, cfg: &FitConfig, library: &mut Option<NbrdfLibrary>) -> Result<Subject> {
     let spec = InputSpec::parse(input);
     if let InputSpec::Fit(path) = &spec {
-        let fit = FittedMaterial::load(path).with_context(|| input.to_owned())?;
+        let fit = FittedMaterial::load(path)?;
         let fit_ms = fit.record.timings_ms.total;
         return Ok(Subject {
             input: input.to_owned(),
@@ -42,9 +42,7 @@ pub fn open(input: &str, cfg: &FitConfig, library: &mut Option<NbrdfLibrary>) ->
             fit_ms,
         });
     }
-    let src = spec
-        .open(None, library, Residence::Read)
-        .with_context(|| input.to_owned())?;
+    let src = spec.open(None, library, Residence::Read)?;
     let fitted = |src: &dyn Brdf| -> Result<(FittedMaterial, f64)> {
         let t = Instant::now();
         let fit =

@@ -39,9 +39,7 @@ pub fn sweep_input(
     if matches!(spec, InputSpec::Fit(_)) {
         return Ok(Vec::new());
     }
-    let src = spec
-        .open(None, library, Residence::Read)
-        .with_context(|| input.to_owned())?;
+    let src = spec.open(None, library, Residence::Read)?;
     if !src.is_isotropic() {
         return Ok(Vec::new());
     }
