@@ -24,6 +24,7 @@ use facet_fit::model::geometry::azimuth_between;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, NdfKind, correlation, g2};
 use facet_fit::model::rgb::Rgb;
+use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use glam::DVec3;
@@ -133,12 +134,6 @@ fn coated_error(src: &MerlBrdf, set: &GridSamples, coat: Coat, cfg: &FitConfig) 
         },
         set,
     ))
-}
-
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
 fn main() {

@@ -14,6 +14,7 @@ use facet_fit::model::brdf::Brdf;
 use facet_fit::model::material::FittedMaterial;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::rgb::Rgb;
+use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use glam::DVec3;
@@ -56,12 +57,6 @@ struct Row {
     single: f64,
     per_channel: f64,
     ms: [f64; 2],
-}
-
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
 fn row(lib: &NbrdfLibrary, name: &str, cfg: &FitConfig) -> Row {

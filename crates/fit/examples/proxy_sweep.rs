@@ -8,6 +8,7 @@
 
 use facet_fit::fitting::{FitConfig, Models, fit_material};
 use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use std::time::Instant;
@@ -18,12 +19,6 @@ struct Row {
     beckmann: f64,
     max_f: f64,
     ms: f64,
-}
-
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
 }
 
 fn main() {

@@ -10,16 +10,11 @@ use facet_fit::export::rgl::{BsdfResolution, rgl_tensor, sampling_ndfs};
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::metric::grid::{GridSamples, error_metric};
 use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::rgl::RglBsdf;
 use std::time::Instant;
-
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v[((v.len() - 1) as f64 * q).round() as usize]
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

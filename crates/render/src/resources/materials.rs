@@ -16,6 +16,10 @@ use std::sync::Arc;
 /// Fresnel tables are resampled on this many θd nodes over [0, π/2], inclusive.
 pub const FRESNEL_NODES: usize = 91;
 
+/// The GGX α the ray cone widens by where a material states none (a tabulated fit without a
+/// GGX model, an RGL file): a moderately rough lobe.
+const UNKNOWN_CONE_ALPHA: f32 = 0.3;
+
 /// An uploaded material as the CPU knows it: its GPU record and, as types, the class, NDF kind
 /// and shading queue that the record carries as tags for the GPU. The CPU reads these from here;
 /// the record's tags are written from them, never parsed back.
@@ -257,11 +261,9 @@ fn plan_model<'a>(
         }
         Ndf::Tabulated(tab) => {
             // The ray cone widens by the fit's GGX α where there is one.
-            let cone_alpha = fit
-                .record
-                .ggx
-                .as_ref()
-                .map_or(0.3, |p| (p.alpha_x * p.alpha_y).sqrt() as f32);
+            let cone_alpha = fit.record.ggx.as_ref().map_or(UNKNOWN_CONE_ALPHA, |p| {
+                (p.alpha_x * p.alpha_y).sqrt() as f32
+            });
             let s = &tab.stretch;
             (gpu.alpha_x, gpu.alpha_y) = (s.alpha_x as f32, s.alpha_y as f32);
             gpu.rotation = s.rotation as f32;
@@ -301,9 +303,9 @@ fn plan_measured<'a>(
             plan
         }
         (Measurement::Rgl(_), _) => {
-            // The ray cone widens as for a moderately rough lobe: the file states no α.
+            // The file states no α.
             let gpu = GpuMaterial {
-                roughness: 0.3,
+                roughness: UNKNOWN_CONE_ALPHA,
                 ..gpu
             };
             MaterialPlan {
