@@ -126,27 +126,37 @@ impl MerlTable {
     /// Samples f_r(wi, wo) at the bin lower edges; below the horizon and where `f` has no
     /// value the sample is marked missing (−1). [`MerlTable::sample`] samples a BRDF.
     pub fn from_fn(f: impl Fn(DVec3, DVec3) -> Option<Rgb> + Sync) -> Self {
+        Self::from_fn_where(|_, _, _| true, f)
+    }
+
+    /// [`MerlTable::from_fn`] on the bins (θh, θd, φd) = (i, j, k) that `keep` names; the
+    /// others are missing.
+    pub fn from_fn_where(
+        keep: impl Fn(usize, usize, usize) -> bool + Sync,
+        f: impl Fn(DVec3, DVec3) -> Option<Rgb> + Sync,
+    ) -> Self {
         let mut raw = vec![(-1.0f64).to_le_bytes(); 3 * SAMPLES];
-        let values: Vec<Option<Rgb>> = (0..SAMPLES)
+        let values: Vec<(usize, Rgb)> = (0..SAMPLES)
             .into_par_iter()
-            .map(|s| {
+            .filter_map(|s| {
                 let (i, j, k) = (
                     s / (PHI_D_RES * THETA_D_RES),
                     s / PHI_D_RES % THETA_D_RES,
                     s % PHI_D_RES,
                 );
+                if !keep(i, j, k) {
+                    return None;
+                }
                 let (wi, wo) = from_half_diff(bin_angles(i, j, k));
                 if wi.z <= 0.0 || wo.z <= 0.0 {
                     return None;
                 }
-                f(wi, wo)
+                f(wi, wo).map(|v| (s, v))
             })
             .collect();
-        for (s, v) in values.into_iter().enumerate() {
-            if let Some(v) = v {
-                for c in 0..3 {
-                    raw[c * SAMPLES + s] = (v[c] / SCALE[c]).to_le_bytes();
-                }
+        for (s, v) in values {
+            for c in 0..3 {
+                raw[c * SAMPLES + s] = (v[c] / SCALE[c]).to_le_bytes();
             }
         }
         MerlTable {
@@ -269,6 +279,19 @@ impl MerlTable {
     /// bin coordinates; φd wraps with period π; missing corners are left out and the weights of
     /// the others renormalised.
     pub fn lookup_interpolated(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        self.lookup_interpolated_less(wi, wo, |_, _, _| 0.0)
+    }
+
+    /// [`MerlTable::lookup_interpolated`] of the table less `g` sampled at the same bins
+    /// (θh, θd, φd) = (i, j, k): the interpolation of value − g(bin). A sharp lobe known in
+    /// closed form, subtracted on the grid before interpolating, leaves a remainder that
+    /// interpolates as well as the rest of the table.
+    pub fn lookup_interpolated_less(
+        &self,
+        wi: DVec3,
+        wo: DVec3,
+        g: impl Fn(usize, usize, usize) -> f64,
+    ) -> Option<Rgb> {
         let x = bin_coords(to_half_diff(wi, wo));
         let axis = |v: f64, n: usize| {
             let v = v.clamp(0.0, (n - 1) as f64);
@@ -289,7 +312,8 @@ impl MerlTable {
                         continue;
                     }
                     if let Some(v) = self.value(i, j, k) {
-                        (0..3).for_each(|c| sum[c] += w * v[c]);
+                        let g = g(i, j, k);
+                        (0..3).for_each(|c| sum[c] += w * (v[c] - g));
                         wsum += w;
                     }
                 }

@@ -1,11 +1,12 @@
 //! The models: the [`brdf::Brdf`] trait every source and fit implements, the shading-frame
 //! geometry, microfacet NDFs (GGX, Beckmann, tabulated with its stretch and visible-normal
-//! sampling), Fresnel tables and curves, analytic specifications and the fit record
+//! sampling), Fresnel tables and curves, a clear coat over a base ([`coat`]), analytic specifications and the fit record
 //! ([`material::FittedMaterial`]) that the renderer reads. Nothing here fits anything.
 
 pub mod albedo;
 pub mod analytic;
 pub mod brdf;
+pub mod coat;
 pub mod fresnel;
 pub mod fresnel_curves;
 pub mod geometry;
