@@ -12,7 +12,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::Brdf;
 use facet_fit::extract::Stopping;
-use facet_fit::fitting::{Backend, FitConfig, Models, fit_material_on};
+use facet_fit::fitting::{Backend, CoatSearch, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
 use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::fresnel_curves::FresnelChoice;
@@ -140,6 +140,13 @@ pub enum FresnelArg {
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CoatArg {
+    Auto,
+    Always,
+    Off,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum QuadratureArg {
     UniformTheta,
     SqrtMidpoint,
@@ -199,6 +206,7 @@ pub struct FitArgs {
         conflicts_with_all = [
             "inputs", "shard", "model", "aniso", "resolution", "phi_resolution", "iterations",
             "tolerance", "quadrature", "backend", "no_diffuse", "no_refine", "fresnel", "nbrdf",
+            "coat", "no_coat",
         ]
     )]
     summary: Vec<PathBuf>,
@@ -215,6 +223,15 @@ pub struct FitArgs {
     /// recorded with their errors either way (not with --no-diffuse or --aniso).
     #[arg(long, value_enum, default_value = "table")]
     fresnel: FresnelArg,
+    /// When to search a clear coat over a base (η 1.5; its α, its weight and the base under it
+    /// fitted), kept where the coated model fits better: `auto` where the single layer's
+    /// tabulated error is above 0.03, `always`, or `off`. The single layer's models are
+    /// written either way; a coat kept is the fit JSON's `coat`.
+    #[arg(long, value_enum, default_value = "auto")]
+    coat: CoatArg,
+    /// The same as --coat off: the single layer alone.
+    #[arg(long, conflicts_with = "coat")]
+    no_coat: bool,
     /// Neural proxy file for `nbrdf:` inputs (default: `$FACET_NBRDF`, else the MERL-100
     /// proxies embedded in Facet).
     #[arg(long)]
@@ -240,6 +257,13 @@ impl FitArgs {
         }
         cfg.diffuse &= !self.no_diffuse;
         cfg.refine &= !self.no_refine && cfg.diffuse;
+        if cfg.diffuse && !self.aniso {
+            cfg.coat = match (self.no_coat, self.coat) {
+                (true, _) | (_, CoatArg::Off) => CoatSearch::Off,
+                (_, CoatArg::Auto) => CoatSearch::Auto,
+                (_, CoatArg::Always) => CoatSearch::Always,
+            };
+        }
         cfg.fresnel = match self.fresnel {
             FresnelArg::Table => FresnelChoice::Table,
             FresnelArg::Conductor => FresnelChoice::Conductor,

@@ -117,7 +117,11 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode> {
     prepare_out(&args.out, args.force)?;
     let gpu = crate::render_cmd::open_gpu()?;
     let mut renderer = SphereRenderer::new(&gpu, args.resolution, args.spp, args.env.as_deref())?;
-    let mut cfg = FitConfig::isotropic();
+    // The page compares the single layer's models (a coat is not searched).
+    let mut cfg = FitConfig {
+        coat: facet_fit::fitting::CoatSearch::Off,
+        ..FitConfig::isotropic()
+    };
     cfg.extract.resolution = args.fit_resolution;
     let mut library = None;
     let bar = progress_bar(inputs.len());

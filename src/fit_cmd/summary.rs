@@ -7,8 +7,9 @@
 //! `-`:
 //! `material, json, iterations, tab_err, tab_rho_d_r, tab_rho_d_g, tab_rho_d_b, ggx_alpha_x,
 //! ggx_alpha_y, ggx_err, ggx_moments_err, beckmann_alpha_x, beckmann_alpha_y, beckmann_err,
-//! total_ms`; then a row `median` with the medians of the error columns (the medians line's
-//! figures) and of `total_ms`. The timing, the only column that changes from run to run, is
+//! coat_alpha, coat_weight, coat_err, total_ms` (the coat's columns empty where the fit kept
+//! none; `coat_err` is the coated tabulated model's error); then a row `median` with the medians
+//! of the error columns (the medians line's figures) and of `total_ms`. The timing, the only column that changes from run to run, is
 //! last.
 
 use super::shard::{Manifest, Shard};
@@ -40,7 +41,7 @@ pub fn print_summary(rows: &[FitRow]) {
     let mut out = std::io::stdout().lock();
     let _ = writeln!(
         out,
-        "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8}",
+        "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8}  {:>8}",
         "material",
         "iters",
         "tab err",
@@ -49,6 +50,7 @@ pub fn print_summary(rows: &[FitRow]) {
         "ggx err",
         "beckmann αx/αy",
         "beck err",
+        "coat err",
         "ms"
     );
     for FitRow { record: r, .. } in rows {
@@ -68,10 +70,14 @@ pub fn print_summary(rows: &[FitRow]) {
         } else {
             "-".into()
         };
+        let ce = r
+            .coat
+            .as_ref()
+            .map_or("-".into(), |c| format!("{:.4}", c.error));
         let _ = writeln!(
             out,
-            "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8.1}",
-            r.name, r.iterations, te, kd, ga, ge, ba, be, r.timings_ms.total
+            "{:<28} {:>5} {:>9} {:>17}  {:>17} {:>8}  {:>17} {:>8}  {:>8}  {:>8.1}",
+            r.name, r.iterations, te, kd, ga, ge, ba, be, ce, r.timings_ms.total
         );
     }
 }
@@ -85,22 +91,24 @@ fn median(rows: &[FitRow], f: impl Fn(&FitRecord) -> Option<f64>) -> Option<f64>
 }
 
 /// The medians of the errors: tabulated, GGX (by least squares), GGX by slope moments,
-/// Beckmann.
-fn error_medians(rows: &[FitRow]) -> [Option<f64>; 4] {
+/// Beckmann, and the coated tabulated models' (over the fits that kept a coat).
+fn error_medians(rows: &[FitRow]) -> [Option<f64>; 5] {
     [
         median(rows, |r| r.tabulated.error),
         median(rows, |r| r.ggx.as_ref().map(|p| p.error)),
         median(rows, |r| r.ggx.as_ref().map(|p| p.moments.error)),
         median(rows, |r| r.beckmann.as_ref().map(|p| p.error)),
+        median(rows, |r| r.coat.as_ref().map(|c| c.error)),
     ]
 }
 
 /// The medians line, with `seconds` as the time the sweep took.
 pub fn print_medians(rows: &[FitRow], seconds: f64) {
-    let [tab, ggx, ggx_m, beck] =
+    let [tab, ggx, ggx_m, beck, coat] =
         error_medians(rows).map(|m| m.map_or("-".into(), |m| format!("{m:.4}")));
+    let coated = rows.iter().filter(|r| r.record.coat.is_some()).count();
     println!(
-        "median error over {} fits: tabulated {tab}, ggx {ggx} (moments {ggx_m}), beckmann {beck}; {seconds:.2} s in all",
+        "median error over {} fits: tabulated {tab}, ggx {ggx} (moments {ggx_m}), beckmann {beck}; coat kept by {coated} (their coated error {coat}); {seconds:.2} s in all",
         rows.len()
     );
 }
@@ -124,7 +132,7 @@ pub fn summary_csv(rows: &[FitRow]) -> String {
     let mut s = String::from(
         "material,json,iterations,tab_err,tab_rho_d_r,tab_rho_d_g,tab_rho_d_b,ggx_alpha_x,\
          ggx_alpha_y,ggx_err,ggx_moments_err,beckmann_alpha_x,beckmann_alpha_y,beckmann_err,\
-         total_ms\n",
+         coat_alpha,coat_weight,coat_err,total_ms\n",
     );
     for FitRow { json, record: r } in rows {
         let rho = |c: usize| r.diffuse_lobe.then_some(r.tabulated.diffuse[c]);
@@ -150,6 +158,9 @@ pub fn summary_csv(rows: &[FitRow]) -> String {
             bx,
             by,
             be,
+            r.coat.as_ref().map(|c| c.coat.alpha),
+            r.coat.as_ref().map(|c| c.coat.weight),
+            r.coat.as_ref().map(|c| c.error),
             Some(r.timings_ms.total),
         ];
         let mut line = vec![
@@ -161,9 +172,9 @@ pub fn summary_csv(rows: &[FitRow]) -> String {
         s += &(line.join(",") + "\n");
     }
     if !rows.is_empty() {
-        let [tab, ggx, ggx_m, beck] = error_medians(rows).map(csv_number);
+        let [tab, ggx, ggx_m, beck, coat] = error_medians(rows).map(csv_number);
         let ms = csv_number(median(rows, |r| Some(r.timings_ms.total)));
-        s += &format!("median,,,{tab},,,,,,{ggx},{ggx_m},,,{beck},{ms}\n");
+        s += &format!("median,,,{tab},,,,,,{ggx},{ggx_m},,,{beck},,,{coat},{ms}\n");
     }
     s
 }

@@ -299,6 +299,16 @@ pub fn export(
     let kind = choose_kind(options.kind, p, &fits, recorded);
     let curve = Curve::of(target, kind, &fits);
     note_approximations(&mut notes, target, kind, p, &fits, recorded);
+    if let Some(c) = &r.coat {
+        notes.push(format!(
+            "the fit's clear coat (η {}, α {:.4}, weight {:.3}; coated tabulated error {:.3e} against the single layer's {}) is not exported: this is the single layer",
+            c.coat.eta,
+            c.coat.alpha,
+            c.coat.weight,
+            c.error,
+            fmt_error(r.tabulated.error)
+        ));
+    }
     let mut report = Report {
         target: target.name(),
         source_fit: path.display().to_string(),
@@ -629,6 +639,7 @@ mod tests {
             diffuse_lobe: p.fresnel_fits.is_some(),
             separation_rounds: 1,
             refine_rounds: 0,
+            coat: None,
             timings_ms: Default::default(),
         }
     }

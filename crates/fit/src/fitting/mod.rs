@@ -9,6 +9,7 @@
 //! backend of the fit (`evaluator.rs`: the CPU, or a GPU with the source's samples uploaded).
 
 mod analytic;
+pub mod coat;
 pub mod diffuse;
 mod evaluator;
 pub mod fresnel_fit;
@@ -89,6 +90,22 @@ pub struct FitConfig {
     /// The Fresnel each model renders with: its table, or the conductor, dielectric or Schlick
     /// curve fitted to it ([`crate::fitting::fresnel_fit`]; diffuse fits only, where F lies in [0, 1]).
     pub fresnel: FresnelChoice,
+    /// When to search a clear coat over a base ([`coat`]), kept where the coated model fits
+    /// better (diffuse fits only).
+    pub coat: CoatSearch,
+}
+
+/// When a fit searches a clear coat over a base ([`coat`]). The search costs about 40
+/// fits of the base (1–3 s on 2 cores), so by default it runs only where the single layer
+/// leaves an error a coat could lower.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CoatSearch {
+    /// Never: the single layer alone (`--no-coat`).
+    Off,
+    /// Where the single layer's tabulated error is above [`coat::TRY_ABOVE`] (the default).
+    Auto,
+    /// On every fit with a diffuse lobe (`--coat always`).
+    Always,
 }
 
 impl FitConfig {
@@ -102,14 +119,22 @@ impl FitConfig {
             diffuse: true,
             refine: true,
             fresnel: FresnelChoice::Table,
+            coat: CoatSearch::Auto,
         }
     }
+
+    /// [`FitConfig::isotropic`] without the coat: the fit that samples a measured material.
+    pub const SAMPLING: FitConfig = FitConfig {
+        coat: CoatSearch::Off,
+        ..Self::isotropic()
+    };
 
     /// The paper's pipeline: isotropic, one specular lobe, F averaged, no refinement.
     pub const fn single_lobe() -> Self {
         FitConfig {
             diffuse: false,
             refine: false,
+            coat: CoatSearch::Off,
             ..Self::isotropic()
         }
     }
@@ -124,6 +149,7 @@ impl FitConfig {
             diffuse: false,
             refine: false,
             fresnel: FresnelChoice::Table,
+            coat: CoatSearch::Off,
         }
     }
 }
@@ -246,9 +272,11 @@ fn fit_with(
         extract: extract_ms,
         fresnel: fresnel_ms,
         fit: fit_ms,
+        coat: 0.0,
         total: 0.0,
     };
-    fit.material(source, tab, ggx, beckmann, timings, start)
+    let material = fit.material(source, tab, ggx, beckmann, timings, start)?;
+    fit.with_coat(material, start)
 }
 
 /// The analytic fit with the lowest error: the refinement's other start.
@@ -263,6 +291,28 @@ fn best_analytic<'p>(
 }
 
 impl Fit<'_> {
+    /// The coat step ([`coat`]) where the settings ask for it and the single layer's tabulated
+    /// error is known: the material with the coat attached when one fits better.
+    fn with_coat(&self, mut m: FittedMaterial, start: Instant) -> Result<FittedMaterial, FitError> {
+        let wanted = |e: &f64| match self.cfg.coat {
+            CoatSearch::Off => false,
+            CoatSearch::Auto => *e > coat::TRY_ABOVE,
+            CoatSearch::Always => true,
+        };
+        let single = m.record.tabulated.error.filter(wanted);
+        let Some(single) = single.filter(|_| self.diffuse) else {
+            return Ok(m);
+        };
+        let t = Instant::now();
+        if let Some(coated) = coat::fit_coat(self.src, self.cfg, &self.grids.full, single)? {
+            m.record.coat = Some(coated.record());
+            m.coated = Some(Box::new(coated.models));
+        }
+        m.record.timings_ms.coat = ms(t);
+        m.record.timings_ms.total = ms(start);
+        Ok(m)
+    }
+
     /// The record of the fit and its models, the tabulated NDF as the pipeline built it.
     fn material(
         &self,
@@ -309,6 +359,7 @@ impl Fit<'_> {
             diffuse_lobe: self.diffuse,
             separation_rounds: tab.separation_rounds,
             refine_rounds: tab.refine_rounds,
+            coat: None,
             timings_ms: timings,
         };
         FittedMaterial::from_parts(record, Arc::new(tab.ndf)).map_err(|problem| {

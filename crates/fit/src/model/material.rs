@@ -3,6 +3,7 @@
 
 use crate::error::FitError;
 use crate::model::brdf::Brdf;
+use crate::model::coat::{Coat, CoatLayer, Coated};
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::fresnel_curves::FresnelFits;
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
@@ -93,6 +94,9 @@ pub struct Timings {
     pub fresnel: f64,
     /// The GGX / Beckmann fits with their errors (and physical Fresnel fits).
     pub fit: f64,
+    /// The coat's search and its base's fit (0 without one).
+    #[serde(default)]
+    pub coat: f64,
     /// The whole fit.
     pub total: f64,
 }
@@ -145,8 +149,53 @@ pub struct FitRecord {
     /// Rounds of the refinement of the tabulated NDF in the metric's space (0: none).
     #[serde(default)]
     pub refine_rounds: usize,
+    /// A clear coat over a base, where it fits the source better than the single layer above
+    /// (absent: none was searched, or none fitted better). The single layer's models stay
+    /// what they are; this is a second, coated model.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coat: Option<CoatRecord>,
     /// How long each phase took.
     pub timings_ms: Timings,
+}
+
+/// A coat kept by the fit ([`crate::model::coat`]): its parameters, the coated models' errors
+/// against the source, and the base under it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CoatRecord {
+    /// η, α and weight of the coat.
+    #[serde(flatten)]
+    pub coat: Coat,
+    /// The coated tabulated model's error against the source (compare with
+    /// `tabulated.error`, the single layer's).
+    pub error: f64,
+    /// The coated GGX model's error, when GGX was fitted.
+    #[serde(default)]
+    pub ggx_error: Option<f64>,
+    /// The coated Beckmann model's error, when Beckmann was fitted.
+    #[serde(default)]
+    pub beckmann_error: Option<f64>,
+    /// The base: the fit of the data as seen from inside the coat, its models evaluated at the
+    /// refracted directions (its own errors are against those data).
+    pub base: Box<FitRecord>,
+}
+
+/// The coated models of a fit: the coat and the base's models under it.
+#[derive(Clone, Debug)]
+pub struct CoatedModels {
+    /// The coat.
+    pub layer: CoatLayer,
+    /// The base's models.
+    pub base: FittedMaterial,
+}
+
+impl CoatedModels {
+    /// One of the base's models under the coat, if it was fitted.
+    pub fn model(&self, choice: ModelChoice) -> Option<Coated<MicrofacetBrdf>> {
+        self.base.model(choice).map(|m| Coated {
+            layer: self.layer.clone(),
+            base: m.clone(),
+        })
+    }
 }
 
 /// Which model of a fit to use.
@@ -184,6 +233,8 @@ pub struct FittedMaterial {
     pub ggx: Option<MicrofacetBrdf>,
     /// The Beckmann model, when fitted.
     pub beckmann: Option<MicrofacetBrdf>,
+    /// The coated models, when the fit kept a coat (`record.coat`).
+    pub coated: Option<Box<CoatedModels>>,
 }
 
 impl FittedMaterial {
@@ -250,11 +301,13 @@ impl FittedMaterial {
             };
         let ggx = param(NdfKind::Ggx, &record.ggx)?;
         let beckmann = param(NdfKind::Beckmann, &record.beckmann)?;
+        let coated = record.coat.as_ref().map(coated_models).transpose()?;
         Ok(FittedMaterial {
             record,
             tabulated,
             ggx,
             beckmann,
+            coated,
         })
     }
 
@@ -335,6 +388,17 @@ fn check_normalised(ndf: &TabulatedNdf) -> Result<(), String> {
         "tabulated.tables: the NDF integrates to ∫ D cos θ dω = {area:e}, not 1 (a normal \
          distribution; at most a factor of {NORMALISATION_SLACK} off is read)"
     ))
+}
+
+/// The coated models of a record's coat, or an error naming the field.
+fn coated_models(c: &CoatRecord) -> Result<Box<CoatedModels>, String> {
+    if c.base.coat.is_some() {
+        return Err("coat.base: a base under a coat holds a coat itself".into());
+    }
+    let layer = CoatLayer::new(c.coat)?;
+    let base =
+        FittedMaterial::from_record((*c.base).clone()).map_err(|e| format!("coat.base: {e}"))?;
+    Ok(Box::new(CoatedModels { layer, base }))
 }
 
 /// The Fresnel a model renders with: its table, or the fit that `fits.used` names.

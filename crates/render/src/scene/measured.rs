@@ -108,8 +108,9 @@ impl MeasuredMaterial {
         let data = Measurement::of(&spec, &*src).map_err(|e| fail(&e))?;
         let fit = match fit {
             Some(f) => f,
+            // The fit only samples the measurement: no coat is searched.
             None => Arc::new(
-                facet_fit::fit_material(&*src, source, &FitConfig::isotropic())
+                facet_fit::fit_material(&*src, source, &FitConfig::SAMPLING)
                     .map_err(|e| fail(&format!("fitting its sampling NDF: {e}")))?,
             ),
         };

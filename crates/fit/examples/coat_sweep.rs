@@ -1,0 +1,100 @@
+//! Issue 48's coat measured on a library of neural proxies: each fitted with and without the
+//! coat step ([`facet_fit::fitting::coat`]) searched on every material (`CoatSearch::Always`;
+//! the default searches only above `coat::TRY_ABOVE`), the errors side by side, the coat kept
+//! and its time.
+//!
+//! `cargo run --release -p facet-fit --example coat_sweep -- [NBRDF.json] [NAME_FILTER]`
+
+use facet_fit::fitting::{CoatSearch, FitConfig, fit_material};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::numerics::stats::quantile;
+use facet_fit::sources::merl::MerlBrdf;
+use facet_fit::sources::nbrdf::NbrdfLibrary;
+use std::path::Path;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let lib = match args.first().filter(|a| a.as_str() != "-") {
+        Some(p) => NbrdfLibrary::open(Path::new(p)).unwrap(),
+        None => NbrdfLibrary::embedded(),
+    };
+    let filter = args.get(1).cloned().unwrap_or_default();
+    let mut rows = Vec::new();
+    for name in lib.names().filter(|n| n.contains(&filter)) {
+        let src = MerlBrdf::from_table(name, MerlTable::sample(&lib.get(name).unwrap())).unwrap();
+        let cfg = FitConfig {
+            coat: CoatSearch::Always,
+            ..FitConfig::isotropic()
+        };
+        let m = fit_material(&src, name, &cfg).unwrap();
+        let t = m.record.timings_ms;
+        let single = m.record.tabulated.error.unwrap();
+        let (with, note) = match &m.record.coat {
+            Some(c) => (
+                c.error,
+                format!(
+                    "coat η {:.2} α {:.4} w {:.3}; base GGX α {:.4}",
+                    c.coat.eta,
+                    c.coat.alpha,
+                    c.coat.weight,
+                    c.base.ggx.as_ref().map_or(f64::NAN, |p| p.alpha_x)
+                ),
+            ),
+            None => (single, "no coat".into()),
+        };
+        println!(
+            "{name:<28} single {single:.4}  coated {with:.4} ({:.3}×)  {note}  fit {:.0} ms, coat {:.0} ms",
+            with / single,
+            t.total - t.coat,
+            t.coat
+        );
+        rows.push((
+            name.to_owned(),
+            single,
+            with,
+            m.record.coat.is_some(),
+            t.total - t.coat,
+            t.coat,
+        ));
+    }
+    let one: Vec<f64> = rows.iter().map(|r| r.1).collect();
+    let two: Vec<f64> = rows.iter().map(|r| r.2).collect();
+    let kept = rows.iter().filter(|r| r.3).count();
+    let ms: Vec<f64> = rows.iter().map(|r| r.4 + r.5).collect();
+    println!(
+        "single layer: median {:.4} p90 {:.4}; with the coat step: median {:.4} p90 {:.4}; coat kept by {kept} of {}; fit time median {:.0} ms",
+        quantile(&one, 0.5),
+        quantile(&one, 0.9),
+        quantile(&two, 0.5),
+        quantile(&two, 0.9),
+        rows.len(),
+        quantile(&ms, 0.5),
+    );
+    // The default (`CoatSearch::Auto`) searches only above TRY_ABOVE: its errors and times.
+    let auto = |r: &(String, f64, f64, bool, f64, f64)| r.1 > facet_fit::fitting::coat::TRY_ABOVE;
+    let auto_err: Vec<f64> = rows
+        .iter()
+        .map(|r| if auto(r) { r.2 } else { r.1 })
+        .collect();
+    let auto_ms: Vec<f64> = rows
+        .iter()
+        .map(|r| r.4 + if auto(r) { r.5 } else { 0.0 })
+        .collect();
+    let single_ms: Vec<f64> = rows.iter().map(|r| r.4).collect();
+    println!(
+        "the default (--coat auto, searched where the single layer's error is above {}): searched {}, kept {}; median {:.4} p90 {:.4}; fit time median {:.0} ms, p90 {:.0} ms (the single layer alone: median {:.0} ms)",
+        facet_fit::fitting::coat::TRY_ABOVE,
+        rows.iter().filter(|r| auto(r)).count(),
+        rows.iter().filter(|r| auto(r) && r.3).count(),
+        quantile(&auto_err, 0.5),
+        quantile(&auto_err, 0.9),
+        quantile(&auto_ms, 0.5),
+        quantile(&auto_ms, 0.9),
+        quantile(&single_ms, 0.5),
+    );
+    rows.sort_by(|a, b| b.1.total_cmp(&a.1));
+    println!("the ten worst single layers:");
+    for r in rows.iter().take(10) {
+        println!("  {:<28} {:.4} → {:.4}", r.0, r.1, r.2);
+    }
+}

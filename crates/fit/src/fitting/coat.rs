@@ -1,0 +1,255 @@
+//! The coat step: a clear coat ([`crate::model::coat`]) searched over the single-layer fit and
+//! kept only where the coated model fits the source better.
+//!
+//! For a candidate coat the base is what the data must be under it, seen from inside
+//! ([`SeenFromInside`]: f_base(ωi', ωo') = η² (f(ωi, ωo) − coat lobe) / (T(θi) T(θo)) at the
+//! outside directions of each inside pair; pairs past the critical angle have none and are
+//! missing), fitted by the same pipeline as any source. The candidate's score is the coated
+//! model's error on the source's own samples. The search: the best of a coarse grid of α and
+//! weight, then α by Brent's method in log α between the grid's neighbours, the weight, and α
+//! again within ±10 % and finer, on a cheap base fit (32 extraction nodes, the
+//! tabulated model alone, no refinement) and every [`SEARCH_STRIDE`]-th row of the source;
+//! then one full fit of the base at the coat found. The coat is kept when the coated tabulated
+//! model's error on the full grid is below (1 − [`KEEP_MARGIN`]) times the single layer's.
+
+use crate::error::FitError;
+use crate::fitting::{CoatSearch, FitConfig, Models};
+use crate::metric::grid::{GridSamples, error_metric};
+use crate::model::brdf::Brdf;
+use crate::model::coat::{Coat, CoatLayer, Coated};
+use crate::model::geometry::from_half_diff;
+use crate::model::material::{CoatRecord, CoatedModels, FittedMaterial};
+use crate::model::merl_grid::MerlTable;
+use crate::model::merl_grid::bin_angles;
+use crate::model::microfacet::MicrofacetBrdf;
+use crate::model::rgb::Rgb;
+use crate::numerics::optim::brent;
+use crate::sources::merl::MerlBrdf;
+use glam::DVec3;
+
+/// The coat's index of refraction: a clear lacquer's (car paints' coats are 1.45–1.55).
+pub const COAT_ETA: f64 = 1.5;
+/// [`CoatSearch::Auto`] searches a coat where the single layer's tabulated error is above this.
+pub const TRY_ABOVE: f64 = 0.03;
+/// The coarse grid the search starts from: α ...
+const GRID_ALPHAS: [f64; 5] = [0.005, 0.015, 0.04, 0.1, 0.3];
+/// ... and weight.
+const GRID_WEIGHTS: [f64; 3] = [0.15, 0.5, 1.0];
+/// A coat is kept when it lowers the tabulated model's error by at least this fraction.
+pub const KEEP_MARGIN: f64 = 0.01;
+/// The search scores candidates on every `SEARCH_STRIDE`-th (θh, θd) row of the source.
+const SEARCH_STRIDE: usize = 16;
+/// The search's base fits see every `SEARCH_PHI_STRIDE`-th φd bin of the data under the coat.
+const SEARCH_PHI_STRIDE: usize = 4;
+/// The search's base fits extract on this many nodes.
+const SEARCH_RESOLUTION: usize = 32;
+
+/// A coat kept by the fit: the layer and the base fitted under it.
+#[derive(Clone, Debug)]
+pub struct CoatedFit {
+    /// The coat and the base's models under it.
+    pub models: CoatedModels,
+    /// The coated tabulated model's error on the source's full grid.
+    pub error: f64,
+    /// The coated GGX and Beckmann models' errors, where fitted.
+    pub ggx_error: Option<f64>,
+    /// See `ggx_error`.
+    pub beckmann_error: Option<f64>,
+}
+
+impl CoatedFit {
+    /// What the fit JSON holds of it.
+    pub fn record(&self) -> CoatRecord {
+        CoatRecord {
+            coat: self.models.layer.coat,
+            error: self.error,
+            ggx_error: self.ggx_error,
+            beckmann_error: self.beckmann_error,
+            base: Box::new(self.models.base.record.clone()),
+        }
+    }
+}
+
+/// The data as the base must be under `layer`, at inside directions.
+pub struct SeenFromInside<'a> {
+    /// The measurement on the MERL grid.
+    pub data: &'a MerlTable,
+    /// The coat over the base.
+    pub layer: &'a CoatLayer,
+}
+
+/// Where tan²θh / α_c² is below this the coat's lobe is subtracted on the grid (D_c above
+/// 1/101² of its peak); elsewhere at the point.
+const SHARP_LOBE: f64 = 100.0;
+
+impl SeenFromInside<'_> {
+    /// The data less the coat's lobe at outside directions (i, o). Near the lobe's peak the
+    /// lobe is subtracted at each grid sample before interpolating
+    /// ([`MerlTable::lookup_interpolated_less`]): the grid's interpolation of a sharp lobe is
+    /// off by far more than a base's values.
+    fn less_coat(&self, i: DVec3, o: DVec3) -> Option<Rgb> {
+        let h = (i + o).normalize();
+        let a2 = self.layer.coat.alpha * self.layer.coat.alpha;
+        if (1.0 - h.z * h.z) / (h.z * h.z) > SHARP_LOBE * a2 {
+            let r = self.layer.reflection(i, o);
+            return Some(self.data.lookup_interpolated(i, o)?.map(|v| v - r));
+        }
+        self.data.lookup_interpolated_less(i, o, |a, b, c| {
+            let (bi, bo) = from_half_diff(bin_angles(a, b, c));
+            self.layer.reflection(bi, bo)
+        })
+    }
+}
+
+impl Brdf for SeenFromInside<'_> {
+    fn name(&self) -> &str {
+        "under a coat"
+    }
+
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        let coat = &self.layer.coat;
+        let (i, o) = (coat.refract_out(wi)?, coat.refract_out(wo)?);
+        let t = self.layer.base_factor(i, o);
+        Some(self.less_coat(i, o)?.map(|v| (v / t).max(0.0)))
+    }
+}
+
+/// The base fitted under `layer` with `cfg`, on every `phi_stride`-th φd bin of the grid.
+pub fn fit_base(
+    src: &dyn Brdf,
+    data: &MerlTable,
+    layer: &CoatLayer,
+    cfg: &FitConfig,
+    phi_stride: usize,
+) -> Result<FittedMaterial, FitError> {
+    let seen = SeenFromInside { data, layer };
+    let name = format!("{}-base", src.name());
+    let table = MerlTable::from_fn_where(|_, _, k| k % phi_stride == 0, |wi, wo| seen.eval(wi, wo));
+    let under = MerlBrdf::from_table(&name, table).map_err(|problem| FitError::Extraction {
+        name: name.clone(),
+        problem: format!("under a coat {:?}: {problem}", layer.coat),
+    })?;
+    let cfg = FitConfig {
+        coat: CoatSearch::Off,
+        ..*cfg
+    };
+    crate::fitting::fit_material(&under, &name, &cfg)
+}
+
+/// The coated model's error on `set`.
+pub fn coated_error(layer: &CoatLayer, base: &MicrofacetBrdf, set: &GridSamples) -> f64 {
+    error_metric(
+        &Coated {
+            layer: layer.clone(),
+            base: base.clone(),
+        },
+        set,
+    )
+}
+
+/// The search's score of one coat: the coated model's error on `set` with a cheap base fit;
+/// infinite where the data under the coat cannot be fitted.
+fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &GridSamples) -> f64 {
+    let Ok(layer) = CoatLayer::new(coat) else {
+        return f64::INFINITY;
+    };
+    let mut cheap = FitConfig {
+        models: Models {
+            tabulated: true,
+            ggx: false,
+            beckmann: false,
+        },
+        refine: false,
+        ..*cfg
+    };
+    cheap.extract.resolution = SEARCH_RESOLUTION;
+    match fit_base(src, data, &layer, &cheap, SEARCH_PHI_STRIDE) {
+        Ok(base) => coated_error(&layer, &base.tabulated, set),
+        Err(_) => f64::INFINITY,
+    }
+}
+
+/// The coat that scores best: α at weight 1, then the weight, then α again.
+pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamples) -> Coat {
+    let set = full.subsample(SEARCH_STRIDE);
+    let score = |coat: Coat| score(src, data, coat, cfg, &set);
+    // The best of a coarse grid: the score has several minima on real paints.
+    let (mut best, mut at) = (f64::INFINITY, (0, 0));
+    for (i, &alpha) in GRID_ALPHAS.iter().enumerate() {
+        for (j, &weight) in GRID_WEIGHTS.iter().enumerate() {
+            let s = score(Coat::new(COAT_ETA, alpha, weight));
+            if s < best {
+                (best, at) = (s, (i, j));
+            }
+        }
+    }
+    // Brent's method in ln α on [lo, hi], to `tol` times |ln α| (about 3 ln α's bits).
+    let by_alpha = |coat: Coat, (lo, hi): (f64, f64), tol: f64| Coat {
+        alpha: brent(
+            |x| {
+                score(Coat {
+                    alpha: x.exp(),
+                    ..coat
+                })
+            },
+            lo.ln(),
+            coat.alpha.ln(),
+            hi.ln(),
+            tol,
+        )
+        .exp(),
+        ..coat
+    };
+    let (i, j) = at;
+    let start = Coat::new(COAT_ETA, GRID_ALPHAS[i], GRID_WEIGHTS[j]);
+    let bracket = (
+        GRID_ALPHAS[i.saturating_sub(1)].min(start.alpha / 2.0),
+        GRID_ALPHAS[(i + 1).min(GRID_ALPHAS.len() - 1)].max(start.alpha * 2.0),
+    );
+    let coat = by_alpha(start, bracket, 0.003);
+    let coat = Coat {
+        weight: brent(
+            |w| score(Coat { weight: w, ..coat }),
+            0.0,
+            coat.weight,
+            1.0,
+            0.01,
+        ),
+        ..coat
+    };
+    // Again within ±10 % of the α found, finer: the base's α moves about 3 % per 1 % of the coat's.
+    let near = (coat.alpha / 1.1, coat.alpha * 1.1);
+    by_alpha(coat, near, 0.0004)
+}
+
+/// The coat step of a fit whose single layer has the tabulated error `single`: the coat found
+/// by [`search`], its base fitted in full, kept if it fits better.
+pub fn fit_coat(
+    src: &dyn Brdf,
+    cfg: &FitConfig,
+    full: &GridSamples,
+    single: f64,
+) -> Result<Option<CoatedFit>, FitError> {
+    let data = src.merl_table();
+    let coat = search(src, &data, cfg, full);
+    let layer = CoatLayer::new(coat).map_err(|problem| FitError::Extraction {
+        name: src.name().into(),
+        problem,
+    })?;
+    let Ok(base) = fit_base(src, &data, &layer, cfg, 1) else {
+        return Ok(None);
+    };
+    let error = coated_error(&layer, &base.tabulated, full);
+    if !(error < (1.0 - KEEP_MARGIN) * single) {
+        return Ok(None);
+    }
+    Ok(Some(CoatedFit {
+        ggx_error: base.ggx.as_ref().map(|m| coated_error(&layer, m, full)),
+        beckmann_error: base
+            .beckmann
+            .as_ref()
+            .map(|m| coated_error(&layer, m, full)),
+        error,
+        models: CoatedModels { layer, base },
+    }))
+}
