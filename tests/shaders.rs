@@ -221,7 +221,9 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         layout_check!(GpuMaterial, "render/extend.wgsl", "Material", {
             base_color, emissive, diffuse, kind, ndf_kind, alpha_x, alpha_y, rotation,
             metallic, roughness, normal_scale, tex_base, tex_mr, tex_normal, tex_emissive,
-            fresnel_offset, fresnel_count, tab_offset, queue, measured_offset, pad0, pad1, pad2,
+            fresnel_offset, fresnel_count, tab_offset, queue, measured_offset, coat_block,
+            coat_weight, coat_alpha, coat_eta, tex_clearcoat, tex_clearcoat_roughness,
+            tex_clearcoat_normal, clearcoat_normal_scale, pad0, pad1, pad2,
         }),
         layout_check!(GpuLight, "render/extend.wgsl", "Light", {
             kind, prim, cos_inner, cos_outer, position, direction, intensity, leaf, pad0, pad1,

@@ -33,6 +33,17 @@ struct Material {
     queue: u32,
     // a measured material's table: its MERL grid or its RGL block in `tables`
     measured_offset: u32,
+    // a coated material's coat block in `tables` (NONE: no coat), render/coat.inc.wgsl
+    coat_block: u32,
+    coat_weight: f32,
+    coat_alpha: f32,
+    coat_eta: f32,
+    // KHR_materials_clearcoat's textures (NONE: none) and normal scale (glTF stage: coat_weight
+    // the factor, coat_alpha the roughness)
+    tex_clearcoat: u32,
+    tex_clearcoat_roughness: u32,
+    tex_clearcoat_normal: u32,
+    clearcoat_normal_scale: f32,
     pad0: u32,
     pad1: u32,
     pad2: u32,
@@ -123,6 +134,9 @@ struct Surface {
     ng: vec3<f32>,
     // shading frame (normal-mapped), n on the side of ng
     n: vec3<f32>,
+    // the interpolated vertex normal (before the normal map) and tangent (w: the bitangent's sign)
+    n_vertex: vec3<f32>,
+    tangent: vec4<f32>,
     t: vec3<f32>,
     b: vec3<f32>,
     uv: vec2<f32>,
@@ -181,15 +195,10 @@ fn surface_at(prim: u32, bu: f32, bv: f32, wo: vec3<f32>) -> Surface {
     s.curvature = max(max(length(n1 - n0) / max(length(dp1), 1e-20), length(n2 - n0) / max(length(dp2), 1e-20)),
                       length(n2 - n1) / max(length(p2 - p1), 1e-20));
     let m = materials[s.material];
+    s.n_vertex = n;
+    s.tangent = tg;
     if (m.tex_normal != NONE) {
-        // Tangent-space normal map (glTF): n' = normalize(t x + b y + n z), xy scaled.
-        let tn = texture_sample(m.tex_normal, s.uv).xyz * 2.0 - 1.0;
-        let t0 = normalize(tg.xyz - n * dot(n, tg.xyz));
-        let b0 = cross(n, t0) * select(-1.0, 1.0, tg.w >= 0.0);
-        let mapped = normalize(t0 * tn.x * m.normal_scale + b0 * tn.y * m.normal_scale + n * max(tn.z, 1e-3));
-        if (all(mapped == mapped)) {
-            n = mapped;
-        }
+        n = normal_mapped(n, tg, m.tex_normal, m.normal_scale, s.uv);
     }
     s.ng = ng;
     s.n = n;
@@ -202,6 +211,16 @@ fn surface_at(prim: u32, bu: f32, bv: f32, wo: vec3<f32>) -> Surface {
     s.t = normalize(t);
     s.b = cross(n, s.t);
     return s;
+}
+
+// Tangent-space normal map (glTF) about the vertex normal n: n' = normalize(t x + b y + n z),
+// xy scaled; n where the map gives no direction.
+fn normal_mapped(n: vec3<f32>, tg: vec4<f32>, tex: u32, scale: f32, uv: vec2<f32>) -> vec3<f32> {
+    let tn = texture_sample(tex, uv).xyz * 2.0 - 1.0;
+    let t0 = normalize(tg.xyz - n * dot(n, tg.xyz));
+    let b0 = cross(n, t0) * select(-1.0, 1.0, tg.w >= 0.0);
+    let mapped = normalize(t0 * tn.x * scale + b0 * tn.y * scale + n * max(tn.z, 1e-3));
+    return select(n, mapped, all(mapped == mapped));
 }
 
 fn to_local(s: Surface, w: vec3<f32>) -> vec3<f32> {

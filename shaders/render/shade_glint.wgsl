@@ -7,6 +7,8 @@
 // the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
 // N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals, mixed with
 // the cosine lobe by albedo where the fit has a diffuse term (as shade_microfacet.wgsl).
+// Under a fit's coat (render/coat.inc.wgsl) the flakes are the base's: the same counts, lit and
+// seen along the directions refracted into the coat and attenuated by its transmission.
 
 #include "render/frame.inc.wgsl"
 #include "common/ndf_kind.inc.wgsl"
@@ -30,6 +32,7 @@ override Q_SHADE: u32;
 #include "glint/chains2.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
+#include "render/coat.inc.wgsl"
 
 struct Bsdf {
     material: u32,
@@ -43,6 +46,9 @@ struct Bsdf {
     p_spec: f32,
     // Picks the direction cell each query reads (glint_cell_u in glint/glint_brdf.inc.wgsl).
     cell_u: f32,
+    // the specular and diffuse lobes' albedo estimates (luminance)
+    albedo: f32,
+    coat: Coat,
 }
 
 // A world vector in the tangent plane to UV: least squares through J = [dP/du dP/dv],
@@ -81,6 +87,8 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     let spec = luminance(fresnel_table(m, 1.0));
     let diff = luminance(b.diffuse);
     b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
+    b.albedo = spec + diff;
+    b.coat = coat_of(m);
     // The cone's circle of radius w/2 around the ray, projected onto the tangent plane: an
     // ellipse with semi-axes r (across the ray) and r / |cos θ| (along it).
     let d = path_get(R_DIR, slot).xyz;
@@ -109,7 +117,7 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
 }
 
 // Both directions from one walk over the footprint's flakes.
-fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
+fn base_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
     glint_tab = b.tab;
     glint_cell_u = b.cell_u;
     let k = glint_factor_pair(wi_light, wi_bsdf, wo, b.center, b.a, b.b);
@@ -140,7 +148,7 @@ fn glint_lambda(w: vec3<f32>) -> f32 {
 }
 
 // The smooth lobe's visible normals: analytic, or the table's visible distribution.
-fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+fn base_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return 0.0;
     }
@@ -154,7 +162,11 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
 }
 
-fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
+fn base_albedo(b: Bsdf) -> f32 {
+    return b.albedo;
+}
+
+fn base_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
     if (u.z >= b.p_spec) {
         return sample_cosine(u.xy);
     }

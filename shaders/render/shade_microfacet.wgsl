@@ -5,7 +5,8 @@
 // visible from ωo (by frame.ndf_sampling: analytic in closed form, tabulated by the table's
 // visible slices); else the cosine lobe when the fit has a diffuse term.
 // MEASURED = 1 (with TABULATED = 1): f is a measured MERL-grid table (render/merl.inc.wgsl),
-// sampled as its fit's tabulated model is.
+// sampled as its fit's tabulated model is. A fit that kept a coat is this model under its coat
+// (render/coat.inc.wgsl).
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -14,6 +15,7 @@
 #include "render/shade.inc.wgsl"
 #include "render/tabulated.inc.wgsl"
 #include "render/merl.inc.wgsl"
+#include "render/coat.inc.wgsl"
 
 override Q_SHADE: u32;
 override TABULATED: bool;
@@ -25,6 +27,9 @@ struct Bsdf {
     tab: TabNdf,
     diffuse: vec3<f32>,
     p_spec: f32,
+    // the specular and diffuse lobes' albedo estimates (luminance)
+    albedo: f32,
+    coat: Coat,
 }
 
 fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
@@ -40,6 +45,8 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     let spec = luminance(fresnel_table(m, 1.0));
     let diff = luminance(b.diffuse);
     b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
+    b.albedo = spec + diff;
+    b.coat = coat_of(m);
     if (frame.ndf_sampling == NDF_SAMPLING_COSINE) {
         b.p_spec = 0.0;
     }
@@ -81,7 +88,7 @@ fn mf_sample_h(b: Bsdf, wo: vec3<f32>, u: vec2<f32>) -> vec3<f32> {
     return lobe_sample_h(b.analytic, wo, u);
 }
 
-fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+fn base_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return vec3<f32>(0.0);
     }
@@ -94,7 +101,7 @@ fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     return f * mf_d(b, h) * g / (4.0 * wi.z * wo.z) + b.diffuse / PI;
 }
 
-fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+fn base_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return 0.0;
     }
@@ -104,11 +111,15 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
 }
 
-fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
-    return array<vec3<f32>, 2>(bsdf_eval(b, wi_light, wo), bsdf_eval(b, wi_bsdf, wo));
+fn base_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
+    return array<vec3<f32>, 2>(base_eval(b, wi_light, wo), base_eval(b, wi_bsdf, wo));
 }
 
-fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
+fn base_albedo(b: Bsdf) -> f32 {
+    return b.albedo;
+}
+
+fn base_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
     var wi: vec3<f32>;
     if (u.z < b.p_spec) {
         let h = mf_sample_h(b, wo, u.xy);

@@ -106,6 +106,18 @@ pub struct GpuMaterial {
     pub queue: u32,
     /// A measured material's table (its MERL grid or its RGL block) in the scene tables.
     pub measured_offset: u32,
+    /// A coated material's coat block in the scene tables (NONE: no coat): its lobe's albedo
+    /// table (shaders/render/coat.inc.wgsl).
+    pub coat_block: u32,
+    pub coat_weight: f32,
+    pub coat_alpha: f32,
+    pub coat_eta: f32,
+    /// KHR_materials_clearcoat's textures (NONE: none) and normal scale; the glTF stage reads
+    /// its factor and roughness from coat_weight and coat_alpha.
+    pub tex_clearcoat: u32,
+    pub tex_clearcoat_roughness: u32,
+    pub tex_clearcoat_normal: u32,
+    pub clearcoat_normal_scale: f32,
     pub pad0: u32,
     pub pad1: u32,
     pub pad2: u32,

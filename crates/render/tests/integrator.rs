@@ -251,6 +251,50 @@ fn glints_with_huge_density_render_the_smooth_model() {
     }
 }
 
+/// Glints under a coat: with a huge flake density the glint material is its smooth coated
+/// model (the image means agree within 2 %), and the coat is seen (the uncoated glints' mean is
+/// more than 5 % away).
+#[test]
+fn coated_glints_with_huge_density_render_the_smooth_coated_model() {
+    use facet_fit::model::coat::Coat;
+    use facet_fit::model::material::CoatRecord;
+    let Some(gpu) = gpu_for_tests("coated_glints_with_huge_density_render_the_smooth_coated_model")
+    else {
+        return;
+    };
+    let env = Environment::Constant(Vec3::ONE);
+    let mut record = conductor_fit().record.clone();
+    record.coat = Some(CoatRecord {
+        coat: Coat::new(1.5, 0.05, 1.0),
+        error: 0.0,
+        ggx_error: None,
+        beckmann_error: None,
+        base: Box::new(conductor_fit().record.clone()),
+    });
+    let coated = Arc::new(FittedMaterial::from_record(record).unwrap());
+    let spec = GlintParams {
+        density: 1e12,
+        gamma_deg: 5.0,
+        threshold: 50.0,
+    };
+    let on = |x, y| theta_o(x, y, 70.0).is_some();
+    let mean = |fit: &Arc<FittedMaterial>, glint: Option<GlintParams>| {
+        let mut m = facet_material(ModelChoice::Ggx, glint);
+        m.facet.as_mut().unwrap().fit = fit.clone();
+        let scene = sphere_scene(m);
+        let (img, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), config(16));
+        img.mean_where(on)[0]
+    };
+    let smooth = mean(&coated, None);
+    let glinty = mean(&coated, Some(spec));
+    let bare = mean(&conductor_fit(), Some(spec));
+    println!(
+        "coated: smooth {smooth:.4}, glints (N = 1e12) {glinty:.4}; uncoated glints {bare:.4}"
+    );
+    assert!((glinty / smooth - 1.0).abs() < 0.02, "{glinty} vs {smooth}");
+    assert!((bare / smooth - 1.0).abs() > 0.05, "{bare} vs {smooth}");
+}
+
 /// The filtered switch leaves no seam: counting everywhere, the mean everywhere and a threshold
 /// in the middle of the footprints' expected counts give the same image mean.
 #[test]

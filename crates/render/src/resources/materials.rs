@@ -6,6 +6,7 @@ use crate::error::RenderError;
 use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
 use crate::scene::{GlintParams, Material, MeasuredMaterial, Measurement};
+use facet_fit::model::coat::CoatLayer;
 use facet_fit::model::material::FittedMaterial;
 use facet_fit::model::merl_grid::{MerlTable, SAMPLES};
 use facet_fit::model::microfacet::{MicrofacetBrdf, Ndf, NdfKind};
@@ -105,6 +106,8 @@ pub struct MaterialPlan<'a> {
     pub glint: Option<(Ndf, GlintParams)>,
     /// A measured material's data, placed once per scene however many materials share it.
     pub measured: Option<&'a Arc<Measurement>>,
+    /// A coated fit's coat (its base is the plan's model).
+    pub coat: Option<&'a CoatLayer>,
 }
 
 impl MaterialPlan<'_> {
@@ -116,6 +119,9 @@ impl MaterialPlan<'_> {
         }
         if self.measured.is_some() || old.kind == MaterialKind::Measured {
             return Err("measured materials are rebuilt");
+        }
+        if self.coat.is_some() || old.gpu.coat_block != NONE {
+            return Err("coated materials are rebuilt");
         }
         if self.slot.kind != old.kind || self.slot.ndf != old.ndf {
             return Err("the material class changed");
@@ -134,6 +140,13 @@ impl MaterialPlan<'_> {
         }
         if let Some(tab) = self.tabulated {
             self.slot.gpu.tab_offset = tables.push(source, tabulated_block(tab));
+        }
+        if let Some(layer) = self.coat {
+            let gpu = &mut self.slot.gpu;
+            gpu.coat_block = tables.push(source, coat_block(layer));
+            gpu.coat_weight = layer.coat.weight as f32;
+            gpu.coat_alpha = layer.coat.alpha as f32;
+            gpu.coat_eta = layer.coat.eta as f32;
         }
     }
 }
@@ -160,6 +173,14 @@ pub fn tabulated_block(tab: &TabulatedNdf) -> Vec<f32> {
         block.extend(t.iter().map(|&v| v as f32));
     }
     block
+}
+
+/// A coat's block as shaders/render/coat.inc.wgsl reads it: [n, E_c at the n nodes].
+pub fn coat_block(layer: &CoatLayer) -> Vec<f32> {
+    let nodes = layer.albedo_nodes();
+    std::iter::once(nodes.len() as f32)
+        .chain(nodes.iter().map(|&e| e as f32))
+        .collect()
 }
 
 /// A MERL-grid table as shaders/render/merl.inc.wgsl reads it: f_r per sample, RGB
@@ -189,7 +210,7 @@ fn texture(t: Option<u32>) -> u32 {
 /// a glint material renders that model's NDF (analytic or tabulated) as flakes; a measured
 /// material is evaluated from its table, a MERL-grid one sampled by its fit's tabulated model.
 pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
-    let gpu = GpuMaterial {
+    let mut gpu = GpuMaterial {
         base_color: m.base_color.to_array(),
         emissive: m.emissive.extend(m.specular).to_array(),
         alpha_x: 1.0,
@@ -201,8 +222,21 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
         tex_mr: texture(m.metallic_roughness_texture),
         tex_normal: texture(m.normal_texture),
         tex_emissive: texture(m.emissive_texture),
+        coat_block: NONE,
+        tex_clearcoat: NONE,
+        tex_clearcoat_roughness: NONE,
+        tex_clearcoat_normal: NONE,
         ..Default::default()
     };
+    if let Some(c) = &m.clearcoat {
+        gpu.coat_weight = c.factor;
+        gpu.coat_alpha = c.roughness;
+        gpu.coat_eta = 1.5;
+        gpu.tex_clearcoat = texture(c.texture);
+        gpu.tex_clearcoat_roughness = texture(c.roughness_texture);
+        gpu.tex_clearcoat_normal = texture(c.normal_texture);
+        gpu.clearcoat_normal_scale = c.normal_scale;
+    }
     if let Some(measured) = &m.measured {
         return plan_measured(gpu, m, measured);
     }
@@ -213,15 +247,21 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
             tabulated: None,
             glint: None,
             measured: None,
+            coat: None,
         });
     };
-    let brdf = f.fit.model(f.model).ok_or_else(|| {
+    // A fit that kept a coat renders its coated model: a glint material its base's flakes
+    // under the coat.
+    let coated = f.fit.coated.as_deref();
+    let fit = coated.map_or(&*f.fit, |c| &c.base);
+    let brdf = fit.model(f.model).ok_or_else(|| {
         RenderError::input(
             &f.source,
             format!("material {:?}: the fit has no {:?} model", m.name, f.model),
         )
     })?;
-    let mut plan = plan_model(gpu, brdf, &f.fit);
+    let mut plan = plan_model(gpu, brdf, fit);
+    plan.coat = coated.map(|c| &c.layer);
     // A glint material keeps its NDF's parameters (and a tabulated one its tables) for the
     // glint stage's D, Λ and sampling.
     plan.glint = f.glint.map(|g| {
@@ -278,6 +318,7 @@ fn plan_model<'a>(
         tabulated,
         glint: None,
         measured: None,
+        coat: None,
     }
 }
 
@@ -314,6 +355,7 @@ fn plan_measured<'a>(
                 tabulated: None,
                 glint: None,
                 measured: None,
+                coat: None,
             }
         }
     };

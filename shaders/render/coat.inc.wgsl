@@ -1,0 +1,134 @@
+// Include-only. A clear coat over a shading stage's base BSDF (Rust twin:
+// facet_fit::model::coat::Coated):
+//   f = w F(η, ωi·h) D_c(h) G2_c / (4 cos θi cos θo) + T(θi) T(θo) f_base(ωi', ωo') / η²,
+// D_c GGX of the coat's α, ωi' and ωo' refracted into the coat (sin θ' = sin θ / η), T = 1 − w E_c(θ)
+// with E_c the coat lobe's directional albedo, tabulated in the material's coat block:
+// [n, E_c at cos θ = (k + ½)/n for k < n].
+// Sampling: the coat's lobe (its normals, as lobe_sample_h) with probability
+//   p = w E_c(θo) / (w E_c(θo) + T(θo) base_albedo(b)),
+// else the base's sampling from ωo' and the result refracted out (a direction past the critical
+// angle is refused: z < 0); pdf = p pdf_coat + (1 − p) pdf_base(ωi') cos θi / (η² cos θi').
+// The includer's Bsdf has a field `coat: Coat` (coat_of), and the includer defines
+//   base_eval2(b, wi_light, wi_bsdf, wo), base_pdf(b, wi, wo), base_sample_wi(b, wo, u),
+//   base_albedo(b) (an estimate of the base's albedo, for p),
+// from which this file defines bsdf_eval2, bsdf_pdf and bsdf_sample_wi for shade.inc.wgsl. A
+// material without a coat (coat.block == NONE) is its base, unchanged.
+
+struct Coat {
+    block: u32,
+    weight: f32,
+    eta: f32,
+    ndf: AnalyticNdf,
+}
+
+fn coat_of(m: Material) -> Coat {
+    return Coat(m.coat_block, m.coat_weight, m.coat_eta, AnalyticNdf(NDF_KIND_GGX, m.coat_alpha, m.coat_alpha, 0.0));
+}
+
+// Into the coat: sin θ' = sin θ / η; a direction below the surface stays below it.
+fn coat_in(c: Coat, w: vec3<f32>) -> vec3<f32> {
+    if (w.z <= 0.0) {
+        return vec3<f32>(0.0, 0.0, -1.0);
+    }
+    let s = w.xy / c.eta;
+    return vec3<f32>(s, sqrt(max(1.0 - dot(s, s), 0.0)));
+}
+
+// Out of the coat; z = −1 at or past the critical angle.
+fn coat_out(c: Coat, w: vec3<f32>) -> vec3<f32> {
+    let s = w.xy * c.eta;
+    let c2 = 1.0 - dot(s, s);
+    if (c2 <= 0.0 || w.z <= 0.0) {
+        return vec3<f32>(0.0, 0.0, -1.0);
+    }
+    return vec3<f32>(s, sqrt(c2));
+}
+
+// E_c(θ), linear in cos θ between the block's nodes.
+fn coat_lobe_albedo(c: Coat, cos_theta: f32) -> f32 {
+    let n = u32(tables[c.block]);
+    let x = max(clamp(cos_theta, 0.0, 1.0) * f32(n) - 0.5, 0.0);
+    let k = min(u32(x), n - 2u);
+    let t = min(x - f32(k), 1.0);
+    return mix(tables[c.block + 1u + k], tables[c.block + 2u + k], t);
+}
+
+// T(θ) = 1 − w E_c(θ).
+fn coat_transmission(c: Coat, cos_theta: f32) -> f32 {
+    return 1.0 - c.weight * coat_lobe_albedo(c, cos_theta);
+}
+
+// Unpolarised Fresnel reflectance of a dielectric of relative index η.
+fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if (sin2_t >= 1.0) {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    let r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (r_parl * r_parl + r_perp * r_perp);
+}
+
+// The coat's own reflection, w F D G2 / (4 cos θi cos θo).
+fn coat_reflection(c: Coat, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+    let h = normalize(wi + wo);
+    let g = g2_correlated(ndf_lambda(c.ndf, wi), ndf_lambda(c.ndf, wo), wi, wo);
+    return c.weight * fresnel_dielectric(dot(wi, h), c.eta) * ndf_d(c.ndf, h) * g / (4.0 * wi.z * wo.z);
+}
+
+// The probability of sampling the coat's lobe from ωo: its share of the layers' albedos.
+fn coat_probability(b: Bsdf, wo: vec3<f32>) -> f32 {
+    let r = b.coat.weight * coat_lobe_albedo(b.coat, wo.z);
+    let t = coat_transmission(b.coat, wo.z) * base_albedo(b);
+    return select(1.0, r / (r + t), r + t > 0.0);
+}
+
+// The coated f for one direction, given the base's value at the refracted pair.
+fn coated(c: Coat, wi: vec3<f32>, wo: vec3<f32>, base: vec3<f32>) -> vec3<f32> {
+    if (wi.z <= 0.0 || wo.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let t = coat_transmission(c, wi.z) * coat_transmission(c, wo.z) / (c.eta * c.eta);
+    return vec3<f32>(coat_reflection(c, wi, wo)) + t * base;
+}
+
+fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
+    let c = b.coat;
+    if (c.block == NONE) {
+        return base_eval2(b, wi_light, wi_bsdf, wo);
+    }
+    let base = base_eval2(b, coat_in(c, wi_light), coat_in(c, wi_bsdf), coat_in(c, wo));
+    return array<vec3<f32>, 2>(coated(c, wi_light, wo, base[0]), coated(c, wi_bsdf, wo, base[1]));
+}
+
+fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+    let c = b.coat;
+    if (c.block == NONE) {
+        return base_pdf(b, wi, wo);
+    }
+    if (wi.z <= 0.0 || wo.z <= 0.0) {
+        return 0.0;
+    }
+    let p = coat_probability(b, wo);
+    let h = normalize(wi + wo);
+    let coat = lobe_pdf_h(c.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
+    let wi_in = coat_in(c, wi);
+    // dωi' / dωi = cos θi / (η² cos θi')
+    let base = base_pdf(b, wi_in, coat_in(c, wo)) * wi.z / (c.eta * c.eta * wi_in.z);
+    return p * coat + (1.0 - p) * base;
+}
+
+fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
+    let c = b.coat;
+    if (c.block == NONE) {
+        return base_sample_wi(b, wo, u);
+    }
+    let p = coat_probability(b, wo);
+    if (u.z < p) {
+        let h = lobe_sample_h(c.ndf, wo, u.xy);
+        return 2.0 * dot(wo, h) * h - wo;
+    }
+    let wi_in = base_sample_wi(b, coat_in(c, wo), vec3<f32>(u.xy, (u.z - p) / (1.0 - p)));
+    return coat_out(c, wi_in);
+}
