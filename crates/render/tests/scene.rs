@@ -334,6 +334,63 @@ fn materials_textures_and_emissive_strength() {
     );
 }
 
+/// KHR_materials_clearcoat: factors, its three textures (linear), the normal map's scale; a
+/// factor of 0 is no coat; an index past the file's textures and a factor that is not a number
+/// are errors naming the material.
+#[test]
+fn clearcoat_extension_is_read() {
+    let dir = temp_dir("clearcoat");
+    let write = |coat: serde_json::Value, file: &str| {
+        let mut g = GltfBuilder::default();
+        let (p, _, i) = g.triangle();
+        g.images.push(json!({"uri": png_data_uri(2, 2)}));
+        g.textures.push(json!({"source": 0}));
+        g.extensions_used.push("KHR_materials_clearcoat");
+        let m = g.material(json!({
+            "name": "lacquer",
+            "pbrMetallicRoughness": {"baseColorFactor": [0.6, 0.1, 0.1, 1.0]},
+            "extensions": {"KHR_materials_clearcoat": coat}
+        }));
+        let mesh = g.mesh("tri", json!({"POSITION": p}), Some(i), Some(m));
+        let root = g.node(json!({"mesh": mesh}));
+        g.write(&[root], &dir.join(file));
+        dir.join(file)
+    };
+    let s = load(&write(
+        json!({"clearcoatFactor": 0.9, "clearcoatTexture": {"index": 0},
+               "clearcoatRoughnessFactor": 0.3, "clearcoatRoughnessTexture": {"index": 0},
+               "clearcoatNormalTexture": {"index": 0, "scale": 0.5}}),
+        "coat.gltf",
+    ));
+    let c = s.materials[0].clearcoat.expect("a clear coat");
+    assert_eq!((c.factor, c.roughness, c.normal_scale), (0.9, 0.3, 0.5));
+    let t = c.texture.unwrap();
+    assert_eq!((c.roughness_texture, c.normal_texture), (Some(t), Some(t)));
+    assert!(!s.textures[t as usize].srgb, "coat textures are linear");
+    let none = load(&write(
+        json!({"clearcoatRoughnessFactor": 0.3}),
+        "none.gltf",
+    ));
+    assert!(none.materials[0].clearcoat.is_none());
+    for (coat, says) in [
+        (
+            json!({"clearcoatFactor": 1.0, "clearcoatTexture": {"index": 4}}),
+            "clearcoatTexture.index 4: the file has 1 textures",
+        ),
+        (
+            json!({"clearcoatFactor": "thick"}),
+            "clearcoatFactor is \"thick\"",
+        ),
+    ] {
+        let path = write(coat, "bad.gltf");
+        let e = load_err(&path, &LoadOptions::default());
+        assert!(
+            e.contains("bad.gltf") && e.contains("lacquer") && e.contains(says),
+            "{e}"
+        );
+    }
+}
+
 fn facet_scene(dir: &Path, facet: serde_json::Value) -> PathBuf {
     let mut g = GltfBuilder::default();
     let (p, _, i) = g.triangle();

@@ -1,5 +1,6 @@
 //! glTF materials → [`Material`]: metallic-roughness factors and textures, emissive strength,
-//! and the Facet extension carried in `extras`:
+//! KHR_materials_clearcoat ([`Clearcoat`]: factors, textures, the coat's normal map), and the
+//! Facet extension carried in `extras`:
 //!
 //! ```json
 //! "extras": {"facet": {"fit": "path/to/fit.json", "model": "tabulated|ggx|beckmann",
@@ -21,7 +22,7 @@
 
 use super::gltf_buffers::Buffers;
 use super::uri::{UriTarget, resolve};
-use super::{FacetMaterial, GlintParams, Material, MeasuredMaterial, Texture};
+use super::{Clearcoat, FacetMaterial, GlintParams, Material, MeasuredMaterial, Texture};
 use crate::error::RenderError;
 use facet_fit::io::input::{self, Cap};
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
@@ -226,12 +227,13 @@ impl<'a> MaterialLoader<'a> {
             }
         }
         doc.materials()
-            .map(|m| self.material(&m, textures, warnings))
+            .map(|m| self.material(doc, &m, textures, warnings))
             .collect()
     }
 
     fn material(
         &mut self,
+        doc: &gltf::Document,
         m: &gltf::Material,
         textures: &mut Vec<Texture>,
         warnings: &mut Vec<String>,
@@ -252,6 +254,7 @@ impl<'a> MaterialLoader<'a> {
         let finite_or = |x: f32, d: f32| if x.is_finite() { x } else { d };
         let base_color = Vec4::from(pbr.base_color_factor());
         let (facet, measured) = self.facet(m, &name)?;
+        let clearcoat = self.clearcoat(doc, m, &name, textures, warnings)?;
         Ok(Material {
             base_color: if base_color.is_finite() {
                 base_color
@@ -272,10 +275,74 @@ impl<'a> MaterialLoader<'a> {
                 Vec3::ZERO
             },
             emissive_texture,
+            clearcoat,
             facet,
             measured,
             name,
         })
+    }
+
+    /// KHR_materials_clearcoat of `m`, if any with a factor above 0. A texture index past the
+    /// file's textures, or a field of the wrong type, is an error naming the material; a
+    /// texture that cannot be loaded is a warning (the factor alone is used).
+    fn clearcoat(
+        &mut self,
+        doc: &gltf::Document,
+        m: &gltf::Material,
+        name: &str,
+        textures: &mut Vec<Texture>,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Clearcoat>, RenderError> {
+        let Some(ext) = m.extension_value("KHR_materials_clearcoat") else {
+            return Ok(None);
+        };
+        let gltf_path = self.gltf_path;
+        let bad = |problem: String| {
+            RenderError::input(
+                gltf_path,
+                format!("material `{name}` KHR_materials_clearcoat: {problem}"),
+            )
+        };
+        let number = |key: &str, default: f64| match ext.get(key) {
+            None => Ok(default),
+            Some(v) => v
+                .as_f64()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| bad(format!("{key} is {v}, not a finite number"))),
+        };
+        let factor = number("clearcoatFactor", 0.0)?.clamp(0.0, 1.0) as f32;
+        let roughness = number("clearcoatRoughnessFactor", 0.0)?.clamp(0.0, 1.0) as f32;
+        if factor == 0.0 {
+            return Ok(None);
+        }
+        let mut texture = |key: &str| -> Result<Option<u32>, RenderError> {
+            let Some(info) = ext.get(key) else {
+                return Ok(None);
+            };
+            let index = info
+                .get("index")
+                .and_then(Value::as_u64)
+                .ok_or_else(|| bad(format!("{key} has no texture index")))?;
+            let t = doc.textures().nth(index as usize).ok_or_else(|| {
+                let n = doc.textures().len();
+                bad(format!("{key}.index {index}: the file has {n} textures"))
+            })?;
+            Ok(self.texture(&t.source(), false, name, textures, warnings))
+        };
+        let coat = Clearcoat {
+            factor,
+            texture: texture("clearcoatTexture")?,
+            roughness,
+            roughness_texture: texture("clearcoatRoughnessTexture")?,
+            normal_texture: texture("clearcoatNormalTexture")?,
+            normal_scale: ext
+                .get("clearcoatNormalTexture")
+                .and_then(|n| n.get("scale"))
+                .and_then(Value::as_f64)
+                .filter(|x| x.is_finite())
+                .unwrap_or(1.0) as f32,
+        };
+        Ok(Some(coat))
     }
 
     /// The Facet material from extras and/or an override: a fitted model, or a measurement.

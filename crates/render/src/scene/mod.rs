@@ -80,6 +80,26 @@ impl Default for Camera {
     }
 }
 
+/// KHR_materials_clearcoat over a glTF metallic-roughness material, layered as the extension
+/// specifies: f = (1 − c F) f_base + c F D_c G2_c / (4 |n_c·ωi| |n_c·ωo|), F = 0.04 + 0.96
+/// (1 − |ωo·h|)⁵, D_c GGX of α = roughness² about the coat's normal n_c (the vertex normal, or
+/// its own normal map; not the base's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Clearcoat {
+    /// `clearcoatFactor` c (> 0: a factor of 0 is no coat and is not stored).
+    pub factor: f32,
+    /// `clearcoatTexture`: its R channel multiplies the factor.
+    pub texture: Option<u32>,
+    /// `clearcoatRoughnessFactor`.
+    pub roughness: f32,
+    /// `clearcoatRoughnessTexture`: its G channel multiplies the roughness.
+    pub roughness_texture: Option<u32>,
+    /// `clearcoatNormalTexture`: the coat's tangent-space normal map.
+    pub normal_texture: Option<u32>,
+    /// The normal map's `scale`.
+    pub normal_scale: f32,
+}
+
 /// A glTF metallic-roughness material, optionally replaced by a Facet material.
 #[derive(Clone, Debug)]
 pub struct Material {
@@ -106,6 +126,8 @@ pub struct Material {
     pub emissive: Vec3,
     /// Texture index of the emission.
     pub emissive_texture: Option<u32>,
+    /// KHR_materials_clearcoat: a clear coat over the metallic-roughness material.
+    pub clearcoat: Option<Clearcoat>,
     /// A fitted material from `extras.facet` or `--material NAME=FILE`.
     pub facet: Option<FacetMaterial>,
     /// A measured material (`extras.facet.model: "measured"`, or `--material NAME=FILE` naming
@@ -127,6 +149,7 @@ impl Default for Material {
             normal_scale: 1.0,
             emissive: Vec3::ZERO,
             emissive_texture: None,
+            clearcoat: None,
             facet: None,
             measured: None,
         }
