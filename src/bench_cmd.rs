@@ -28,6 +28,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 
+mod coat;
 mod lights;
 mod measured;
 mod shard;
@@ -70,6 +71,8 @@ pub enum Section {
     Lights,
     /// A measured material (MERL table, RGL file) against its tabulated fit at equal spp.
     Measured,
+    /// A fit with and without a clear coat (smooth and glints) at equal spp.
+    Coat,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -280,6 +283,9 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
         }
         if on(Section::Measured) {
             report["measured"] = measured::measured(g, sizes.noise.0, sizes.noise.1)?;
+        }
+        if on(Section::Coat) {
+            report["coat"] = coat::coat(g, sizes.noise.0, sizes.noise.1)?;
         }
         if on(Section::Shard) {
             report["shard"] = shard::shards(sizes.runs, sizes.shard.0, sizes.shard.1)?;

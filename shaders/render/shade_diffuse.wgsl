@@ -2,6 +2,10 @@
 // weight of KHR_materials_specular): GGX α = roughness², F0 = mix(0.04 · specular, base, metallic),
 //   f = (1 − metallic)(1 − specular · F) base/π + F D G2 / (4 cos θi cos θo).
 // Specular weight 0 and metallic 0 is a pure Lambertian surface.
+// KHR_materials_clearcoat (facet_render::scene::Clearcoat), the extension's layering:
+//   f_coated = (1 − c F_c) f + c F_c D_c G2_c / (4 |n_c·ωi| |n_c·ωo|), F_c = F_schlick(0.04, ωo·h),
+// D_c GGX of α = roughness² about the coat's normal n_c (the vertex normal or the coat's own map),
+// sampled with probability c F_c(n_c·ωo) against the base's estimated albedo.
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
@@ -18,6 +22,12 @@ struct Bsdf {
     ndf: AnalyticNdf,
     // probability of sampling the specular lobe
     p_spec: f32,
+    // the clear coat: factor (0: none), GGX, its frame in the shading frame (z its normal)
+    cc: f32,
+    cc_ndf: AnalyticNdf,
+    cc_t: vec3<f32>,
+    cc_b: vec3<f32>,
+    cc_n: vec3<f32>,
 }
 
 fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
@@ -40,7 +50,71 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     b.specular = m.emissive.w;
     b.ndf = AnalyticNdf(0u, alpha, alpha, 0.0);
     b.p_spec = b.metallic + (1.0 - b.metallic) * 0.5 * min(b.specular, 1.0);
+    b.cc = 0.0;
+    if (m.coat_weight > 0.0) {
+        clearcoat_setup(&b, s, m);
+    }
     return b;
+}
+
+fn clearcoat_setup(b: ptr<function, Bsdf>, s: Surface, m: Material) {
+    var cc = m.coat_weight;
+    var roughness = m.coat_alpha;
+    if (m.tex_clearcoat != NONE) {
+        cc *= texture_sample(m.tex_clearcoat, s.uv).x;
+    }
+    if (m.tex_clearcoat_roughness != NONE) {
+        roughness *= texture_sample(m.tex_clearcoat_roughness, s.uv).y;
+    }
+    var n = s.n_vertex;
+    if (m.tex_clearcoat_normal != NONE) {
+        n = normal_mapped(n, s.tangent, m.tex_clearcoat_normal, m.clearcoat_normal_scale, s.uv);
+    }
+    var nc = to_local(s, n);
+    if (nc.z <= 1e-4) {
+        nc = vec3<f32>(0.0, 0.0, 1.0);
+    }
+    nc = normalize(nc);
+    var t = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(nc.x) > 0.9);
+    t = normalize(t - nc * dot(nc, t));
+    (*b).cc = clamp(cc, 0.0, 1.0);
+    let alpha = max(roughness * roughness, 1e-3);
+    (*b).cc_ndf = AnalyticNdf(NDF_KIND_GGX, alpha, alpha, 0.0);
+    (*b).cc_n = nc;
+    (*b).cc_t = t;
+    (*b).cc_b = cross(nc, t);
+}
+
+fn to_coat(b: Bsdf, w: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(w, b.cc_t), dot(w, b.cc_b), dot(w, b.cc_n));
+}
+
+fn from_coat(b: Bsdf, w: vec3<f32>) -> vec3<f32> {
+    return w.x * b.cc_t + w.y * b.cc_b + w.z * b.cc_n;
+}
+
+// c F_c(ωo·h): the weight of the coat's lobe, and 1 − it the base's.
+fn clearcoat_weight(b: Bsdf, wo: vec3<f32>, h: vec3<f32>) -> f32 {
+    return b.cc * schlick(vec3<f32>(0.04), abs(dot(wo, h))).x;
+}
+
+// D_c G2_c / (4 |n_c·ωi| |n_c·ωo|) in the coat's frame.
+fn clearcoat_lobe(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+    let i = to_coat(b, wi);
+    let o = to_coat(b, wo);
+    if (i.z <= 0.0 || o.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(i + o);
+    let g = g2_correlated(ndf_lambda(b.cc_ndf, i), ndf_lambda(b.cc_ndf, o), i, o);
+    return ndf_d(b.cc_ndf, h) * g / (4.0 * i.z * o.z);
+}
+
+// The probability of sampling the coat: c F_c(n_c·ωo) against the base's estimated albedo.
+fn clearcoat_probability(b: Bsdf, wo: vec3<f32>) -> f32 {
+    let r = b.cc * schlick(vec3<f32>(0.04), to_coat(b, wo).z).x;
+    let base = max(luminance(b.base) * (1.0 - b.metallic) + b.p_spec, 0.05);
+    return r / (r + (1.0 - r) * base);
 }
 
 fn schlick(f0: vec3<f32>, c: f32) -> vec3<f32> {
@@ -50,6 +124,17 @@ fn schlick(f0: vec3<f32>, c: f32) -> vec3<f32> {
 }
 
 fn bsdf_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
+    if (b.cc > 0.0) {
+        if (wi.z <= 0.0 || wo.z <= 0.0) {
+            return vec3<f32>(0.0);
+        }
+        let w = clearcoat_weight(b, wo, normalize(wi + wo));
+        return (1.0 - w) * base_eval(b, wi, wo) + vec3<f32>(w * clearcoat_lobe(b, wi, wo));
+    }
+    return base_eval(b, wi, wo);
+}
+
+fn base_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return vec3<f32>(0.0);
     }
@@ -68,6 +153,21 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     if (wi.z <= 0.0 || wo.z <= 0.0) {
         return 0.0;
     }
+    if (b.cc > 0.0) {
+        let p = clearcoat_probability(b, wo);
+        let i = to_coat(b, wi);
+        let o = to_coat(b, wo);
+        var coat = 0.0;
+        if (i.z > 0.0 && o.z > 0.0) {
+            let h = normalize(i + o);
+            coat = lobe_pdf_h(b.cc_ndf, o, h) / (4.0 * abs(dot(o, h)));
+        }
+        return p * coat + (1.0 - p) * base_pdf(b, wi, wo);
+    }
+    return base_pdf(b, wi, wo);
+}
+
+fn base_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     let h = normalize(wi + wo);
     let spec = lobe_pdf_h(b.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
     return b.p_spec * spec + (1.0 - b.p_spec) * wi.z / PI;
@@ -78,6 +178,22 @@ fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -
 }
 
 fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
+    if (b.cc > 0.0) {
+        let p = clearcoat_probability(b, wo);
+        if (u.z < p) {
+            let o = to_coat(b, wo);
+            if (o.z <= 0.0) {
+                return vec3<f32>(0.0, 0.0, -1.0);
+            }
+            let h = lobe_sample_h(b.cc_ndf, o, u.xy);
+            return from_coat(b, 2.0 * dot(o, h) * h - o);
+        }
+        return base_sample_wi(b, wo, vec3<f32>(u.xy, (u.z - p) / (1.0 - p)));
+    }
+    return base_sample_wi(b, wo, u);
+}
+
+fn base_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
     var wi: vec3<f32>;
     if (u.z < b.p_spec) {
         let h = lobe_sample_h(b.ndf, wo, u.xy);

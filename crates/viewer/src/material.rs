@@ -230,9 +230,19 @@ impl EditedMaterial {
         }
     }
 
-    /// The edited record as saved: edited α and ρd, Fresnel tables times the tint.
+    /// Whether anything was edited: α, rotation, ρd or the tint.
+    pub fn is_edited(&self) -> bool {
+        self.record != self.base.record || self.tint != [1.0; 3]
+    }
+
+    /// The edited record as saved: edited α and ρd, Fresnel tables times the tint. The edits
+    /// are the single layer's: a fit's coat (`record.coat`, which the renderer prefers) is kept
+    /// only while nothing is edited, so that what is shown and saved is the edited model.
     pub fn edited_record(&self) -> FitRecord {
         let mut r = self.record.clone();
+        if self.is_edited() {
+            r.coat = None;
+        }
         let tint = |t: &mut facet_fit::model::fresnel::FresnelTable| {
             for v in &mut t.rgb {
                 for (x, k) in v.iter_mut().zip(self.tint) {
@@ -350,4 +360,40 @@ pub struct MaterialKey {
     pub tint: [f64; 3],
     /// Glint settings, when glints are shown.
     pub glint: Option<GlintEdit>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use facet_fit::model::coat::Coat;
+    use facet_fit::model::material::CoatRecord;
+
+    /// The demo's fit with a coat attached, as the fit attaches one.
+    fn coated_fit() -> FittedMaterial {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../assets/demo/default_fit.json");
+        let fit = FittedMaterial::load(&path).unwrap();
+        let mut record = fit.record.clone();
+        record.coat = Some(CoatRecord {
+            coat: Coat::new(1.5, 0.05, 1.0),
+            error: 0.0,
+            ggx_error: None,
+            beckmann_error: None,
+            base: Box::new(fit.record.clone()),
+        });
+        FittedMaterial::from_record(record).unwrap()
+    }
+
+    /// Unedited, the coated model is shown and saved; the first edit of the single layer
+    /// drops the coat from both.
+    #[test]
+    fn an_edit_shows_and_saves_the_edited_single_layer() {
+        let mut m = EditedMaterial::new(coated_fit(), "coated.json".into());
+        assert!(!m.is_edited() && m.edited_record().coat.is_some());
+        assert!(m.fitted().unwrap().coated.is_some());
+        let (ax, ay, rot) = m.alpha().unwrap();
+        m.set_alpha(ax * 1.5, ay * 1.5, rot);
+        assert!(m.is_edited() && m.edited_record().coat.is_none());
+        assert!(m.fitted().unwrap().coated.is_none());
+    }
 }
