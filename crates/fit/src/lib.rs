@@ -29,12 +29,12 @@
 //! |---|---|
 //! | [`io`] | input files read safely (regular, bounded, mapped), outputs written atomically |
 //! | [`numerics`] | quadrature rules, the χ² test |
-//! | [`model`] | the [`Brdf`] trait, geometry, microfacet NDFs (GGX, Beckmann, tabulated), Fresnel, analytic specs, the fit record [`FittedMaterial`] |
+//! | [`model`] | the [`Brdf`] trait, geometry, microfacet NDFs (GGX, Beckmann, tabulated), Fresnel, a clear coat over a base, analytic specs, the fit record [`FittedMaterial`] |
 //! | [`sources`] | measurements: MERL files, the neural proxies, RGL `.bsdf` files; [`sources::InputSpec`] names one |
 //! | [`extract`] | the paper's algorithm: the kernel and the power iteration |
 //! | [`metric`] | passes over the MERL grid: the error metric, the Fresnel average, the linear solves |
 //! | `gpu` | the extraction and the grid passes as WGSL compute passes (feature `gpu`) |
-//! | [`fitting`] | one fit from a source: [`fitting::fit_material`], the analytic fits, the diffuse lobe, the refinement, the Fresnel curves |
+//! | [`fitting`] | one fit from a source: [`fitting::fit_material`], the analytic fits, the diffuse lobe, the refinement, the Fresnel curves, the coat |
 //! | [`export`] | a fit written for Mitsuba 3, pbrt-v4, glTF 2.0, or as an RGL `.bsdf` |
 //!
 //! ## Features

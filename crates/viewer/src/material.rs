@@ -1,5 +1,6 @@
 //! The edited material: a fit record, the model shown, and the edits applied on top of it.
 
+use facet_fit::model::coat::Coat;
 use facet_fit::model::material::{FitRecord, FittedMaterial, ModelChoice};
 use facet_render::scene::{FacetMaterial, GlintParams, Material, MeasuredMaterial, Measurement};
 use std::path::PathBuf;
@@ -87,6 +88,9 @@ pub struct EditedMaterial {
     pub lock: bool,
     /// The measurement the fit was made from (`None` for a fit JSON).
     pub measurement: Option<Arc<Measurement>>,
+    /// The fit's coat as edited (η, α, weight); `None`: the fit has none, or it is switched
+    /// off.
+    pub coat: Option<Coat>,
 }
 
 impl EditedMaterial {
@@ -101,12 +105,13 @@ impl EditedMaterial {
         EditedMaterial {
             base: Arc::new(base),
             source,
-            record,
             shown,
             tint: [1.0; 3],
             glint: GlintEdit::default(),
             lock: true,
             measurement: None,
+            coat: record.coat.as_ref().map(|c| c.coat),
+            record,
         }
     }
 
@@ -230,19 +235,29 @@ impl EditedMaterial {
         }
     }
 
-    /// Whether anything was edited: α, rotation, ρd or the tint.
+    /// Whether the single layer was edited: α, rotation, ρd or the tint.
     pub fn is_edited(&self) -> bool {
         self.record != self.base.record || self.tint != [1.0; 3]
     }
 
-    /// The edited record as saved: edited α and ρd, Fresnel tables times the tint. The edits
-    /// are the single layer's: a fit's coat (`record.coat`, which the renderer prefers) is kept
-    /// only while nothing is edited, so that what is shown and saved is the edited model.
+    /// Whether the fit kept a coat (which [`Self::coat`] edits).
+    pub fn has_coat(&self) -> bool {
+        self.base.record.coat.is_some()
+    }
+
+    /// The edited record as saved: edited α and ρd, Fresnel tables times the tint, the coat's
+    /// edited η, α and weight. The sliders of α, ρd and the tint edit the single layer: a fit's
+    /// coat (`record.coat`, which the renderer prefers) is kept only while they are untouched,
+    /// so that what is shown and saved is the edited model. (The coat's recorded errors are the
+    /// fitted coat's.)
     pub fn edited_record(&self) -> FitRecord {
         let mut r = self.record.clone();
-        if self.is_edited() {
-            r.coat = None;
-        }
+        r.coat = match (&r.coat, self.coat) {
+            (Some(c), Some(coat)) if !self.is_edited() => {
+                Some(facet_fit::model::material::CoatRecord { coat, ..c.clone() })
+            }
+            _ => None,
+        };
         let tint = |t: &mut facet_fit::model::fresnel::FresnelTable| {
             for v in &mut t.rgb {
                 for (x, k) in v.iter_mut().zip(self.tint) {
@@ -335,6 +350,10 @@ impl EditedMaterial {
             beckmann: p(&self.record.beckmann),
             tint: self.tint,
             glint: (self.shown == Shown::Glint).then_some(self.glint),
+            coat: self
+                .coat
+                .filter(|_| !self.is_edited())
+                .map(|c| [c.eta, c.alpha, c.weight]),
         }
     }
 }
@@ -360,12 +379,13 @@ pub struct MaterialKey {
     pub tint: [f64; 3],
     /// Glint settings, when glints are shown.
     pub glint: Option<GlintEdit>,
+    /// The coat's η, α and weight, when one is shown.
+    pub coat: Option<[f64; 3]>,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use facet_fit::model::coat::Coat;
     use facet_fit::model::material::CoatRecord;
 
     /// The demo's fit with a coat attached, as the fit attaches one.
@@ -394,6 +414,22 @@ mod tests {
         let (ax, ay, rot) = m.alpha().unwrap();
         m.set_alpha(ax * 1.5, ay * 1.5, rot);
         assert!(m.is_edited() && m.edited_record().coat.is_none());
+        assert!(m.fitted().unwrap().coated.is_none());
+    }
+
+    /// The coat's own edits reach the rendered model; switched off, the single layer shows.
+    #[test]
+    fn coat_edits_reach_the_rendered_model() {
+        let mut m = EditedMaterial::new(coated_fit(), "coated.json".into());
+        let before = m.key();
+        m.coat = Some(Coat::new(1.7, 0.2, 0.5));
+        assert_ne!(m.key(), before);
+        let fit = m.fitted().unwrap();
+        assert_eq!(
+            fit.coated.as_ref().unwrap().layer.coat,
+            Coat::new(1.7, 0.2, 0.5)
+        );
+        m.coat = None;
         assert!(m.fitted().unwrap().coated.is_none());
     }
 }

@@ -38,6 +38,9 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
     if m.shown == Shown::Glint {
         glint_sliders(m, ui);
     }
+    if m.has_coat() && m.shown != Shown::Measured {
+        coat_sliders(m, ui);
+    }
     if m.key() != before {
         app.edited_at = Some(Instant::now());
     }
@@ -205,6 +208,38 @@ fn glint_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
             .logarithmic(true)
             .text("threshold"),
     );
+}
+
+/// The fit's clear coat: on or off, its weight, α and η. Shown until the single layer is
+/// edited (the edits are the single layer's; `EditedMaterial::edited_record`).
+fn coat_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
+    ui.label("Clear coat (the fit's):");
+    if m.is_edited() {
+        ui.label("not shown: the single layer is edited");
+        return;
+    }
+    let fitted = m.base.record.coat.as_ref().map(|c| c.coat);
+    let mut on = m.coat.is_some();
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut on, "coat");
+        if ui.small_button("fitted").clicked() {
+            m.coat = fitted;
+            on = true;
+        }
+    });
+    if !on {
+        m.coat = None;
+        return;
+    }
+    let mut c = m.coat.or(fitted).expect("has_coat: the fit has a coat");
+    ui.add(egui::Slider::new(&mut c.weight, 0.0..=1.0).text("weight"));
+    ui.add(
+        egui::Slider::new(&mut c.alpha, 1e-3..=1.0)
+            .logarithmic(true)
+            .text("α"),
+    );
+    ui.add(egui::Slider::new(&mut c.eta, 1.05..=2.5).text("η"));
+    m.coat = Some(c);
 }
 
 /// The exposure, the save field and the status line.
