@@ -734,6 +734,32 @@ fn gold_scene(sphere: Material) -> Result<(Scene, Environment)> {
 }
 
 /// The noise and speed of one configuration on one scene.
+/// `material` on the gold scene's sphere at `side`² and `spp` ([`measure_noise`]), with its
+/// time a sample and variance as ratios to the first call's (`first` keeps them): one row of a
+/// side-by-side section, as measured, as [time ratio, variance ratio], and as JSON.
+pub(crate) fn gold_row(
+    gpu: &Gpu,
+    material: Material,
+    side: u32,
+    spp: u32,
+    first: &mut Option<(f64, f64)>,
+) -> Result<(Measured, [f64; 2], Value)> {
+    let (scene, env) = gold_scene(material)?;
+    let m = measure_noise(
+        gpu,
+        &scene,
+        Some(&env),
+        ResourceConfig::standard(),
+        square(side),
+        spp,
+        facet_render::NdfSampling::Visible,
+    )?;
+    let (v0, t0) = *first.get_or_insert((m.var, m.ns));
+    let ratios = [m.ns / t0, m.var / v0];
+    let row = json!({"ns_per_sample": m.ns, "time_ratio": ratios[0], "variance": m.var, "variance_ratio": ratios[1], "mean": m.mean});
+    Ok((m, ratios, row))
+}
+
 pub(crate) struct Measured {
     /// The variance of a pixel: E[(a − b)²] / 2 over two seeds, averaged over pixels and
     /// channels.

@@ -3,7 +3,7 @@
 //! glints, at equal spp: the time a sample and the variance, each against the uncoated smooth
 //! fit's.
 
-use super::{gold_scene, measure_noise, square};
+use super::gold_row;
 use anyhow::Result;
 use facet_fit::model::coat::Coat;
 use facet_fit::model::material::{CoatRecord, FittedMaterial, ModelChoice};
@@ -11,7 +11,6 @@ use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::{FitConfig, fit_material};
 use facet_render::scene::{FacetMaterial, GlintParams, Material};
-use facet_render::{NdfSampling, ResourceConfig};
 use serde_json::{Value, json};
 use std::sync::Arc;
 
@@ -69,26 +68,13 @@ pub fn coat(gpu: &facet_gpu::Gpu, side: u32, spp: u32) -> Result<Value> {
             }),
             ..Default::default()
         };
-        let (scene, env) = gold_scene(material)?;
-        let m = measure_noise(
-            gpu,
-            &scene,
-            Some(&env),
-            ResourceConfig::standard(),
-            square(side),
-            spp,
-            NdfSampling::Visible,
-        )?;
-        let (v0, t0) = *base.get_or_insert((m.var, m.ns));
+        let (m, [t, v], mut row) = gold_row(gpu, material, side, spp, &mut base)?;
         println!(
-            "  {label:<15} {:.0} ns a sample ({:.2}×), variance {:.3e} ({:.2}×), mean {:.4}",
-            m.ns,
-            m.ns / t0,
-            m.var,
-            m.var / v0,
-            m.mean
+            "  {label:<15} {:.0} ns a sample ({t:.2}×), variance {:.3e} ({v:.2}×), mean {:.4}",
+            m.ns, m.var, m.mean
         );
-        rows.push(json!({"material": label, "ns_per_sample": m.ns, "time_ratio": m.ns / t0, "variance": m.var, "variance_ratio": m.var / v0, "mean": m.mean}));
+        row["material"] = json!(label);
+        rows.push(row);
     }
     Ok(
         json!({"spec": SPEC, "coat": {"eta": COAT.eta, "alpha": COAT.alpha, "weight": COAT.weight}, "side": side, "spp": spp, "rows": rows}),

@@ -4,7 +4,7 @@
 //! sample and the variance against the fit's, the image means, and the memory of each table on
 //! the GPU.
 
-use super::{gold_scene, measure_noise, square};
+use super::gold_row;
 use anyhow::{Result, anyhow};
 use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
 use facet_fit::model::material::ModelChoice;
@@ -13,7 +13,6 @@ use facet_fit::sources::{InputSpec, nbrdf::NbrdfLibrary};
 use facet_fit::{FitConfig, fit_material};
 use facet_render::resources::materials::measured_block;
 use facet_render::scene::{FacetMaterial, Material, MeasuredMaterial, Measurement};
-use facet_render::{NdfSampling, ResourceConfig};
 use serde_json::{Value, json};
 use std::sync::Arc;
 
@@ -68,27 +67,17 @@ pub fn measured(gpu: &facet_gpu::Gpu, side: u32, spp: u32) -> Result<Value> {
             .measured
             .as_ref()
             .map_or(0, |m| 4 * measured_block(&m.data).len());
-        let (scene, env) = gold_scene(material)?;
-        let m = measure_noise(
-            gpu,
-            &scene,
-            Some(&env),
-            ResourceConfig::standard(),
-            square(side),
-            spp,
-            NdfSampling::Visible,
-        )?;
-        let (v0, t0) = *base.get_or_insert((m.var, m.ns));
+        let (m, [t, v], mut row) = gold_row(gpu, material, side, spp, &mut base)?;
         println!(
-            "  {label:<14} {:.0} ns a sample ({:.2}×), variance {:.3e} ({:.2}×), mean {:.4}, table {:.1} MiB",
+            "  {label:<14} {:.0} ns a sample ({t:.2}×), variance {:.3e} ({v:.2}×), mean {:.4}, table {:.1} MiB",
             m.ns,
-            m.ns / t0,
             m.var,
-            m.var / v0,
             m.mean,
             bytes as f64 / (1 << 20) as f64
         );
-        rows.push(json!({"material": label, "ns_per_sample": m.ns, "time_ratio": m.ns / t0, "variance": m.var, "variance_ratio": m.var / v0, "mean": m.mean, "table_bytes": bytes}));
+        row["material"] = json!(label);
+        row["table_bytes"] = json!(bytes);
+        rows.push(row);
     }
     Ok(json!({"proxy": PROXY, "side": side, "spp": spp, "rows": rows}))
 }
