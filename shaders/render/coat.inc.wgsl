@@ -14,6 +14,9 @@
 // from which this file defines bsdf_eval2, bsdf_pdf and bsdf_sample_wi for shade.inc.wgsl. A
 // material without a coat (coat.block == NONE) is its base, unchanged.
 
+#include "common/microfacet.inc.wgsl"
+#include "render/none.inc.wgsl"
+
 struct Coat {
     block: u32,
     weight: f32,
