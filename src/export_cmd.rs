@@ -62,6 +62,10 @@ pub struct ExportArgs {
     /// Replace the output file when it exists (never the fit itself).
     #[arg(long)]
     pub force: bool,
+    /// Export the single layer of a fit that kept a clear coat (default: the coat over its
+    /// base, for pbrt and glTF; Mitsuba always gets the single layer).
+    #[arg(long)]
+    pub no_coat: bool,
 }
 
 impl ExportArgs {
@@ -82,6 +86,7 @@ impl ExportArgs {
                 KindArg::Conductor => KindRequest::Conductor,
                 KindArg::Plastic => KindRequest::Plastic,
             },
+            coat: !self.no_coat,
         }
     }
 }

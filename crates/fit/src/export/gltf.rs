@@ -1,6 +1,6 @@
 //! The glTF 2.0 writer: a `.gltf` holding one metallic-roughness material (with
-//! `KHR_materials_anisotropy`, `KHR_materials_ior` and `KHR_materials_specular` where they
-//! apply), the statement in its `extras`; and glTF's mapping of α to roughness and anisotropy.
+//! `KHR_materials_anisotropy`, `KHR_materials_ior`, `KHR_materials_specular` and
+//! `KHR_materials_clearcoat` where they apply), the statement in its `extras`; and glTF's mapping of α to roughness and anisotropy.
 
 use super::{Kind, Report, fmt_error, schlick_ior};
 use crate::model::fresnel_curves::FresnelFits;
@@ -76,6 +76,15 @@ pub(super) fn write(
             (p.diffuse, 0.0)
         }
     };
+    if let Some(c) = report.coat {
+        extensions.insert(
+            "KHR_materials_clearcoat".into(),
+            json!({
+                "clearcoatFactor": c.weight,
+                "clearcoatRoughnessFactor": alpha_to_roughness(c.alpha),
+            }),
+        );
+    }
     let mut used: Vec<&String> = extensions.keys().collect();
     used.sort();
     let mut material = json!({

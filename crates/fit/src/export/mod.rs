@@ -22,6 +22,12 @@
 //! contains the dielectric one (k = 0), so its error is never much above the dielectric's, and
 //! a colourless table fits both alike.
 //!
+//! A fit that kept a clear coat ([`crate::model::coat`]) is exported coated where the target has
+//! a coat ([`Target::has_coat`]: pbrt-v4's `coatedconductor` / `coateddiffuse`, glTF's
+//! `KHR_materials_clearcoat`): the base's analytic fit under the coat, with the coated model's
+//! recorded error; elsewhere, or with [`ExportOptions::coat`] false, the single layer, and the
+//! statement says which.
+//!
 //! Each target's writer is in its own module: [`mitsuba`], `pbrt` and [`gltf`]; [`rgl`] writes
 //! a fit's model as an RGL `.bsdf` file.
 
@@ -83,6 +89,12 @@ impl Target {
     pub fn has_beckmann(self) -> bool {
         self == Target::Mitsuba
     }
+
+    /// Whether the target can write a clear coat over the material (pbrt-v4's coated BSDFs,
+    /// glTF's clearcoat; Mitsuba 3 has no coated conductor).
+    pub fn has_coat(self) -> bool {
+        self != Target::Mitsuba
+    }
 }
 
 /// Which analytic fit to export.
@@ -131,6 +143,20 @@ pub struct ExportOptions {
     pub model: ModelRequest,
     /// Conductor, plastic, or chosen by F0.
     pub kind: KindRequest,
+    /// Export the fit's clear coat where it has one and the target can write one; false:
+    /// the single layer.
+    pub coat: bool,
+}
+
+/// The clear coat of an export: the fit's, over the base written.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CoatExport {
+    /// The coat's index of refraction.
+    pub eta: f64,
+    /// Its GGX α.
+    pub alpha: f64,
+    /// The weight of its reflection.
+    pub weight: f64,
 }
 
 /// What an export approximates, written into it (a comment, or the glTF material's `extras`)
@@ -170,15 +196,26 @@ pub struct Report {
     pub fresnel_fits_recorded: bool,
     /// What the target cannot represent, and what stands in for it.
     pub notes: Vec<String>,
+    /// The clear coat written over the material, if any (the model and its values are then
+    /// the base's, and `table_error` the coated model's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub coat: Option<CoatExport>,
 }
 
 impl Report {
     /// One line: the target, the material, the model and α, the Fresnel and its error.
     pub fn summary(&self) -> String {
-        let error = match self.fresnel_error {
-            Some(e) => format!("error {e:.3e}"),
-            None => "error unknown (fitted at export)".into(),
+        let error = match (self.fresnel_error, self.coat) {
+            (Some(e), _) => format!("error {e:.3e}"),
+            (None, Some(_)) => "error unknown (under the coat)".into(),
+            (None, None) => "error unknown (fitted at export)".into(),
         };
+        let coat = self.coat.map_or(String::new(), |c| {
+            format!(
+                " under a clear coat (η {}, α {:.4}, weight {:.3})",
+                c.eta, c.alpha, c.weight
+            )
+        });
         let alpha = if self.alpha_x == self.alpha_y {
             format!("α {:.4}", self.alpha_x)
         } else {
@@ -188,7 +225,7 @@ impl Report {
             )
         };
         format!(
-            "{}: {} as a {} {} ({} fit, {alpha}), {} Fresnel {error} (with the F table {:.3e}); {} approximation(s) noted in the file",
+            "{}: {} as a {} {} ({} fit, {alpha}){coat}, {} Fresnel {error} (with the F table {:.3e}); {} approximation(s) noted in the file",
             self.target,
             self.material,
             self.distribution,
@@ -223,12 +260,16 @@ impl Report {
                 self.rotation_deg,
                 self.diffuse
             ),
-            match self.fresnel_error {
-                Some(e) => format!(
+            match (self.fresnel_error, self.coat) {
+                (Some(e), _) => format!(
                     "Fresnel: the {} fit; Facet's error metric of the model with it: {e:e} (with the fit's F table: {:e}; RMS to the table {:.2e}).",
                     self.fresnel, self.table_error, self.fresnel_rms
                 ),
-                None => format!(
+                (None, Some(c)) => format!(
+                    "Coat: a clear dielectric of eta {}, GGX alpha {}, weight {} over the model above, whose values are the base's fitted under it (seen through the coat). Fresnel: the base's {} fit (RMS {:.2e} to its table); Facet's error metric of the coated model with the tables: {:e}, with the curve: unknown.",
+                    c.eta, c.alpha, c.weight, self.fresnel, self.fresnel_rms, self.table_error
+                ),
+                (None, None) => format!(
                     "Fresnel: the {} curve fitted at export to the model's F table (RMS {:.2e}); its error in Facet's metric is unknown (the fit recorded none; with the F table: {:e}).",
                     self.fresnel, self.fresnel_rms, self.table_error
                 ),
@@ -294,21 +335,22 @@ pub fn export(
     let r = &fit.record;
     let target = options.target;
     let mut notes = Vec::new();
-    let (fit_kind, p) = choose(r, options, &mut notes).map_err(bad)?;
-    let (fits, recorded) = fresnel_fits(r, p, &mut notes);
+    // A coat written: the base's fit under it is the model exported.
+    let coat = r
+        .coat
+        .as_ref()
+        .filter(|_| options.coat && target.has_coat());
+    let rec = coat.map_or(r, |c| &*c.base);
+    let (fit_kind, p) = choose(rec, options, &mut notes).map_err(bad)?;
+    let (fits, recorded) = fresnel_fits(rec, p, &mut notes);
     let kind = choose_kind(options.kind, p, &fits, recorded);
     let curve = Curve::of(target, kind, &fits);
     note_approximations(&mut notes, target, kind, p, &fits, recorded);
-    if let Some(c) = &r.coat {
-        notes.push(format!(
-            "the fit's clear coat (η {}, α {:.4}, weight {:.3}; coated tabulated error {:.3e} against the single layer's {}) is not exported: this is the single layer",
-            c.coat.eta,
-            c.coat.alpha,
-            c.coat.weight,
-            c.error,
-            fmt_error(r.tabulated.error)
-        ));
-    }
+    note_coat(&mut notes, r, coat.is_some(), target);
+    let coated_error = |c: &crate::model::material::CoatRecord| match fit_kind {
+        NdfKind::Ggx => c.ggx_error,
+        NdfKind::Beckmann => c.beckmann_error,
+    };
     let mut report = Report {
         target: target.name(),
         source_fit: path.display().to_string(),
@@ -325,11 +367,17 @@ pub fn export(
         rotation_deg: p.rotation.to_degrees(),
         diffuse: p.diffuse,
         fresnel: curve.name,
-        fresnel_error: known_error(recorded, curve.quality),
+        // A base's curve was measured against the data under the coat, not the source.
+        fresnel_error: known_error(recorded, curve.quality).filter(|_| coat.is_none()),
         fresnel_rms: curve.quality.rms,
-        table_error: p.error,
+        table_error: coat.map_or(p.error, |c| coated_error(c).unwrap_or(c.error)),
         fresnel_fits_recorded: recorded,
         notes,
+        coat: coat.map(|c| CoatExport {
+            eta: c.coat.eta,
+            alpha: c.coat.alpha,
+            weight: c.coat.weight,
+        }),
     };
     let id = crate::io::input::safe_file_stem(&r.name);
     let text = match target {
@@ -448,6 +496,44 @@ fn note_approximations(
         }
     };
     notes.push(g_note.into());
+}
+
+/// What becomes of the fit's coat (`written`, or the single layer exported), added to `notes`.
+fn note_coat(notes: &mut Vec<String>, r: &FitRecord, written: bool, target: Target) {
+    let Some(c) = &r.coat else { return };
+    let (eta, alpha, w) = (c.coat.eta, c.coat.alpha, c.coat.weight);
+    if !written {
+        let why = if target.has_coat() {
+            "not asked for"
+        } else {
+            "Mitsuba 3 has no coated conductor or coated rough plastic with a base of its own"
+        };
+        notes.push(format!(
+            "the fit's clear coat (η {eta}, α {alpha:.4}, weight {w:.3}; coated tabulated error {:.3e} against the single layer's {}) is not exported ({why}): this is the single layer",
+            c.error,
+            fmt_error(r.tabulated.error)
+        ));
+        return;
+    }
+    notes.push(format!(
+        "the base's values are those fitted under the coat (the data seen through it); the single layer's tabulated error is {}, the coated one's {:.3e}",
+        fmt_error(r.tabulated.error),
+        c.error
+    ));
+    match target {
+        Target::Pbrt => {
+            notes.push("pbrt-v4's coated BSDFs are evaluated stochastically (a random walk between the interface and the base, thickness 0.01, no medium): light scatters between the layers, where Facet's coat takes one crossing each way".into());
+            if w < 0.99 {
+                notes.push(format!("pbrt-v4's interface reflects its whole Fresnel: the coat's weight {w:.3} is written as 1"));
+            }
+        }
+        Target::Gltf => {
+            notes.push(format!(
+                "KHR_materials_clearcoat does not refract: the base is lit and seen along the outside directions and weighted by 1 − c F_schlick(0.04) (Facet: refracted, T(θi) T(θo) / η²), with ior 1.5 (the fit's η {eta})"
+            ));
+        }
+        Target::Mitsuba => {}
+    }
 }
 
 fn fmt_error(e: Option<f64>) -> String {
@@ -663,8 +749,99 @@ mod tests {
                 target,
                 model,
                 kind: KindRequest::Auto,
+                coat: true,
             },
         )
+    }
+
+    /// A fit that kept a coat exports the coat over its base's GGX fit: pbrt-v4's
+    /// coatedconductor with the coat as the interface and the base as the conductor, glTF's
+    /// clearcoat (factor w, roughness √α); the coated model's recorded error; Mitsuba, or
+    /// `coat: false`, the single layer, saying so.
+    #[test]
+    fn a_coat_is_exported_over_its_base() {
+        use crate::model::coat::Coat;
+        use crate::model::material::CoatRecord;
+        let gold = |a| Some(param(a, a, 0.0, &Fresnel::GOLD, [0.0; 3], true));
+        let mut r = record(gold(0.3), None);
+        r.coat = Some(CoatRecord {
+            coat: Coat::new(1.5, 0.04, 0.8),
+            error: 0.01,
+            ggx_error: Some(0.012),
+            beckmann_error: None,
+            base: Box::new(record(gold(0.2), None)),
+        });
+        let m = FittedMaterial::from_record(r).unwrap();
+        let pbrt = run(&m, Target::Pbrt, ModelRequest::Ggx).unwrap();
+        for line in [
+            r#""string type" [ "coatedconductor" ]"#,
+            r#""float interface.eta" [ 1.5 ]"#,
+            r#""float interface.uroughness" [ 0.04 ]"#,
+            r#""float conductor.uroughness" [ 0.2 ]"#,
+        ] {
+            assert!(pbrt.text.contains(line), "{line}:\n{}", pbrt.text);
+        }
+        let rep = &pbrt.report;
+        assert_eq!((rep.table_error, rep.fresnel_error), (0.012, None));
+        assert!(
+            rep.notes.iter().any(|n| n.contains("written as 1")),
+            "{:?}",
+            rep.notes
+        );
+        assert!(
+            rep.summary()
+                .contains("under a clear coat (η 1.5, α 0.0400, weight 0.800)")
+        );
+
+        let gltf = run(&m, Target::Gltf, ModelRequest::Ggx).unwrap();
+        let doc: serde_json::Value = serde_json::from_str(&gltf.text).unwrap();
+        let mat = &doc["materials"][0];
+        let cc = &mat["extensions"]["KHR_materials_clearcoat"];
+        assert_eq!(cc["clearcoatFactor"], 0.8);
+        assert!((cc["clearcoatRoughnessFactor"].as_f64().unwrap() - 0.2).abs() < 1e-12);
+        let rough = mat["pbrMetallicRoughness"]["roughnessFactor"]
+            .as_f64()
+            .unwrap();
+        assert!((rough - 0.2f64.sqrt()).abs() < 1e-12, "the base's α 0.2");
+        assert!(
+            doc["extensionsUsed"]
+                .to_string()
+                .contains("KHR_materials_clearcoat")
+        );
+
+        let mitsuba = run(&m, Target::Mitsuba, ModelRequest::Ggx).unwrap();
+        assert!(
+            mitsuba
+                .text
+                .contains(r#"<float name="alpha" value="0.3"/>"#)
+        );
+        assert!(mitsuba.report.coat.is_none());
+        assert!(
+            mitsuba
+                .report
+                .notes
+                .iter()
+                .any(|n| n.contains("not exported (Mitsuba 3"))
+        );
+        let single = export(
+            &m,
+            Path::new("fits/test.json"),
+            &ExportOptions {
+                target: Target::Pbrt,
+                model: ModelRequest::Ggx,
+                kind: KindRequest::Auto,
+                coat: false,
+            },
+        )
+        .unwrap();
+        assert!(single.text.contains(r#""string type" [ "conductor" ]"#));
+        assert!(
+            single
+                .report
+                .notes
+                .iter()
+                .any(|n| n.contains("not asked for"))
+        );
     }
 
     /// A GGX gold fit exports the fit's conductor η and k exactly, α as is, the conductor's
