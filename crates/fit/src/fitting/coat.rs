@@ -8,7 +8,8 @@
 //! model's error on the source's own samples. The search: the best of a coarse grid of α and
 //! weight, then α by Brent's method in log α between the grid's neighbours, the weight, and α
 //! again within ±10 % and finer, on a cheap base fit (32 extraction nodes, the
-//! tabulated model alone, no refinement) and every [`SEARCH_STRIDE`]-th row of the source;
+//! tabulated model alone, no refinement, every fourth φd bin) scored on every 16th row of the
+//! source;
 //! then one full fit of the base at the coat found. The coat is kept when the coated tabulated
 //! model's error on the full grid is below (1 − [`KEEP_MARGIN`]) times the single layer's.
 
