@@ -25,7 +25,7 @@ fn fits() -> Result<[Arc<FittedMaterial>; 2]> {
     let model = facet_fit::model::analytic::parse_analytic(SPEC)?;
     let src =
         MerlBrdf::from_table("gold", MerlTable::sample(&model)).map_err(anyhow::Error::msg)?;
-    let bare = fit_material(&src, SPEC, &FitConfig::SAMPLING)?;
+    let bare = fit_material(&src, SPEC, &FitConfig::SINGLE_LAYER)?;
     let mut record = bare.record.clone();
     record.coat = Some(CoatRecord {
         coat: COAT,

@@ -23,7 +23,7 @@ const PROXY: &str = "gold-metallic-paint";
 fn materials() -> Result<[(&'static str, Material); 3]> {
     let src = NbrdfLibrary::embedded().get(PROXY)?;
     let source = format!("nbrdf:{PROXY}");
-    let fit = Arc::new(fit_material(&src, &source, &FitConfig::SAMPLING)?);
+    let fit = Arc::new(fit_material(&src, &source, &FitConfig::SINGLE_LAYER)?);
     let table = Measurement::of(&InputSpec::parse(&source), &src).map_err(|e| anyhow!(e))?;
     let (tensor, _) = rgl_tensor(&src, &fit.tabulated.ndf, BsdfResolution::standard(), "")
         .map_err(|e| anyhow!("{PROXY}.bsdf: {e}"))?;

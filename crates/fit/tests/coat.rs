@@ -65,11 +65,12 @@ fn coat_over_a_lambertian_is_found() {
         m.record.tabulated.error, c.coat, c.error, c.base.tabulated.diffuse
     );
     assert!((c.coat.alpha - 0.05).abs() < 0.02 * 0.05, "{:?}", c.coat);
-    // ρd is solved with F per θd bin on the directions the coat lets through (θd' < 41.8°),
-    // which share part of it: 1.5 % low on each channel as measured.
+    // ρd is solved beside a specular lobe with F per θd bin, on the directions the coat lets
+    // through (θd' < 41.8°): that lobe takes about 0.007 of it in every channel as measured.
+    // Within 0.01, 2 % of the largest albedo.
     let rho = c.base.tabulated.diffuse;
     for (got, want) in rho.iter().zip([0.5, 0.3, 0.1]) {
-        assert!((got - want).abs() < 0.025 * want, "{rho:?}");
+        assert!((got - want).abs() < 0.01, "{rho:?}");
     }
 }
 

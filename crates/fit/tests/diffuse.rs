@@ -191,7 +191,7 @@ fn refined_tabulated_model_beats_the_analytic_fits_on_proxies() {
     ] {
         let table = facet_fit::model::merl_grid::MerlTable::sample(&lib.get(name).unwrap());
         let src = facet_fit::sources::merl::MerlBrdf::from_table(name, table).unwrap();
-        let r = fit_material(&src, name, &FitConfig::isotropic())
+        let r = fit_material(&src, name, &FitConfig::SINGLE_LAYER)
             .unwrap()
             .record;
         let tab = r.tabulated.error.unwrap();

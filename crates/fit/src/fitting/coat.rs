@@ -5,9 +5,9 @@
 //! ([`SeenFromInside`]: f_base(ωi', ωo') = η² (f(ωi, ωo) − coat lobe) / (T(θi) T(θo)) at the
 //! outside directions of each inside pair; pairs past the critical angle have none and are
 //! missing), fitted by the same pipeline as any source. The candidate's score is the coated
-//! model's error on the source's own samples. The search: the best of a coarse grid of α and
-//! weight, then α by Brent's method in log α between the grid's neighbours, the weight, and α
-//! again within ±10 % and finer, on a cheap base fit (32 extraction nodes, the
+//! model's error on the source's own samples. The search: α by Brent's method in log α at each
+//! of three weights, the best of those, then its weight, and α again within ±10 % and finer, on
+//! a cheap base fit (32 extraction nodes, the
 //! tabulated model alone, no refinement, every fourth φd bin) scored on every 16th row of the
 //! source;
 //! then one full fit of the base at the coat found. The coat is kept when the coated tabulated
@@ -32,10 +32,12 @@ use glam::DVec3;
 pub const COAT_ETA: f64 = 1.5;
 /// [`CoatSearch::Auto`] searches a coat where the single layer's tabulated error is above this.
 pub const TRY_ABOVE: f64 = 0.03;
-/// The coarse grid the search starts from: α ...
-const GRID_ALPHAS: [f64; 5] = [0.005, 0.015, 0.04, 0.1, 0.3];
-/// ... and weight.
-const GRID_WEIGHTS: [f64; 3] = [0.15, 0.5, 1.0];
+/// The coat's α is searched in [`ALPHA_RANGE`].0 ..= .1, from [`ALPHA_START`] ...
+pub const ALPHA_RANGE: (f64, f64) = (0.003, 0.5);
+/// ... a lacquer's typical roughness, ...
+const ALPHA_START: f64 = 0.03;
+/// ... at each of these weights.
+const START_WEIGHTS: [f64; 3] = [0.15, 0.5, 1.0];
 /// A coat is kept when it lowers the tabulated model's error by at least this fraction.
 pub const KEEP_MARGIN: f64 = 0.01;
 /// The search scores candidates on every `SEARCH_STRIDE`-th (θh, θd) row of the source.
@@ -174,16 +176,6 @@ fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &Gr
 pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamples) -> Coat {
     let set = full.subsample(SEARCH_STRIDE);
     let score = |coat: Coat| score(src, data, coat, cfg, &set);
-    // The best of a coarse grid: the score has several minima on real paints.
-    let (mut best, mut at) = (f64::INFINITY, (0, 0));
-    for (i, &alpha) in GRID_ALPHAS.iter().enumerate() {
-        for (j, &weight) in GRID_WEIGHTS.iter().enumerate() {
-            let s = score(Coat::new(COAT_ETA, alpha, weight));
-            if s < best {
-                (best, at) = (s, (i, j));
-            }
-        }
-    }
     // Brent's method in ln α on [lo, hi], to `tol` times |ln α| (about 3 ln α's bits).
     let by_alpha = |coat: Coat, (lo, hi): (f64, f64), tol: f64| Coat {
         alpha: brent(
@@ -201,13 +193,17 @@ pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamp
         .exp(),
         ..coat
     };
-    let (i, j) = at;
-    let start = Coat::new(COAT_ETA, GRID_ALPHAS[i], GRID_WEIGHTS[j]);
-    let bracket = (
-        GRID_ALPHAS[i.saturating_sub(1)].min(start.alpha / 2.0),
-        GRID_ALPHAS[(i + 1).min(GRID_ALPHAS.len() - 1)].max(start.alpha * 2.0),
-    );
-    let coat = by_alpha(start, bracket, 0.003);
+    // α searched at each of a few weights: the score has several minima on real paints, and
+    // at an α off the true one a lower weight hides the mismatch.
+    let coat = START_WEIGHTS
+        .iter()
+        .map(|&w| {
+            let c = by_alpha(Coat::new(COAT_ETA, ALPHA_START, w), ALPHA_RANGE, 0.003);
+            (score(c), c)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, c)| c)
+        .expect("START_WEIGHTS is not empty");
     let coat = Coat {
         weight: brent(
             |w| score(Coat { weight: w, ..coat }),

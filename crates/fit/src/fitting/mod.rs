@@ -123,8 +123,9 @@ impl FitConfig {
         }
     }
 
-    /// [`FitConfig::isotropic`] without the coat: the fit that samples a measured material.
-    pub const SAMPLING: FitConfig = FitConfig {
+    /// [`FitConfig::isotropic`] without the coat: the single layer alone (`--no-coat`), as the
+    /// fit that samples a measured material takes it.
+    pub const SINGLE_LAYER: FitConfig = FitConfig {
         coat: CoatSearch::Off,
         ..Self::isotropic()
     };

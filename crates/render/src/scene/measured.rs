@@ -110,7 +110,7 @@ impl MeasuredMaterial {
             Some(f) => f,
             // The fit only samples the measurement: no coat is searched.
             None => Arc::new(
-                facet_fit::fit_material(&*src, source, &FitConfig::SAMPLING)
+                facet_fit::fit_material(&*src, source, &FitConfig::SINGLE_LAYER)
                     .map_err(|e| fail(&format!("fitting its sampling NDF: {e}")))?,
             ),
         };
