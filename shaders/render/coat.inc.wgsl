@@ -5,7 +5,7 @@
 // with E_c the coat lobe's directional albedo, tabulated in the material's coat block:
 // [n, E_c at cos θ = (k + ½)/n for k < n].
 // Sampling: the coat's lobe (its normals, as lobe_sample_h) with probability
-//   p = w E_c(θo) / (w E_c(θo) + T(θo) base_albedo(b)),
+//   p = w E_c(θo) / (w E_c(θo) + T(θo) max(base_albedo(b), 0.02)),
 // else the base's sampling from ωo' and the result refracted out (a direction past the critical
 // angle is refused: z < 0); pdf = p pdf_coat + (1 − p) pdf_base(ωi') cos θi / (η² cos θi').
 // The includer's Bsdf has a field `coat: Coat` (coat_of), and the includer defines
@@ -80,10 +80,11 @@ fn coat_reflection(c: Coat, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     return c.weight * fresnel_dielectric(dot(wi, h), c.eta) * ndf_d(c.ndf, h) * g / (4.0 * wi.z * wo.z);
 }
 
-// The probability of sampling the coat's lobe from ωo: its share of the layers' albedos.
+// The probability of sampling the coat's lobe from ωo: its share of the layers' albedos (the
+// base's estimate at least 0.02, so that a base that estimates none is still sampled).
 fn coat_probability(b: Bsdf, wo: vec3<f32>) -> f32 {
     let r = b.coat.weight * coat_lobe_albedo(b.coat, wo.z);
-    let t = coat_transmission(b.coat, wo.z) * base_albedo(b);
+    let t = coat_transmission(b.coat, wo.z) * max(base_albedo(b), 0.02);
     return select(1.0, r / (r + t), r + t > 0.0);
 }
 

@@ -2,7 +2,7 @@
 //! GGX + Lambertian base): its histogram against the CPU's pdf of the same mixture (χ²), and
 //! its pdf against the CPU's, for a sharp and a rough coat, from normal to grazing views. The
 //! CPU's pdf is written here from the mixture's definition: the coat's visible normals with
-//! probability p = w E_c(θo) / (w E_c(θo) + T(θo) a), else the base's sampling from the
+//! probability p = w E_c(θo) / (w E_c(θo) + T(θo) max(a, 0.02)), else the base's sampling from the
 //! refracted ωo, its pdf times the refraction's Jacobian cos θi / (η² cos θi').
 
 use facet_fit::model::coat::{Coat, CoatLayer};
@@ -24,7 +24,7 @@ fn pdf(layer: &CoatLayer, wo: DVec3, wi: DVec3) -> f64 {
     let c = layer.coat;
     let (alpha, p_spec, albedo) = BASE;
     let r = c.weight * layer.lobe_albedo(wo.z);
-    let p = r / (r + layer.transmission(wo.z) * albedo);
+    let p = r / (r + layer.transmission(wo.z) * albedo.max(0.02));
     let coat_ndf = AnalyticNdf::isotropic(NdfKind::Ggx, c.alpha);
     let h = (wi + wo).normalize();
     let coat = coat_ndf.pdf_visible(wo, h) / (4.0 * wo.dot(h).abs());
