@@ -172,7 +172,8 @@ fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &Gr
     }
 }
 
-/// The coat that scores best: α at weight 1, then the weight, then α again.
+/// The coat that scores best: α at each of the weights 0.15, 0.5 and 1, the best of those, then its
+/// weight, then α again within ±10 %.
 pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamples) -> Coat {
     let set = full.subsample(SEARCH_STRIDE);
     let score = |coat: Coat| score(src, data, coat, cfg, &set);

@@ -231,7 +231,6 @@ pub fn plan(m: &Material) -> Result<MaterialPlan<'_>, RenderError> {
     if let Some(c) = &m.clearcoat {
         gpu.coat_weight = c.factor;
         gpu.coat_alpha = c.roughness;
-        gpu.coat_eta = 1.5;
         gpu.tex_clearcoat = texture(c.texture);
         gpu.tex_clearcoat_roughness = texture(c.roughness_texture);
         gpu.tex_clearcoat_normal = texture(c.normal_texture);
