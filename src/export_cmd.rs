@@ -11,7 +11,9 @@ use std::process::ExitCode;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum TargetArg {
-    /// Mitsuba 3 XML: a `roughconductor` or `roughplastic` `<bsdf>` (`mi.load_file`, `<include>`).
+    /// Mitsuba 3 XML: a `roughconductor` or `roughplastic` `<bsdf>` (`mi.load_file`, `<include>`);
+    /// a coated fit as a `measured` `<bsdf>` and the coated model tabulated in NAME.coated.bsdf
+    /// beside it.
     Mitsuba,
     /// pbrt-v4: a `conductor` or `coateddiffuse` MakeNamedMaterial (Include it, then
     /// NamedMaterial).
@@ -63,7 +65,7 @@ pub struct ExportArgs {
     #[arg(long)]
     pub force: bool,
     /// Export the single layer of a fit that kept a clear coat (default: the coat over its
-    /// base, for pbrt and glTF; Mitsuba always gets the single layer).
+    /// base; for Mitsuba, tabulated).
     #[arg(long)]
     pub no_coat: bool,
 }
@@ -125,18 +127,63 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode> {
         );
     }
     let exported = export(&fit, &args.fit, &options)?;
+    let table = exported
+        .table
+        .as_ref()
+        .map(|t| (out.with_file_name(&t.name), t))
+        .map(|(path, t)| check_table_path(&path, &out, args).map(|()| (path, t)))
+        .transpose()?;
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         crate::output::folder(dir, "--out")?;
     }
-    // Through a temporary file renamed into place, as `facet fit` writes its JSON.
-    facet_fit::io::output::write_bytes_atomically(&out, &exported.text).map_err(|e| {
+    // The table first: the file that names it is written only once it is there.
+    if let Some((path, t)) = &table {
+        write(path, &t.bytes)?;
+    }
+    write(&out, exported.text.as_bytes())?;
+    println!("{}", exported.report.summary());
+    match &table {
+        Some((path, _)) => println!("wrote {} and {}", out.display(), path.display()),
+        None => println!("wrote {}", out.display()),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The table a coated Mitsuba export names, at `path` beside the output: never the fit, an
+/// existing file only with --force.
+fn check_table_path(path: &Path, out: &Path, args: &ExportArgs) -> Result<()> {
+    if path == out {
+        bail!(
+            "--out {}: is the name of the coat's table the export writes beside it; choose another --out",
+            out.display()
+        );
+    }
+    if same_file(&args.fit, path) {
+        bail!(
+            "{}: the coat's table would replace the fit it is exported from; export it from another folder or with another --out",
+            path.display()
+        );
+    }
+    if path.is_dir() {
+        bail!("{}: the coat's table's name is a folder", path.display());
+    }
+    if path.exists() && !args.force {
+        bail!(
+            "{}: exists (the coat's table named by the export); --force replaces it",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// `bytes` at `path` through a temporary file renamed into place, as `facet fit` writes its
+/// JSON.
+fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    facet_fit::io::output::write_bytes_atomically(path, bytes).map_err(|e| {
         anyhow::anyhow!(
             "{}: cannot write: {}",
-            out.display(),
+            path.display(),
             facet_fit::io::input::io_problem(&e)
         )
-    })?;
-    println!("{}", exported.report.summary());
-    println!("wrote {}", out.display());
-    Ok(ExitCode::SUCCESS)
+    })
 }

@@ -534,3 +534,127 @@ fn anisotropic_fit_exports_both_alphas() {
             .contains(&"KHR_materials_anisotropy".into())
     );
 }
+
+/// A fit with a coat (here attached by hand: the gold fit's own record as the base under a
+/// coat of α 0.05) exported to Mitsuba 3: a `measured` `<bsdf>` naming the coated model's
+/// table, written beside it and readable as an RGL file; the table is refused when it exists
+/// (kept without --force), or when --out would take its name; `--no-coat` writes the single
+/// layer and no table.
+#[test]
+fn coated_fit_exports_a_table_for_mitsuba() {
+    let dir = common::scratch("export_coat_mitsuba");
+    let (ok, stdout, stderr) = facet(
+        &dir,
+        &[
+            "fit",
+            GOLD,
+            "--model",
+            "ggx",
+            "--coat",
+            "off",
+            "--backend",
+            "cpu",
+            "--out",
+            ".",
+        ],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    let fit = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .unwrap();
+    let mut rec = json(&fit);
+    let base = rec.clone();
+    rec["coat"] = serde_json::json!({
+        "eta": 1.5, "alpha": 0.05, "weight": 1.0,
+        "error": 0.01, "ggx_error": 0.012, "beckmann_error": null,
+        "base": base,
+    });
+    let coated = dir.join("coated.json");
+    std::fs::write(&coated, serde_json::to_string(&rec).unwrap()).unwrap();
+    let name = rec["name"].as_str().unwrap().to_string();
+    let table = dir.join(format!(
+        "{}.coated.bsdf",
+        facet_fit::io::input::safe_file_stem(&name)
+    ));
+
+    let (ok, stdout, stderr) = facet(&dir, &["export", "coated.json", "--to", "mitsuba"]);
+    assert!(ok, "{stdout}\n{stderr}");
+    let xml = std::fs::read_to_string(dir.join("coated.xml")).unwrap();
+    assert_eq!(well_formed(&xml), Ok("bsdf".into()));
+    assert!(xml.contains(r#"<bsdf type="measured""#), "{xml}");
+    assert_eq!(
+        xml_value(&xml, "string", "filename"),
+        table.file_name().unwrap().to_str().unwrap()
+    );
+    assert!(stdout.contains("against the coated model"), "{stdout}");
+    let file = facet_fit::sources::rgl::RglBsdf::open(&table).expect("the table reads");
+    assert!(facet_fit::model::brdf::Brdf::is_isotropic(&file) && !file.is_spectral());
+
+    // The table exists: refused, and neither file changes.
+    std::fs::write(&table, b"mine").unwrap();
+    let (ok, _, stderr) = facet(
+        &dir,
+        &[
+            "export",
+            "coated.json",
+            "--to",
+            "mitsuba",
+            "-o",
+            "other.xml",
+        ],
+    );
+    assert!(
+        !ok && stderr.contains("exists") && stderr.contains("--force"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(&table).unwrap(), b"mine");
+    assert!(!dir.join("other.xml").exists());
+    let (ok, _, stderr) = facet(
+        &dir,
+        &[
+            "export",
+            "coated.json",
+            "--to",
+            "mitsuba",
+            "-o",
+            "other.xml",
+            "--force",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    assert!(facet_fit::sources::rgl::RglBsdf::open(&table).is_ok());
+    let (ok, _, stderr) = facet(
+        &dir,
+        &[
+            "export",
+            "coated.json",
+            "--to",
+            "mitsuba",
+            "-o",
+            table.file_name().unwrap().to_str().unwrap(),
+            "--force",
+        ],
+    );
+    assert!(!ok && stderr.contains("choose another --out"), "{stderr}");
+
+    let (ok, _, stderr) = facet(
+        &dir,
+        &[
+            "export",
+            "coated.json",
+            "--to",
+            "mitsuba",
+            "-o",
+            "single.xml",
+            "--no-coat",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    let single = std::fs::read_to_string(dir.join("single.xml")).unwrap();
+    assert!(
+        single.contains(r#"<bsdf type="roughconductor""#),
+        "{single}"
+    );
+}

@@ -110,6 +110,23 @@ pub(super) fn write(id: &str, p: &ParamRecord, fits: &FresnelFits, report: &mut 
             "roughplastic"
         }
     };
+    document(bsdf, id, &body, report)
+}
+
+/// The Mitsuba 3 file of a coated model tabulated in `table` (a file name beside it): a
+/// `measured` `<bsdf>`, the statement above it. Mitsuba finds the table through its file
+/// resolver, which holds the folder of a file loaded with `mi.load_file`.
+pub(super) fn write_measured(id: &str, table: &str, report: &Report) -> String {
+    let body = [format!(
+        r#"    <string name="filename" value="{}"/>"#,
+        xml_attr(table)
+    )];
+    document("measured", id, &body, report)
+}
+
+/// The XML file: the statement of `report` in a comment, then `<bsdf type=bsdf id=id>` holding
+/// `body`'s lines.
+fn document(bsdf: &str, id: &str, body: &[String], report: &Report) -> String {
     let mut s = String::from("<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<!--\n");
     for line in report.lines() {
         s += &format!("  {}\n", xml_comment(&line));

@@ -22,11 +22,13 @@
 //! contains the dielectric one (k = 0), so its error is never much above the dielectric's, and
 //! a colourless table fits both alike.
 //!
-//! A fit that kept a clear coat ([`crate::model::coat`]) is exported coated where the target has
-//! a coat ([`Target::has_coat`]: pbrt-v4's `coatedconductor` / `coateddiffuse`, glTF's
-//! `KHR_materials_clearcoat`): the base's analytic fit under the coat, with the coated model's
-//! recorded error; elsewhere, or with [`ExportOptions::coat`] false, the single layer, and the
-//! statement says which.
+//! A fit that kept a clear coat ([`crate::model::coat`]) is exported coated unless
+//! [`ExportOptions::coat`] is false (then the single layer, and the statement says so): for
+//! pbrt-v4 as `coatedconductor` / `coateddiffuse` and for glTF as `KHR_materials_clearcoat`,
+//! the base's analytic fit under the coat with the coated model's recorded error; for Mitsuba 3,
+//! which has no coated conductor, the coated model itself (the coat over the base's analytic
+//! fit with its F table) tabulated into an RGL `.bsdf` ([`TableFile`]) for its `measured`
+//! plugin, with the table's error against that model beside the model's recorded one.
 //!
 //! Each target's writer is in its own module: [`mitsuba`], `pbrt` and [`gltf`]; [`rgl`] writes
 //! a fit's model as an RGL `.bsdf` file.
@@ -38,7 +40,7 @@ pub mod rgl;
 
 use crate::error::FitError;
 use crate::model::fresnel_curves::{FitQuality, FresnelChoice, FresnelFits};
-use crate::model::material::{FitRecord, FittedMaterial, ParamRecord};
+use crate::model::material::{FitRecord, FittedMaterial, ModelChoice, ParamRecord};
 use crate::model::microfacet::NdfKind;
 use crate::model::rgb::Rgb;
 use serde::Serialize;
@@ -57,8 +59,9 @@ pub const CONDUCTOR_MARGIN: f64 = 0.9;
 /// The renderer an export is written for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Target {
-    /// Mitsuba 3: a `<bsdf>` element (`roughconductor` or `roughplastic`) as the root of an
-    /// XML file, loadable by `mi.load_file` or an `<include>`.
+    /// Mitsuba 3: a `<bsdf>` element (`roughconductor` or `roughplastic`; `measured` with a
+    /// [`TableFile`] for a coat) as the root of an XML file, loadable by `mi.load_file` or an
+    /// `<include>`.
     Mitsuba,
     /// pbrt-v4: a `MakeNamedMaterial` statement (`conductor` or `coateddiffuse`).
     Pbrt,
@@ -88,12 +91,6 @@ impl Target {
     /// Whether the target has a Beckmann distribution (Mitsuba only).
     pub fn has_beckmann(self) -> bool {
         self == Target::Mitsuba
-    }
-
-    /// Whether the target can write a clear coat over the material (pbrt-v4's coated BSDFs,
-    /// glTF's clearcoat; Mitsuba 3 has no coated conductor).
-    pub fn has_coat(self) -> bool {
-        self != Target::Mitsuba
     }
 }
 
@@ -200,15 +197,42 @@ pub struct Report {
     /// the base's, and `table_error` the coated model's).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub coat: Option<CoatExport>,
+    /// The coated model tabulated into a `.bsdf` (Mitsuba 3), if it was.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tabulated: Option<TableExport>,
+}
+
+/// The coated model as the `.bsdf` file of an export ([`TableFile`]) holds it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TableExport {
+    /// The file's name, beside the exported file.
+    pub file: String,
+    /// The file's error against the coated model in Facet's metric, on the MERL grid.
+    pub error: f64,
+    /// The NDF its sample space was built on ([`rgl::sampling_ndfs`]).
+    pub sample_space: &'static str,
 }
 
 impl Report {
     /// One line: the target, the material, the model and α, the Fresnel and its error.
     pub fn summary(&self) -> String {
-        let error = match (self.fresnel_error, self.coat) {
-            (Some(e), _) => format!("error {e:.3e}"),
-            (None, Some(_)) => "error unknown (under the coat)".into(),
-            (None, None) => "error unknown (fitted at export)".into(),
+        let error = match (self.fresnel_error, self.coat, &self.tabulated) {
+            (_, _, Some(t)) => format!(
+                "the F table: error {:.3e}; tabulated in {}, {:.3e} against the coated model",
+                self.table_error, t.file, t.error
+            ),
+            (Some(e), _, _) => format!(
+                "{} Fresnel error {e:.3e} (with the F table {:.3e})",
+                self.fresnel, self.table_error
+            ),
+            (None, Some(_), _) => format!(
+                "{} Fresnel error unknown (under the coat; with the F table {:.3e})",
+                self.fresnel, self.table_error
+            ),
+            (None, None, _) => format!(
+                "{} Fresnel error unknown (fitted at export; with the F table {:.3e})",
+                self.fresnel, self.table_error
+            ),
         };
         let coat = self.coat.map_or(String::new(), |c| {
             format!(
@@ -225,19 +249,28 @@ impl Report {
             )
         };
         format!(
-            "{}: {} as a {} {} ({} fit, {alpha}){coat}, {} Fresnel {error} (with the F table {:.3e}); {} approximation(s) noted in the file",
+            "{}: {} as {} ({} fit, {alpha}){coat}, {error}; {} approximation(s) noted in the file",
             self.target,
             self.material,
-            self.distribution,
-            match self.kind {
-                Kind::Conductor => "conductor",
-                Kind::Plastic => "plastic",
-            },
+            self.written_as(),
             self.fit_model,
-            self.fresnel,
-            self.table_error,
             self.notes.len()
         )
+    }
+
+    /// What the model is written as: `a ggx conductor`, or the base of a tabulated coat.
+    fn written_as(&self) -> String {
+        match self.tabulated {
+            Some(_) => format!("a {} base", self.distribution),
+            None => format!(
+                "a {} {}",
+                self.distribution,
+                match self.kind {
+                    Kind::Conductor => "conductor",
+                    Kind::Plastic => "plastic",
+                }
+            ),
+        }
     }
 
     /// The statement as lines of text (for the XML and pbrt comments).
@@ -248,28 +281,28 @@ impl Report {
                 self.source_fit, self.material
             ),
             format!(
-                "Model: the {} fit, written as a {} {}; alpha_x {}, alpha_y {}, rotation {} deg; rho_d {:?}.",
+                "Model: the {} fit, written as {}; alpha_x {}, alpha_y {}, rotation {} deg; rho_d {:?}.",
                 self.fit_model,
-                self.distribution,
-                match self.kind {
-                    Kind::Conductor => "conductor",
-                    Kind::Plastic => "plastic",
-                },
+                self.written_as(),
                 self.alpha_x,
                 self.alpha_y,
                 self.rotation_deg,
                 self.diffuse
             ),
-            match (self.fresnel_error, self.coat) {
-                (Some(e), _) => format!(
+            match (self.fresnel_error, self.coat, &self.tabulated) {
+                (_, Some(c), Some(t)) => format!(
+                    "Coat: a clear dielectric of eta {}, GGX alpha {}, weight {} over the model above, whose values are the base's fitted under it (seen through the coat), with its own F table; this coated model is tabulated in {} (sample space on the {} NDF). Facet's error metric of the coated model: {:e}; of the table against the coated model: {:e}.",
+                    c.eta, c.alpha, c.weight, t.file, t.sample_space, self.table_error, t.error
+                ),
+                (Some(e), _, _) => format!(
                     "Fresnel: the {} fit; Facet's error metric of the model with it: {e:e} (with the fit's F table: {:e}; RMS to the table {:.2e}).",
                     self.fresnel, self.table_error, self.fresnel_rms
                 ),
-                (None, Some(c)) => format!(
+                (None, Some(c), _) => format!(
                     "Coat: a clear dielectric of eta {}, GGX alpha {}, weight {} over the model above, whose values are the base's fitted under it (seen through the coat). Fresnel: the base's {} fit (RMS {:.2e} to its table); Facet's error metric of the coated model with the tables: {:e}, with the curve: unknown.",
                     c.eta, c.alpha, c.weight, self.fresnel, self.fresnel_rms, self.table_error
                 ),
-                (None, None) => format!(
+                (None, None, _) => format!(
                     "Fresnel: the {} curve fitted at export to the model's F table (RMS {:.2e}); its error in Facet's metric is unknown (the fit recorded none; with the F table: {:e}).",
                     self.fresnel, self.fresnel_rms, self.table_error
                 ),
@@ -287,6 +320,19 @@ pub struct Exported {
     pub text: String,
     /// What it approximates (also written inside `text`).
     pub report: Report,
+    /// A second file the first names, to be written beside it.
+    pub table: Option<TableFile>,
+}
+
+/// The `.bsdf` file a Mitsuba 3 export of a coat names: the coated model tabulated for the
+/// `measured` plugin ([`rgl::rgl_bytes`] at [`rgl::BsdfResolution::standard`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TableFile {
+    /// Its file name (`NAME.coated.bsdf`), which the exported file refers to; it goes in the
+    /// same folder.
+    pub name: String,
+    /// Its contents.
+    pub bytes: Vec<u8>,
 }
 
 /// One of the Fresnel curves with its quality.
@@ -336,16 +382,19 @@ pub fn export(
     let target = options.target;
     let mut notes = Vec::new();
     // A coat written: the base's fit under it is the model exported.
-    let coat = r
-        .coat
-        .as_ref()
-        .filter(|_| options.coat && target.has_coat());
+    let coat = r.coat.as_ref().filter(|_| options.coat);
+    // Mitsuba 3 gets the coated model as a table: no curve stands in for the F table.
+    let tabulate = target == Target::Mitsuba && coat.is_some();
     let rec = coat.map_or(r, |c| &*c.base);
     let (fit_kind, p) = choose(rec, options, &mut notes).map_err(bad)?;
-    let (fits, recorded) = fresnel_fits(rec, p, &mut notes);
+    let mut curve_notes = Vec::new();
+    let (fits, recorded) = fresnel_fits(rec, p, &mut curve_notes);
     let kind = choose_kind(options.kind, p, &fits, recorded);
     let curve = Curve::of(target, kind, &fits);
-    note_approximations(&mut notes, target, kind, p, &fits, recorded);
+    if !tabulate {
+        notes.append(&mut curve_notes);
+        note_approximations(&mut notes, target, kind, p, &fits, recorded);
+    }
     note_coat(&mut notes, r, coat.is_some(), target);
     let coated_error = |c: &crate::model::material::CoatRecord| match fit_kind {
         NdfKind::Ggx => c.ggx_error,
@@ -366,10 +415,10 @@ pub fn export(
         alpha_y: p.alpha_y,
         rotation_deg: p.rotation.to_degrees(),
         diffuse: p.diffuse,
-        fresnel: curve.name,
+        fresnel: if tabulate { "table" } else { curve.name },
         // A base's curve was measured against the data under the coat, not the source.
         fresnel_error: known_error(recorded, curve.quality).filter(|_| coat.is_none()),
-        fresnel_rms: curve.quality.rms,
+        fresnel_rms: if tabulate { 0.0 } else { curve.quality.rms },
         table_error: coat.map_or(p.error, |c| coated_error(c).unwrap_or(c.error)),
         fresnel_fits_recorded: recorded,
         notes,
@@ -378,14 +427,69 @@ pub fn export(
             alpha: c.coat.alpha,
             weight: c.coat.weight,
         }),
+        tabulated: None,
     };
     let id = crate::io::input::safe_file_stem(&r.name);
-    let text = match target {
-        Target::Mitsuba => mitsuba::write(&id, p, &fits, &mut report),
-        Target::Pbrt => pbrt::write(&id, p, &fits, &mut report),
-        Target::Gltf => gltf::write(&r.name, p, &fits, &mut report),
+    let (text, table) = match target {
+        Target::Mitsuba if tabulate => {
+            let table = tabulate_coat(fit, fit_kind, &id, &mut report).map_err(bad)?;
+            (
+                mitsuba::write_measured(&id, &table.name, &report),
+                Some(table),
+            )
+        }
+        Target::Mitsuba => (mitsuba::write(&id, p, &fits, &mut report), None),
+        Target::Pbrt => (pbrt::write(&id, p, &fits, &mut report), None),
+        Target::Gltf => (gltf::write(&r.name, p, &fits, &mut report), None),
     };
-    Ok(Exported { text, report })
+    Ok(Exported {
+        text,
+        report,
+        table,
+    })
+}
+
+/// The coated model of `fit` with the base's `kind` fit, tabulated into `ID.coated.bsdf`
+/// (recorded in `report.tabulated`).
+fn tabulate_coat(
+    fit: &FittedMaterial,
+    kind: NdfKind,
+    id: &str,
+    report: &mut Report,
+) -> Result<TableFile, String> {
+    let choice = match kind {
+        NdfKind::Ggx => ModelChoice::Ggx,
+        NdfKind::Beckmann => ModelChoice::Beckmann,
+    };
+    let model = fit
+        .coated
+        .as_ref()
+        .and_then(|c| c.model(choice))
+        .ok_or_else(|| format!("the coat's base has no {} fit", kind.name()))?;
+    let name = format!("{id}.coated.bsdf");
+    let description = format!(
+        "{} under its clear coat, tabulated by facet {} from the fit {}",
+        report.material,
+        env!("CARGO_PKG_VERSION"),
+        report.source_fit
+    );
+    let (bytes, written) = rgl::rgl_bytes(&model, rgl::BsdfResolution::standard(), &description)
+        .map_err(|e| match e {
+            rgl::RglBytesError::Fit(e) => format!("tabulating the coated model: {e}"),
+            rgl::RglBytesError::Tensor(p) => format!("tabulating the coated model: {p}"),
+        })?;
+    report.notes.push(format!(
+        "Mitsuba 3 has no coated conductor: the coated model is tabulated for its measured plugin ({} θi slices of {}² samples; anything finer than that grid, as a coat's sharp peak, is smoothed: the table's error against the model is {:.3e})",
+        rgl::BsdfResolution::standard().theta_i,
+        rgl::BsdfResolution::standard().sample,
+        written.error
+    ));
+    report.tabulated = Some(TableExport {
+        file: name.clone(),
+        error: written.error,
+        sample_space: written.sample_space,
+    });
+    Ok(TableFile { name, bytes })
 }
 
 /// The Fresnel fits recorded with `p`, or (said in `notes`) fitted here to its F table, and
@@ -503,13 +607,8 @@ fn note_coat(notes: &mut Vec<String>, r: &FitRecord, written: bool, target: Targ
     let Some(c) = &r.coat else { return };
     let (eta, alpha, w) = (c.coat.eta, c.coat.alpha, c.coat.weight);
     if !written {
-        let why = if target.has_coat() {
-            "not asked for"
-        } else {
-            "Mitsuba 3 has no coated conductor or coated rough plastic with a base of its own"
-        };
         notes.push(format!(
-            "the fit's clear coat (η {eta}, α {alpha:.4}, weight {w:.3}; coated tabulated error {:.3e} against the single layer's {}) is not exported ({why}): this is the single layer",
+            "the fit's clear coat (η {eta}, α {alpha:.4}, weight {w:.3}; coated tabulated error {:.3e} against the single layer's {}) is not exported (not asked for): this is the single layer",
             c.error,
             fmt_error(r.tabulated.error)
         ));
@@ -809,20 +908,6 @@ mod tests {
                 .contains("KHR_materials_clearcoat")
         );
 
-        let mitsuba = run(&m, Target::Mitsuba, ModelRequest::Ggx).unwrap();
-        assert!(
-            mitsuba
-                .text
-                .contains(r#"<float name="alpha" value="0.3"/>"#)
-        );
-        assert!(mitsuba.report.coat.is_none());
-        assert!(
-            mitsuba
-                .report
-                .notes
-                .iter()
-                .any(|n| n.contains("not exported (Mitsuba 3"))
-        );
         let single = export(
             &m,
             Path::new("fits/test.json"),
@@ -842,6 +927,75 @@ mod tests {
                 .iter()
                 .any(|n| n.contains("not asked for"))
         );
+    }
+
+    /// Mitsuba 3 gets the coated model tabulated: a `measured` `<bsdf>` naming
+    /// `NAME.coated.bsdf`, the table's bytes, its error against the coated model stated. The
+    /// table holds the coat: its error against the coated model is under a tenth of the single
+    /// layer's distance to that model (the base at α 0.2 under a sharp coat against one lobe of
+    /// α 0.3).
+    #[test]
+    fn mitsuba_gets_the_coat_tabulated() {
+        use crate::metric::grid::{GridSamples, error_metric};
+        use crate::model::coat::Coat;
+        use crate::model::material::CoatRecord;
+        use crate::sources::rgl::RglBsdf;
+        let gold = |a| Some(param(a, a, 0.0, &Fresnel::GOLD, [0.0; 3], true));
+        let mut r = record(gold(0.3), None);
+        r.coat = Some(CoatRecord {
+            coat: Coat::new(1.5, 0.04, 0.8),
+            error: 0.01,
+            ggx_error: Some(0.012),
+            beckmann_error: None,
+            base: Box::new(record(gold(0.2), None)),
+        });
+        let m = FittedMaterial::from_record(r).unwrap();
+        let x = run(&m, Target::Mitsuba, ModelRequest::Ggx).unwrap();
+        assert!(
+            x.text
+                .contains(r#"<bsdf type="measured" id="test_material""#),
+            "{}",
+            x.text
+        );
+        assert!(
+            x.text
+                .contains(r#"<string name="filename" value="test_material.coated.bsdf"/>"#),
+            "{}",
+            x.text
+        );
+        let table = x.table.as_ref().expect("a table");
+        assert_eq!(table.name, "test_material.coated.bsdf");
+        let t = x.report.tabulated.as_ref().unwrap();
+        assert!(x.report.summary().contains("test_material.coated.bsdf"));
+        assert_eq!(x.report.table_error, 0.012);
+        let file = RglBsdf::parse("t", table.bytes.clone()).unwrap();
+        let coated = m.coated.as_ref().unwrap().model(ModelChoice::Ggx).unwrap();
+        let set = GridSamples::new(&coated);
+        let single = error_metric(m.model(ModelChoice::Ggx).unwrap(), &set);
+        let tabulated = error_metric(&file, &set);
+        assert!(
+            (tabulated - t.error).abs() <= 1e-12 * t.error.max(1e-300),
+            "{tabulated} {}",
+            t.error
+        );
+        assert!(
+            tabulated < 0.1 * single,
+            "table {tabulated}, single layer {single}"
+        );
+        // Without the coat, the single layer as before.
+        let single = export(
+            &m,
+            Path::new("fits/test.json"),
+            &ExportOptions {
+                target: Target::Mitsuba,
+                model: ModelRequest::Ggx,
+                kind: KindRequest::Auto,
+                coat: false,
+            },
+        )
+        .unwrap();
+        assert!(single.text.contains(r#"<float name="alpha" value="0.3"/>"#));
+        assert!(single.table.is_none() && single.report.tabulated.is_none());
     }
 
     /// A GGX gold fit exports the fit's conductor η and k exactly, α as is, the conductor's

@@ -117,9 +117,10 @@ pub fn sampling_ndfs(brdf: &dyn Brdf) -> Result<Vec<(&'static str, Ndf)>, FitErr
         Ndf::Tabulated(std::sync::Arc::new(ex.ndf)),
     )];
     // The whole default fit: the refinement and a tabulated analytic NDF, where one fits
-    // better, sharpen the peak further (white-paint: 0.103 → 0.035 in the round trip).
-    let fit =
-        crate::fitting::fit_material(brdf, brdf.name(), &crate::fitting::FitConfig::isotropic())?;
+    // better, sharpen the peak further (white-paint: 0.103 → 0.035 in the round trip). Its
+    // single layer: only the NDF is used, and a coat search would take seconds.
+    let cfg = crate::fitting::FitConfig::SINGLE_LAYER;
+    let fit = crate::fitting::fit_material(brdf, brdf.name(), &cfg)?;
     out.push(("diffuse separated", fit.tabulated.ndf));
     Ok(out)
 }
@@ -243,22 +244,45 @@ pub fn rgl_tensor(
     Ok((w, missing))
 }
 
-/// Writes `brdf` as an RGB `.bsdf` at `path`, through a temporary file renamed into place:
-/// [`rgl_tensor`] on each of the [`sampling_ndfs`], each read back and scored against the
-/// source in Facet's metric on the MERL grid, the best kept.
+/// Writes `brdf` as an RGB `.bsdf` at `path` ([`rgl_bytes`]), through a temporary file renamed
+/// into place.
 pub fn write_rgl(
     path: &Path,
     brdf: &dyn Brdf,
     res: BsdfResolution,
     description: &str,
 ) -> Result<BsdfWritten, FitError> {
-    let bad = |problem: String| FitError::Bsdf {
-        path: path.to_owned(),
-        problem,
-    };
+    let (bytes, written) = rgl_bytes(brdf, res, description).map_err(|e| match e {
+        RglBytesError::Fit(e) => e,
+        RglBytesError::Tensor(problem) => FitError::Bsdf {
+            path: path.to_owned(),
+            problem,
+        },
+    })?;
+    crate::io::output::write_bytes_atomically(path, &bytes).map_err(|e| FitError::io(path, e))?;
+    Ok(written)
+}
+
+/// Why [`rgl_bytes`] failed: the sample space's fit, or the tensor (a problem without a file).
+#[derive(Debug)]
+pub enum RglBytesError {
+    /// The fit of a sample space failed.
+    Fit(FitError),
+    /// The tensor could not be built or read back.
+    Tensor(String),
+}
+
+/// `brdf` as the bytes of an RGB `.bsdf`: [`rgl_tensor`] on each of the [`sampling_ndfs`], each
+/// read back and scored against the source in Facet's metric on the MERL grid, the best kept.
+pub fn rgl_bytes(
+    brdf: &dyn Brdf,
+    res: BsdfResolution,
+    description: &str,
+) -> Result<(Vec<u8>, BsdfWritten), RglBytesError> {
+    let bad = RglBytesError::Tensor;
     let set = crate::metric::grid::GridSamples::new(brdf);
     let mut best: Option<(Vec<u8>, BsdfWritten)> = None;
-    for (label, ndf) in sampling_ndfs(brdf)? {
+    for (label, ndf) in sampling_ndfs(brdf).map_err(RglBytesError::Fit)? {
         let (tensor, missing) = rgl_tensor(brdf, &ndf, res, description).map_err(bad)?;
         let bytes = tensor.to_bytes();
         let back = RglBsdf::parse(brdf.name(), bytes.clone()).map_err(bad)?;
@@ -273,9 +297,7 @@ pub fn write_rgl(
             best = Some((bytes, written));
         }
     }
-    let (bytes, written) = best.expect("at least one sample space");
-    crate::io::output::write_bytes_atomically(path, &bytes).map_err(|e| FitError::io(path, e))?;
-    Ok(written)
+    Ok(best.expect("at least one sample space"))
 }
 
 #[cfg(test)]
