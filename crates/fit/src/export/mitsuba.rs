@@ -137,7 +137,7 @@ fn document(bsdf: &str, id: &str, body: &[String], report: &Report) -> String {
         xml_attr(id)
     );
     for b in body {
-        s += &b;
+        s += b;
         s.push('\n');
     }
     s += "</bsdf>\n";
