@@ -69,7 +69,10 @@ impl Default for GlintEdit {
 }
 
 /// The loaded fit and the edits on it. `record` holds the edited α, rotation and diffuse
-/// albedo ρd of every model; `tint` multiplies every Fresnel table when the record is written out.
+/// albedo ρd of every model, the single layer's and (in `record.coat.base`) those of the base
+/// under the fit's coat; `tint` multiplies the Fresnel tables of the layer shown when the record
+/// is written out. While the coat is shown ([`EditedMaterial::coat_shown`]) the α, ρd and tint
+/// edits go to the base under it, else to the single layer.
 #[derive(Clone, Debug)]
 pub struct EditedMaterial {
     /// The fit as loaded or fitted (the "data's fit" of the plots).
@@ -136,11 +139,48 @@ impl EditedMaterial {
         }
     }
 
+    /// Whether the fit's coat is shown (the fit kept one and it is switched on): the α, ρd and
+    /// tint edits then go to the base under it.
+    pub fn coat_shown(&self) -> bool {
+        self.coat.is_some() && self.record.coat.is_some()
+    }
+
+    /// The layer the α and ρd edits go to: the base under the coat while it is shown, else the
+    /// single layer.
+    fn layer(&self) -> &FitRecord {
+        match &self.record.coat {
+            Some(c) if self.coat.is_some() => &c.base,
+            _ => &self.record,
+        }
+    }
+
+    /// See [`Self::layer`].
+    fn layer_mut(&mut self) -> &mut FitRecord {
+        if self.coat_shown() {
+            let c = self
+                .record
+                .coat
+                .as_mut()
+                .expect("coat_shown: the fit has a coat");
+            &mut c.base
+        } else {
+            &mut self.record
+        }
+    }
+
+    /// The layer of the fit as loaded that [`Self::layer`] edits.
+    fn fitted_layer(&self) -> &FitRecord {
+        match &self.base.record.coat {
+            Some(c) if self.coat.is_some() => &c.base,
+            _ => &self.base.record,
+        }
+    }
+
     /// The smooth model whose NDF the shown material uses: glints take the tabulated NDF when
     /// asked to (or when the fit has no GGX model), else GGX.
     pub fn lobe(&self) -> Shown {
         match self.shown {
-            Shown::Glint if self.glint.tabulated || self.record.ggx.is_none() => Shown::Tabulated,
+            Shown::Glint if self.glint.tabulated || self.layer().ggx.is_none() => Shown::Tabulated,
             Shown::Glint => Shown::Ggx,
             s => s,
         }
@@ -151,14 +191,15 @@ impl EditedMaterial {
         match shown {
             Shown::Measured => self.measurement.is_some(),
             Shown::Tabulated | Shown::Glint => true,
-            Shown::Ggx => self.record.ggx.is_some(),
-            Shown::Beckmann => self.record.beckmann.is_some(),
+            Shown::Ggx => self.layer().ggx.is_some(),
+            Shown::Beckmann => self.layer().beckmann.is_some(),
         }
     }
 
-    /// (αx, αy, rotation) of the shown model: the tabulated stretch or the analytic α.
+    /// (αx, αy, rotation) of the shown model ([`Self::layer`]'s): the tabulated stretch or the
+    /// analytic α.
     pub fn alpha(&self) -> Option<(f64, f64, f64)> {
-        let r = &self.record;
+        let r = self.layer();
         match self.lobe() {
             Shown::Measured => None,
             Shown::Tabulated => {
@@ -173,11 +214,11 @@ impl EditedMaterial {
         }
     }
 
-    /// Sets (αx, αy, rotation) of the shown model; α clamped to [1e-3, 4].
+    /// Sets (αx, αy, rotation) of the shown model ([`Self::layer`]'s); α clamped to [1e-3, 4].
     pub fn set_alpha(&mut self, ax: f64, ay: f64, rotation: f64) {
         let (ax, ay) = (ax.clamp(1e-3, 4.0), ay.clamp(1e-3, 4.0));
         let lobe = self.lobe();
-        let r = &mut self.record;
+        let r = self.layer_mut();
         match lobe {
             Shown::Measured => {}
             Shown::Tabulated => {
@@ -200,9 +241,10 @@ impl EditedMaterial {
         }
     }
 
-    /// The diffuse albedo ρd of the shown model (`None` for the measured data).
+    /// The diffuse albedo ρd of the shown model ([`Self::layer`]'s; `None` for the measured
+    /// data).
     pub fn diffuse(&self) -> Option<[f64; 3]> {
-        let r = &self.record;
+        let r = self.layer();
         match self.lobe() {
             Shown::Measured => None,
             Shown::Tabulated => Some(r.tabulated.diffuse),
@@ -215,7 +257,7 @@ impl EditedMaterial {
     pub fn set_diffuse(&mut self, albedo: [f64; 3]) {
         let albedo = albedo.map(|a| a.clamp(0.0, 1.0));
         let lobe = self.lobe();
-        let r = &mut self.record;
+        let r = self.layer_mut();
         match lobe {
             Shown::Measured => {}
             Shown::Tabulated => r.tabulated.diffuse = albedo,
@@ -226,7 +268,7 @@ impl EditedMaterial {
 
     /// ρd of the shown model as fitted (what "reset" restores).
     pub fn fitted_diffuse(&self) -> Option<[f64; 3]> {
-        let r = &self.base.record;
+        let r = self.fitted_layer();
         match self.lobe() {
             Shown::Measured => None,
             Shown::Tabulated => Some(r.tabulated.diffuse),
@@ -235,7 +277,7 @@ impl EditedMaterial {
         }
     }
 
-    /// Whether the single layer was edited: α, rotation, ρd or the tint.
+    /// Whether α, rotation, ρd (of either layer) or the tint was edited.
     pub fn is_edited(&self) -> bool {
         self.record != self.base.record || self.tint != [1.0; 3]
     }
@@ -245,33 +287,19 @@ impl EditedMaterial {
         self.base.record.coat.is_some()
     }
 
-    /// The edited record as saved: edited α and ρd, Fresnel tables times the tint, the coat's
-    /// edited η, α and weight. The sliders of α, ρd and the tint edit the single layer: a fit's
-    /// coat (`record.coat`, which the renderer prefers) is kept only while they are untouched,
-    /// so that what is shown and saved is the edited model. (The coat's recorded errors are the
-    /// fitted coat's.)
+    /// The edited record as saved: both layers' edited α and ρd, the coat's edited η, α and
+    /// weight (no coat while it is switched off), the Fresnel tables of the layer shown times
+    /// the tint. (The coat's recorded errors are the fitted coat's.)
     pub fn edited_record(&self) -> FitRecord {
         let mut r = self.record.clone();
-        r.coat = match (&r.coat, self.coat) {
-            (Some(c), Some(coat)) if !self.is_edited() => {
-                Some(facet_fit::model::material::CoatRecord { coat, ..c.clone() })
-            }
+        r.coat = match (r.coat.take(), self.coat) {
+            (Some(c), Some(coat)) => Some(facet_fit::model::material::CoatRecord { coat, ..c }),
             _ => None,
         };
-        let tint = |t: &mut facet_fit::model::fresnel::FresnelTable| {
-            for v in &mut t.rgb {
-                for (x, k) in v.iter_mut().zip(self.tint) {
-                    *x *= k;
-                }
-            }
-        };
         if self.tint != [1.0; 3] {
-            tint(&mut r.fresnel);
-            if let Some(p) = r.ggx.as_mut() {
-                tint(&mut p.fresnel);
-            }
-            if let Some(p) = r.beckmann.as_mut() {
-                tint(&mut p.fresnel);
+            match r.coat.as_mut() {
+                Some(c) => tint_tables(&mut c.base, self.tint),
+                None => tint_tables(&mut r, self.tint),
             }
         }
         r
@@ -339,22 +367,41 @@ impl EditedMaterial {
                 ]
             })
         };
-        let s = self.record.tabulated.stretch;
+        let layer = self.layer();
+        let s = layer.tabulated.stretch;
         MaterialKey {
             base: Arc::as_ptr(&self.base) as usize,
             measurement: self.measurement.as_ref().map(|m| Arc::as_ptr(m) as usize),
             shown: self.shown,
             stretch: [s.alpha_x, s.alpha_y, s.rotation],
-            tabulated_diffuse: self.record.tabulated.diffuse,
-            ggx: p(&self.record.ggx),
-            beckmann: p(&self.record.beckmann),
+            tabulated_diffuse: layer.tabulated.diffuse,
+            ggx: p(&layer.ggx),
+            beckmann: p(&layer.beckmann),
             tint: self.tint,
             glint: (self.shown == Shown::Glint).then_some(self.glint),
             coat: self
                 .coat
-                .filter(|_| !self.is_edited())
+                .filter(|_| self.coat_shown())
                 .map(|c| [c.eta, c.alpha, c.weight]),
         }
+    }
+}
+
+/// Every Fresnel table of `r`'s models times `tint`, per channel.
+fn tint_tables(r: &mut FitRecord, tint: [f64; 3]) {
+    let times = |t: &mut facet_fit::model::fresnel::FresnelTable| {
+        for v in &mut t.rgb {
+            for (x, k) in v.iter_mut().zip(tint) {
+                *x *= k;
+            }
+        }
+    };
+    times(&mut r.fresnel);
+    if let Some(p) = r.ggx.as_mut() {
+        times(&mut p.fresnel);
+    }
+    if let Some(p) = r.beckmann.as_mut() {
+        times(&mut p.fresnel);
     }
 }
 
@@ -367,13 +414,14 @@ pub struct MaterialKey {
     pub measurement: Option<usize>,
     /// The model shown.
     pub shown: Shown,
-    /// αx, αy, rotation of the tabulated stretch.
+    /// αx, αy, rotation of the tabulated stretch (of the layer edited: the base under a coat
+    /// shown, else the single layer).
     pub stretch: [f64; 3],
-    /// ρd of the tabulated model.
+    /// ρd of the tabulated model (of the layer edited).
     pub tabulated_diffuse: [f64; 3],
-    /// αx, αy, rotation and ρd of GGX.
+    /// αx, αy, rotation and ρd of GGX (of the layer edited).
     pub ggx: Option<[f64; 6]>,
-    /// αx, αy, rotation and ρd of Beckmann.
+    /// αx, αy, rotation and ρd of Beckmann (of the layer edited).
     pub beckmann: Option<[f64; 6]>,
     /// The Fresnel tint.
     pub tint: [f64; 3],
@@ -404,17 +452,54 @@ mod tests {
         FittedMaterial::from_record(record).unwrap()
     }
 
-    /// Unedited, the coated model is shown and saved; the first edit of the single layer
-    /// drops the coat from both.
+    /// The GGX α of a fitted material (the shown model).
+    fn ggx_alpha(fit: &FittedMaterial) -> f64 {
+        fit.record.ggx.as_ref().unwrap().alpha_x
+    }
+
+    /// With the coat shown, α, ρd and tint edits go to the base under it: the coated model
+    /// rendered and saved has the edited base and the single layer is untouched. With the coat
+    /// off they go to the single layer, and the base keeps its own edits for when it is back.
     #[test]
-    fn an_edit_shows_and_saves_the_edited_single_layer() {
+    fn edits_go_to_the_layer_shown() {
         let mut m = EditedMaterial::new(coated_fit(), "coated.json".into());
-        assert!(!m.is_edited() && m.edited_record().coat.is_some());
-        assert!(m.fitted().unwrap().coated.is_some());
+        assert!(m.coat_shown() && !m.is_edited());
+        let a0 = ggx_alpha(&m.base);
         let (ax, ay, rot) = m.alpha().unwrap();
+        let before = m.key();
         m.set_alpha(ax * 1.5, ay * 1.5, rot);
-        assert!(m.is_edited() && m.edited_record().coat.is_none());
-        assert!(m.fitted().unwrap().coated.is_none());
+        m.set_diffuse([0.25, 0.5, 0.125]);
+        m.tint = [1.0, 0.5, 1.0];
+        assert!(m.is_edited() && m.key() != before);
+        let fit = m.fitted().unwrap();
+        let coated = fit.coated.as_ref().expect("the coat stays");
+        assert_eq!(ggx_alpha(&coated.base), 1.5 * a0);
+        assert_eq!(
+            coated.base.record.ggx.as_ref().unwrap().diffuse,
+            [0.25, 0.5, 0.125]
+        );
+        assert_eq!(ggx_alpha(&fit), a0, "the single layer is untouched");
+        let (f0, f1) = (
+            &m.base.record.fresnel.rgb[10],
+            &coated.base.record.fresnel.rgb[10],
+        );
+        assert_eq!((f1[0], f1[1]), (f0[0], 0.5 * f0[1]), "the base's F tinted");
+        assert_eq!(
+            fit.record.fresnel.rgb[10], *f0,
+            "the single layer's F untinted"
+        );
+
+        m.coat = None;
+        assert!(!m.coat_shown() && m.alpha().unwrap().0 == ax);
+        m.set_alpha(ax * 2.0, ay * 2.0, rot);
+        let fit = m.fitted().unwrap();
+        assert!(fit.coated.is_none() && ggx_alpha(&fit) == 2.0 * a0);
+        m.coat = m.base.record.coat.as_ref().map(|c| c.coat);
+        assert_eq!(m.alpha().unwrap().0, 1.5 * ax, "the base's edit is kept");
+        assert_eq!(
+            m.fitted_diffuse(),
+            m.base.record.ggx.as_ref().map(|p| p.diffuse)
+        );
     }
 
     /// The coat's own edits reach the rendered model; switched off, the single layer shows.

@@ -116,7 +116,11 @@ fn alpha_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
         } else {
             "α of the model"
         };
-        ui.label(what);
+        if m.coat_shown() {
+            ui.label(format!("{what} (the base under the coat; ρd and tint too)"));
+        } else {
+            ui.label(what);
+        }
         let old = (ax, ay);
         ui.add(
             egui::Slider::new(&mut ax, 0.01..=2.0)
@@ -210,14 +214,10 @@ fn glint_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
     );
 }
 
-/// The fit's clear coat: on or off, its weight, α and η. Shown until the single layer is
-/// edited (the edits are the single layer's; `EditedMaterial::edited_record`).
+/// The fit's clear coat: on or off, its weight, α and η. While it is on, the α, ρd and tint
+/// edits above are the base's under it; off, the single layer's.
 fn coat_sliders(m: &mut EditedMaterial, ui: &mut egui::Ui) {
     ui.label("Clear coat (the fit's):");
-    if m.is_edited() {
-        ui.label("not shown: the single layer is edited");
-        return;
-    }
     let fitted = m.base.record.coat.as_ref().map(|c| c.coat);
     let mut on = m.coat.is_some();
     ui.horizontal(|ui| {
