@@ -25,6 +25,20 @@ fn facet(cwd: &Path, args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// Runs `facet fit ARGS --backend cpu --out .` in `dir` and returns the one fit JSON written.
+fn fit_one(dir: &Path, args: &[&str]) -> PathBuf {
+    let mut all = vec!["fit"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--backend", "cpu", "--out", "."]);
+    let (ok, stdout, stderr) = facet(dir, &all);
+    assert!(ok, "{stdout}\n{stderr}");
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .unwrap()
+}
+
 /// The two fits, made once for every test of this file: (gold JSON, plastic JSON).
 fn fits() -> &'static (PathBuf, PathBuf) {
     static FITS: OnceLock<(PathBuf, PathBuf)> = OnceLock::new();
@@ -420,26 +434,7 @@ fn bad_input_is_an_error_naming_the_file() {
 #[test]
 fn single_lobe_fit_exports_with_unknown_error() {
     let dir = common::scratch("export_single_lobe");
-    let (ok, stdout, stderr) = facet(
-        &dir,
-        &[
-            "fit",
-            GOLD,
-            "--no-diffuse",
-            "--model",
-            "ggx",
-            "--backend",
-            "cpu",
-            "--out",
-            ".",
-        ],
-    );
-    assert!(ok, "{stdout}\n{stderr}");
-    let fit = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.extension().is_some_and(|e| e == "json"))
-        .unwrap();
+    let fit = fit_one(&dir, &[GOLD, "--no-diffuse", "--model", "ggx"]);
     assert!(json(&fit).get("fresnel_fits").is_none());
     let (pbrt, stdout) = export(&fit, "pbrt", &[]);
     assert!(stdout.contains("error unknown"), "{stdout}");
@@ -468,10 +463,9 @@ fn single_lobe_fit_exports_with_unknown_error() {
 #[test]
 fn anisotropic_fit_exports_both_alphas() {
     let dir = common::scratch("export_aniso");
-    let (ok, stdout, stderr) = facet(
+    let fit = fit_one(
         &dir,
         &[
-            "fit",
             "analytic:ggx?alpha_x=0.3&alpha_y=0.1&rotation=30&conductor=gold",
             "--aniso",
             "--resolution",
@@ -480,18 +474,8 @@ fn anisotropic_fit_exports_both_alphas() {
             "16",
             "--model",
             "ggx",
-            "--backend",
-            "cpu",
-            "--out",
-            ".",
         ],
     );
-    assert!(ok, "{stdout}\n{stderr}");
-    let fit = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.extension().is_some_and(|e| e == "json"))
-        .unwrap();
     let rec = json(&fit);
     let ggx = &rec["ggx"];
     let (ax, ay, rot) = (
@@ -543,28 +527,8 @@ fn anisotropic_fit_exports_both_alphas() {
 #[test]
 fn coated_fit_exports_a_table_for_mitsuba() {
     let dir = common::scratch("export_coat_mitsuba");
-    let (ok, stdout, stderr) = facet(
-        &dir,
-        &[
-            "fit",
-            GOLD,
-            "--model",
-            "ggx",
-            "--coat",
-            "off",
-            "--backend",
-            "cpu",
-            "--out",
-            ".",
-        ],
-    );
-    assert!(ok, "{stdout}\n{stderr}");
-    let fit = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.extension().is_some_and(|e| e == "json"))
-        .unwrap();
-    let mut rec = json(&fit);
+    let fit = &fits().0;
+    let mut rec = json(fit);
     let base = rec.clone();
     rec["coat"] = serde_json::json!({
         "eta": 1.5, "alpha": 0.05, "weight": 1.0,

@@ -853,12 +853,9 @@ mod tests {
         )
     }
 
-    /// A fit that kept a coat exports the coat over its base's GGX fit: pbrt-v4's
-    /// coatedconductor with the coat as the interface and the base as the conductor, glTF's
-    /// clearcoat (factor w, roughness √α); the coated model's recorded error; Mitsuba, or
-    /// `coat: false`, the single layer, saying so.
-    #[test]
-    fn a_coat_is_exported_over_its_base() {
+    /// A GGX gold fit of α 0.3 that kept a coat (η 1.5, α 0.04, weight 0.8; recorded errors 0.01,
+    /// GGX 0.012) over a base of α 0.2.
+    fn coated_gold() -> FittedMaterial {
         use crate::model::coat::Coat;
         use crate::model::material::CoatRecord;
         let gold = |a| Some(param(a, a, 0.0, &Fresnel::GOLD, [0.0; 3], true));
@@ -870,7 +867,16 @@ mod tests {
             beckmann_error: None,
             base: Box::new(record(gold(0.2), None)),
         });
-        let m = FittedMaterial::from_record(r).unwrap();
+        FittedMaterial::from_record(r).unwrap()
+    }
+
+    /// A fit that kept a coat exports the coat over its base's GGX fit: pbrt-v4's
+    /// coatedconductor with the coat as the interface and the base as the conductor, glTF's
+    /// clearcoat (factor w, roughness √α); the coated model's recorded error; Mitsuba, or
+    /// `coat: false`, the single layer, saying so.
+    #[test]
+    fn a_coat_is_exported_over_its_base() {
+        let m = coated_gold();
         let pbrt = run(&m, Target::Pbrt, ModelRequest::Ggx).unwrap();
         for line in [
             r#""string type" [ "coatedconductor" ]"#,
@@ -937,19 +943,8 @@ mod tests {
     #[test]
     fn mitsuba_gets_the_coat_tabulated() {
         use crate::metric::grid::{GridSamples, error_metric};
-        use crate::model::coat::Coat;
-        use crate::model::material::CoatRecord;
         use crate::sources::rgl::RglBsdf;
-        let gold = |a| Some(param(a, a, 0.0, &Fresnel::GOLD, [0.0; 3], true));
-        let mut r = record(gold(0.3), None);
-        r.coat = Some(CoatRecord {
-            coat: Coat::new(1.5, 0.04, 0.8),
-            error: 0.01,
-            ggx_error: Some(0.012),
-            beckmann_error: None,
-            base: Box::new(record(gold(0.2), None)),
-        });
-        let m = FittedMaterial::from_record(r).unwrap();
+        let m = coated_gold();
         let x = run(&m, Target::Mitsuba, ModelRequest::Ggx).unwrap();
         assert!(
             x.text
