@@ -6,8 +6,10 @@
 // [n, E_c at cos θ = (k + ½)/n for k < n].
 // Sampling: the coat's lobe (its normals, as lobe_sample_h) with probability
 //   p = w E_c(θo) / (w E_c(θo) + T(θo) max(base_albedo(b), 0.02)),
-// else the base's sampling from ωo' and the result refracted out (a direction past the critical
-// angle is refused: z < 0); pdf = p pdf_coat + (1 − p) pdf_base(ωi') cos θi / (η² cos θi').
+// else the base's sampling from ωo', folded into the cone that leaves the coat (coat_fold: a
+// direction past the critical angle would be lost) and refracted out;
+// pdf = p pdf_coat + (1 − p) q(ωi') cos θi / (η² cos θi'), with q the folded base density,
+// q(ω') = pdf_base(ω') + pdf_base(unfold(ω')) cos θ' / (k cos θ_unfolded).
 // The includer's Bsdf has a field `coat: Coat` (coat_of), and the includer defines
 //   base_eval2(b, wi_light, wi_bsdf, wo), base_pdf(b, wi, wo), base_sample_wi(b, wo, u),
 //   base_albedo(b) (an estimate of the base's albedo, for p),
@@ -45,6 +47,32 @@ fn coat_out(c: Coat, w: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0, 0.0, -1.0);
     }
     return vec3<f32>(s, sqrt(c2));
+}
+
+// The fold of a direction past the critical angle into the cone (twin: Coat::fold_in): on the
+// projected disc sin θ = r > s = 1/η goes to r'² = k (r² − s²), k = s² / (1 − s²), azimuth kept.
+fn coat_fold(c: Coat, w: vec3<f32>) -> vec3<f32> {
+    let s2 = 1.0 / (c.eta * c.eta);
+    let r2 = dot(w.xy, w.xy);
+    if (w.z <= 0.0 || r2 <= s2) {
+        return w;
+    }
+    let r2_in = s2 / (1.0 - s2) * (r2 - s2);
+    return vec3<f32>(w.xy * sqrt(r2_in / r2), sqrt(max(1.0 - r2_in, 0.0)));
+}
+
+// The folded base density q(ω') at ω' inside the cone (see the header; twin: Coat::unfold and
+// Coat::fold_density): r² = s² + r'² / k unfolds it.
+fn coat_folded_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
+    let c = b.coat;
+    let s2 = 1.0 / (c.eta * c.eta);
+    let k = s2 / (1.0 - s2);
+    let r2_in = dot(wi.xy, wi.xy);
+    let r2 = min(s2 + r2_in / k, 1.0);
+    let dir = select(vec2<f32>(1.0, 0.0), wi.xy * inverseSqrt(r2_in), r2_in > 0.0);
+    let pre = vec3<f32>(dir * sqrt(r2), sqrt(max(1.0 - r2, 0.0)));
+    let folded = base_pdf(b, pre, wo) * wi.z / (k * max(pre.z, 1e-7));
+    return base_pdf(b, wi, wo) + folded;
 }
 
 // E_c(θ), linear in cos θ between the block's nodes.
@@ -119,7 +147,7 @@ fn bsdf_pdf(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> f32 {
     let coat = lobe_pdf_h(c.ndf, wo, h) / (4.0 * abs(dot(wo, h)));
     let wi_in = coat_in(c, wi);
     // dωi' / dωi = cos θi / (η² cos θi')
-    let base = base_pdf(b, wi_in, coat_in(c, wo)) * wi.z / (c.eta * c.eta * wi_in.z);
+    let base = coat_folded_pdf(b, wi_in, coat_in(c, wo)) * wi.z / (c.eta * c.eta * wi_in.z);
     return p * coat + (1.0 - p) * base;
 }
 
@@ -134,5 +162,5 @@ fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
         return 2.0 * dot(wo, h) * h - wo;
     }
     let wi_in = base_sample_wi(b, coat_in(c, wo), vec3<f32>(u.xy, (u.z - p) / (1.0 - p)));
-    return coat_out(c, wi_in);
+    return coat_out(c, coat_fold(c, wi_in));
 }
