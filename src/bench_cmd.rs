@@ -71,7 +71,7 @@ pub enum Section {
     Lights,
     /// A measured material (MERL table, RGL file) against its tabulated fit at equal spp.
     Measured,
-    /// A fit with and without a clear coat (smooth and glints) at equal spp.
+    /// A fit with and without a clear coat (smooth, glints, a diffuse plastic) at equal spp.
     Coat,
 }
 
