@@ -196,8 +196,8 @@ impl EditedMaterial {
         }
     }
 
-    /// (αx, αy, rotation) of the shown model ([`Self::layer`]'s): the tabulated stretch or the
-    /// analytic α.
+    /// (αx, αy, rotation) of the shown model, in the layer edited ([`Self::coat_shown`]): the
+    /// tabulated stretch or the analytic α.
     pub fn alpha(&self) -> Option<(f64, f64, f64)> {
         let r = self.layer();
         match self.lobe() {
@@ -214,7 +214,7 @@ impl EditedMaterial {
         }
     }
 
-    /// Sets (αx, αy, rotation) of the shown model ([`Self::layer`]'s); α clamped to [1e-3, 4].
+    /// Sets (αx, αy, rotation) of the shown model (the edited layer's); α clamped to [1e-3, 4].
     pub fn set_alpha(&mut self, ax: f64, ay: f64, rotation: f64) {
         let (ax, ay) = (ax.clamp(1e-3, 4.0), ay.clamp(1e-3, 4.0));
         let lobe = self.lobe();
@@ -241,7 +241,7 @@ impl EditedMaterial {
         }
     }
 
-    /// The diffuse albedo ρd of the shown model ([`Self::layer`]'s; `None` for the measured
+    /// The diffuse albedo ρd of the shown model (the edited layer's; `None` for the measured
     /// data).
     pub fn diffuse(&self) -> Option<[f64; 3]> {
         let r = self.layer();
