@@ -14,8 +14,8 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct ConvertArgs {
-    /// The material: a MERL .binary, an RGL .bsdf, a fit .json (its tabulated model),
-    /// `nbrdf:NAME` or `analytic:SPEC`.
+    /// The material: a MERL .binary, an RGL .bsdf, a fit .json (its tabulated model, under its
+    /// coat when it kept one), `nbrdf:NAME` or `analytic:SPEC`.
     pub input: String,
     /// Where to write it, by extension: `.binary` (MERL, sampled at the bins), `.bsdf` (RGL,
     /// RGB, isotropic materials), `.json` (a fit of the input, as `facet fit` writes).

@@ -89,8 +89,8 @@ fn an_uncoated_ggx_gets_no_coat() {
     assert_eq!(m.record.ggx, without.record.ggx);
 }
 
-/// A coat survives the JSON; a file without one (older fits) loads with none; a bad coat is
-/// refused with the field named.
+/// A coat survives the JSON, and the loaded fit as a source is the coated model; a file
+/// without one (older fits) loads with none; a bad coat is refused with the field named.
 #[test]
 fn the_coat_is_recorded() {
     let m = fit_of(&coated(ggx(0.3, Fresnel::GOLD, [0.0; 3])));
@@ -108,6 +108,11 @@ fn the_coat_is_recorded() {
         a.model(model).unwrap().eval(wi, wo),
         b.model(model).unwrap().eval(wi, wo)
     );
+    // As a source (`facet convert fit.json …`, `facet fit fit.json`) the fit is its coated
+    // tabulated model, not the single layer.
+    let coated_value = b.model(model).unwrap().eval(wi, wo);
+    assert_eq!(Brdf::eval(&back, wi, wo), coated_value);
+    assert_ne!(back.tabulated.eval(wi, wo), coated_value);
 
     let mut json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();

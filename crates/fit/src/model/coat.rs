@@ -175,6 +175,18 @@ impl CoatLayer {
         self.albedo[k] * (1.0 - t) + self.albedo[k + 1] * t
     }
 
+    /// The coated f of `base` under this layer at (ωi, ωo): the model's formula, with the base
+    /// borrowed ([`Coated`] owns its base).
+    pub fn over(&self, base: &dyn Brdf, wi: DVec3, wo: DVec3) -> Option<Rgb> {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return None;
+        }
+        let coat = &self.coat;
+        let b = base.eval(coat.refract_in(wi), coat.refract_in(wo))?;
+        let (r, t) = (self.reflection(wi, wo), self.base_factor(wi, wo));
+        Some(b.map(|b| r + t * b))
+    }
+
     /// T(θ) = 1 − w E_c(θ): what enters (or leaves) the coat.
     pub fn transmission(&self, cos_theta: f64) -> f64 {
         1.0 - self.coat.weight * self.lobe_albedo(cos_theta)
@@ -201,16 +213,7 @@ impl<B: Brdf> Brdf for Coated<B> {
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        if wi.z <= 0.0 || wo.z <= 0.0 {
-            return None;
-        }
-        let coat = &self.layer.coat;
-        let base = self.base.eval(coat.refract_in(wi), coat.refract_in(wo))?;
-        let (r, t) = (
-            self.layer.reflection(wi, wo),
-            self.layer.base_factor(wi, wo),
-        );
-        Some(base.map(|b| r + t * b))
+        self.layer.over(&self.base, wi, wo)
     }
 }
 

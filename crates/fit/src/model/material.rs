@@ -426,14 +426,19 @@ fn check_albedo(field: &str, albedo: Rgb) -> Result<(), String> {
     ))
 }
 
-/// A fitted material is a BRDF source: its tabulated model.
+/// A fit as a source (`facet convert fit.json …`, `facet fit fit.json`, a measured material's
+/// `source`): its tabulated model, under its coat when it kept one, the fit's closest model of
+/// the data.
 impl Brdf for FittedMaterial {
     fn name(&self) -> &str {
         &self.record.name
     }
 
     fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        self.tabulated.eval(wi, wo)
+        match &self.coated {
+            Some(c) => c.layer.over(&c.base.tabulated, wi, wo),
+            None => self.tabulated.eval(wi, wo),
+        }
     }
 
     fn is_isotropic(&self) -> bool {

@@ -22,7 +22,7 @@ pub enum InputSpec {
     Nbrdf(String),
     /// `analytic:SPEC`: an analytic model ([`parse_analytic`]).
     Analytic(String),
-    /// A fit `.json`: its tabulated model.
+    /// A fit `.json`: its tabulated model (under its coat when it kept one).
     Fit(PathBuf),
     /// An RGL `.bsdf`.
     Rgl(PathBuf),
