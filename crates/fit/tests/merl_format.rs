@@ -185,3 +185,21 @@ fn filled_table_keeps_valid_samples_and_fills_missing_ones_along_theta_d() {
         (0..3).for_each(|c| assert!((got[c] - held[c]).abs() <= 1e-12 * held[c].max(1e-9)));
     }
 }
+
+/// `bin_directions` (its sines and cosines computed once) is `from_half_diff(bin_angles(…))`
+/// bit for bit on every bin of the grid.
+#[test]
+fn bin_directions_are_the_bins_angles_exactly() {
+    use facet_fit::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES, bin_directions};
+    for i in 0..THETA_H_RES {
+        for j in 0..THETA_D_RES {
+            for k in 0..PHI_D_RES {
+                assert_eq!(
+                    bin_directions(i, j, k),
+                    from_half_diff(bin_angles(i, j, k)),
+                    "bin ({i}, {j}, {k})"
+                );
+            }
+        }
+    }
+}

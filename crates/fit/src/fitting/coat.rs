@@ -18,10 +18,9 @@ use crate::fitting::{CoatSearch, FitConfig, Models};
 use crate::metric::grid::{GridSamples, error_metric};
 use crate::model::brdf::Brdf;
 use crate::model::coat::{Coat, CoatLayer, Coated};
-use crate::model::geometry::from_half_diff;
 use crate::model::material::{CoatRecord, CoatedModels, FittedMaterial};
 use crate::model::merl_grid::MerlTable;
-use crate::model::merl_grid::bin_angles;
+use crate::model::merl_grid::bin_directions;
 use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::rgb::Rgb;
 use crate::numerics::optim::brent;
@@ -100,7 +99,7 @@ impl SeenFromInside<'_> {
             return Some(self.data.lookup_interpolated(i, o)?.map(|v| v - r));
         }
         self.data.lookup_interpolated_less(i, o, |a, b, c| {
-            let (bi, bo) = from_half_diff(bin_angles(a, b, c));
+            let (bi, bo) = bin_directions(a, b, c);
             self.layer.reflection(bi, bo)
         })
     }

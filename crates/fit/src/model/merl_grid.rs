@@ -7,7 +7,7 @@
 //! Sample (i, j, k) sits at the bin's lower edge: θh = (i/90)² π/2, θd = j/90 · π/2, φd = k/180 · π.
 
 use crate::io::mapped_file::MappedFile;
-use crate::model::geometry::{HalfDiff, from_half_diff, to_half_diff};
+use crate::model::geometry::{HalfDiff, to_half_diff};
 use crate::model::rgb::Rgb;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -50,6 +50,27 @@ pub fn bin_angles(i: usize, j: usize, k: usize) -> HalfDiff {
         theta_d: j as f64 / THETA_D_RES as f64 * FRAC_PI_2,
         phi_d: k as f64 / PHI_D_RES as f64 * PI,
     }
+}
+
+/// `from_half_diff(bin_angles(i, j, k))`, the same values bit for bit, from sines and cosines
+/// computed once per axis: the coat search evaluates its lobe at millions of bin corners.
+pub fn bin_directions(i: usize, j: usize, k: usize) -> (DVec3, DVec3) {
+    static TRIG: std::sync::OnceLock<[Vec<(f64, f64)>; 3]> = std::sync::OnceLock::new();
+    let [h, d, p] = TRIG.get_or_init(|| {
+        let axis =
+            |n: usize, angle: &dyn Fn(usize) -> f64| (0..n).map(|x| angle(x).sin_cos()).collect();
+        [
+            axis(THETA_H_RES, &|i| bin_angles(i, 0, 0).theta_h),
+            axis(THETA_D_RES, &|j| bin_angles(0, j, 0).theta_d),
+            axis(PHI_D_RES, &|k| bin_angles(0, 0, k).phi_d),
+        ]
+    });
+    let ((sh, ch), (sd, cd), (sp, cp)) = (h[i], d[j], p[k]);
+    // d = spherical(θd, φd), rotated by θh about y (φh = 0); ωo mirrors ωi about h.
+    let v = DVec3::new(sd * cp, sd * sp, cd);
+    let wi = DVec3::new(ch * v.x + sh * v.z, v.y, -sh * v.x + ch * v.z);
+    let half = DVec3::new(sh, 0.0, ch);
+    (wi, 2.0 * wi.dot(half) * half - wi)
 }
 
 /// Continuous bin coordinates (sample centres at integers) of a Rusinkiewicz pair.
@@ -147,7 +168,7 @@ impl MerlTable {
                 if !keep(i, j, k) {
                     return None;
                 }
-                let (wi, wo) = from_half_diff(bin_angles(i, j, k));
+                let (wi, wo) = bin_directions(i, j, k);
                 if wi.z <= 0.0 || wo.z <= 0.0 {
                     return None;
                 }
