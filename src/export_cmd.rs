@@ -136,11 +136,18 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode> {
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         crate::output::folder(dir, "--out")?;
     }
-    // The table first: the file that names it is written only once it is there.
+    // The table first: the file that names it is written only once it is there. A table made
+    // here is taken back if the file that names it cannot be written.
+    let made = table.as_ref().filter(|(path, _)| !path.exists());
     if let Some((path, t)) = &table {
         write(path, &t.bytes)?;
     }
-    write(&out, exported.text.as_bytes())?;
+    if let Err(e) = write(&out, exported.text.as_bytes()) {
+        if let Some((path, _)) = made {
+            let _ = std::fs::remove_file(path);
+        }
+        return Err(e);
+    }
     println!("{}", exported.report.summary());
     match &table {
         Some((path, _)) => println!("wrote {} and {}", out.display(), path.display()),
