@@ -543,7 +543,13 @@ fn coated_fit_exports_a_table_for_mitsuba() {
         facet_fit::io::input::safe_file_stem(&name)
     ));
 
-    let (ok, stdout, stderr) = facet(&dir, &["export", "coated.json", "--to", "mitsuba"]);
+    // `facet export coated.json --to mitsuba EXTRA…` in the test's folder.
+    let mitsuba = |extra: &[&str]| {
+        let mut args = vec!["export", "coated.json", "--to", "mitsuba"];
+        args.extend_from_slice(extra);
+        facet(&dir, &args)
+    };
+    let (ok, stdout, stderr) = mitsuba(&[]);
     assert!(ok, "{stdout}\n{stderr}");
     let xml = std::fs::read_to_string(dir.join("coated.xml")).unwrap();
     assert_eq!(well_formed(&xml), Ok("bsdf".into()));
@@ -558,63 +564,24 @@ fn coated_fit_exports_a_table_for_mitsuba() {
 
     // The table exists: refused, and neither file changes.
     std::fs::write(&table, b"mine").unwrap();
-    let (ok, _, stderr) = facet(
-        &dir,
-        &[
-            "export",
-            "coated.json",
-            "--to",
-            "mitsuba",
-            "-o",
-            "other.xml",
-        ],
-    );
+    let (ok, _, stderr) = mitsuba(&["-o", "other.xml"]);
     assert!(
         !ok && stderr.contains("exists") && stderr.contains("--force"),
         "{stderr}"
     );
     assert_eq!(std::fs::read(&table).unwrap(), b"mine");
     assert!(!dir.join("other.xml").exists());
-    let (ok, _, stderr) = facet(
-        &dir,
-        &[
-            "export",
-            "coated.json",
-            "--to",
-            "mitsuba",
-            "-o",
-            "other.xml",
-            "--force",
-        ],
-    );
+    let (ok, _, stderr) = mitsuba(&["-o", "other.xml", "--force"]);
     assert!(ok, "{stderr}");
     assert!(facet_fit::sources::rgl::RglBsdf::open(&table).is_ok());
-    let (ok, _, stderr) = facet(
-        &dir,
-        &[
-            "export",
-            "coated.json",
-            "--to",
-            "mitsuba",
-            "-o",
-            table.file_name().unwrap().to_str().unwrap(),
-            "--force",
-        ],
-    );
+    let (ok, _, stderr) = mitsuba(&[
+        "-o",
+        table.file_name().unwrap().to_str().unwrap(),
+        "--force",
+    ]);
     assert!(!ok && stderr.contains("choose another --out"), "{stderr}");
 
-    let (ok, _, stderr) = facet(
-        &dir,
-        &[
-            "export",
-            "coated.json",
-            "--to",
-            "mitsuba",
-            "-o",
-            "single.xml",
-            "--no-coat",
-        ],
-    );
+    let (ok, _, stderr) = mitsuba(&["-o", "single.xml", "--no-coat"]);
     assert!(ok, "{stderr}");
     let single = std::fs::read_to_string(dir.join("single.xml")).unwrap();
     assert!(
