@@ -7,10 +7,12 @@
 //! plus its pdf at the unfolded direction times [`Coat::fold_density`], times the refraction's
 //! Jacobian cos θi / (η² cos θi'). No sample is lost past the critical angle.
 
+mod common;
+
 use facet_fit::model::coat::{Coat, CoatLayer};
 use facet_fit::model::microfacet::{AnalyticNdf, NdfKind};
 use facet_fit::numerics::chi2;
-use facet_gpu::{buffer, dispatch, gpu_for_tests, shader};
+use facet_gpu::{buffer, gpu_for_tests, shader};
 use facet_render::resources::materials::coat_block;
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -77,10 +79,8 @@ fn coat_sampling_matches_its_pdf() {
                 })
                 .collect();
             let ib = buffer::storage(&gpu.device, "inputs", &inputs);
-            let ob = buffer::storage_zeroed(&gpu.device, "samples", u64::from(n) * 16);
-            dispatch::run(
-                &gpu.device,
-                &gpu.queue,
+            let out = common::probe(
+                &gpu,
                 &pipeline,
                 "coat sample",
                 &[
@@ -88,13 +88,10 @@ fn coat_sampling_matches_its_pdf() {
                     mb.as_entire_binding(),
                     bb.as_entire_binding(),
                     ib.as_entire_binding(),
-                    ob.as_entire_binding(),
                 ],
                 n,
                 wg,
             );
-            let out: Vec<[f32; 4]> =
-                buffer::read(&gpu.device, &gpu.queue, &ob, n as usize).unwrap();
             // The base's sampling loses what its specular lobe reflects below the surface (and
             // the coat's, below the horizon): the density of the rest integrates to what is
             // left, so the expected counts take every sample. None is lost past the critical

@@ -3,13 +3,15 @@
 //! extracted table (plain, and stretched and rotated) and an anisotropic table, from normal to
 //! grazing views.
 
+mod common;
+
 use facet_fit::model::geometry::spherical;
 use facet_fit::model::material::FittedMaterial;
 use facet_fit::model::microfacet::Ndf;
 use facet_fit::model::microfacet::{AnalyticNdf, NdfKind};
 use facet_fit::model::tabulated::{NdfTables, Stretch, TabulatedNdf, phi_node, u_node_theta};
 use facet_fit::numerics::chi2;
-use facet_gpu::{buffer, dispatch, shader};
+use facet_gpu::{buffer, shader};
 use facet_render::resources::materials::tabulated_block;
 use glam::DVec3;
 use std::path::Path;
@@ -93,23 +95,18 @@ fn gpu_visible_sampling_of_tabulated_ndfs_follows_its_pdf() {
                 })
                 .collect();
             let ib = buffer::storage(&gpu.device, "inputs", &inputs);
-            let ob = buffer::storage_zeroed(&gpu.device, "samples", u64::from(n) * 16);
-            dispatch::run(
-                &gpu.device,
-                &gpu.queue,
+            let out = common::probe(
+                &gpu,
                 &pipeline,
                 "tabulated sample",
                 &[
                     tb.as_entire_binding(),
                     ub.as_entire_binding(),
                     ib.as_entire_binding(),
-                    ob.as_entire_binding(),
                 ],
                 n,
                 wg,
             );
-            let out: Vec<[f32; 4]> =
-                buffer::read(&gpu.device, &gpu.queue, &ob, n as usize).unwrap();
             let wo = wo.as_dvec3();
             let samples: Vec<DVec3> = out
                 .iter()

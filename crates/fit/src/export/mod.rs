@@ -473,16 +473,12 @@ fn tabulate_coat(
         env!("CARGO_PKG_VERSION"),
         report.source_fit
     );
-    let (bytes, written) = rgl::rgl_bytes(&model, rgl::BsdfResolution::standard(), &description)
-        .map_err(|e| match e {
-            rgl::RglBytesError::Fit(e) => format!("tabulating the coated model: {e}"),
-            rgl::RglBytesError::Tensor(p) => format!("tabulating the coated model: {p}"),
-        })?;
+    let res = rgl::BsdfResolution::standard();
+    let (bytes, written) = rgl::rgl_bytes(&model, res, &description)
+        .map_err(|e| format!("tabulating the coated model: {e}"))?;
     report.notes.push(format!(
         "Mitsuba 3 has no coated conductor: the coated model is tabulated for its measured plugin ({} θi slices of {}² samples; anything finer than that grid, as a coat's sharp peak, is smoothed: the table's error against the model is {:.3e})",
-        rgl::BsdfResolution::standard().theta_i,
-        rgl::BsdfResolution::standard().sample,
-        written.error
+        res.theta_i, res.sample, written.error
     ));
     report.tabulated = Some(TableExport {
         file: name.clone(),

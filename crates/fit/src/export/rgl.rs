@@ -264,11 +264,13 @@ pub fn write_rgl(
 }
 
 /// Why [`rgl_bytes`] failed: the sample space's fit, or the tensor (a problem without a file).
-#[derive(Debug)]
+#[derive(Debug, thiserror::Error)]
 pub enum RglBytesError {
     /// The fit of a sample space failed.
+    #[error("{0}")]
     Fit(FitError),
     /// The tensor could not be built or read back.
+    #[error("{0}")]
     Tensor(String),
 }
 

@@ -233,3 +233,20 @@ pub fn assert_all_finite(s: &facet_render::scene::Scene) {
             .all(|&m| (m as usize) < s.materials.len())
     );
 }
+
+/// Runs a probe `pipeline` (of workgroup size `wg`) over `n` queries: its bindings are
+/// `bindings` and then an output of one vec4 a query, read back.
+pub fn probe(
+    gpu: &facet_gpu::Gpu,
+    pipeline: &wgpu::ComputePipeline,
+    label: &str,
+    bindings: &[wgpu::BindingResource],
+    n: u32,
+    wg: u32,
+) -> Vec<[f32; 4]> {
+    let out = facet_gpu::buffer::storage_zeroed(&gpu.device, "probe out", u64::from(n) * 16);
+    let mut all = bindings.to_vec();
+    all.push(out.as_entire_binding());
+    facet_gpu::dispatch::run(&gpu.device, &gpu.queue, pipeline, label, &all, n, wg);
+    facet_gpu::buffer::read(&gpu.device, &gpu.queue, &out, n as usize).unwrap()
+}
