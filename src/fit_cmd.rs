@@ -146,6 +146,17 @@ pub enum CoatArg {
     Off,
 }
 
+impl CoatArg {
+    /// The search `--coat` and `--no-coat` ask for.
+    pub fn search(self, no_coat: bool) -> CoatSearch {
+        match (no_coat, self) {
+            (true, _) | (_, CoatArg::Off) => CoatSearch::Off,
+            (_, CoatArg::Auto) => CoatSearch::Auto,
+            (_, CoatArg::Always) => CoatSearch::Always,
+        }
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum QuadratureArg {
     UniformTheta,
@@ -258,11 +269,7 @@ impl FitArgs {
         cfg.diffuse &= !self.no_diffuse;
         cfg.refine &= !self.no_refine && cfg.diffuse;
         if cfg.diffuse && !self.aniso {
-            cfg.coat = match (self.no_coat, self.coat) {
-                (true, _) | (_, CoatArg::Off) => CoatSearch::Off,
-                (_, CoatArg::Auto) => CoatSearch::Auto,
-                (_, CoatArg::Always) => CoatSearch::Always,
-            };
+            cfg.coat = self.coat.search(self.no_coat);
         }
         cfg.fresnel = match self.fresnel {
             FresnelArg::Table => FresnelChoice::Table,

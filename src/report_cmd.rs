@@ -15,9 +15,11 @@ mod sweep;
 
 use self::material::{IMG, MaterialReport, report_material};
 use self::scenes::{Lighting, SphereRenderer};
+use crate::fit_cmd::CoatArg;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use facet_fit::FitConfig;
+use facet_fit::fitting::CoatSearch;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
@@ -52,6 +54,15 @@ pub struct ReportArgs {
     /// Polar nodes N of the fits, 2 to 4096.
     #[arg(long, default_value_t = 90, value_parser = crate::args::resolution)]
     fit_resolution: usize,
+    /// When the fits search a clear coat, as `facet fit --coat`: `auto` where the single
+    /// layer's tabulated error is above 0.03 (4–8 s more for such a material on two cores),
+    /// `always`, or `off`. A fit that keeps a coat gets one more sphere, its coated model,
+    /// beside the single layer's three; a fit JSON that kept one shows it whatever this says.
+    #[arg(long, value_enum, default_value = "auto")]
+    coat: CoatArg,
+    /// The same as --coat off.
+    #[arg(long, conflicts_with = "coat")]
+    no_coat: bool,
     /// Fit the first K inputs again at N = 32, 64, 90 and 128 for the plot of run time against
     /// error (0: no sweep). Four more fits per input, about 6 s in all on two CPU cores, so the
     /// default sweeps only the first two inputs (the 10-minute budget of the 100 proxies).
@@ -117,9 +128,8 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode> {
     prepare_out(&args.out, args.force)?;
     let gpu = crate::render_cmd::open_gpu()?;
     let mut renderer = SphereRenderer::new(&gpu, args.resolution, args.spp, args.env.as_deref())?;
-    // The page compares the single layer's models (a coat is not searched).
     let mut cfg = FitConfig {
-        coat: facet_fit::fitting::CoatSearch::Off,
+        coat: args.coat.search(args.no_coat),
         ..FitConfig::isotropic()
     };
     cfg.extract.resolution = args.fit_resolution;
@@ -152,7 +162,12 @@ pub fn run(args: &ReportArgs) -> Result<ExitCode> {
     }
     // The sweep fits again only inputs that were reported.
     let reported: Vec<String> = reports.iter().map(|r| r.input.clone()).collect();
-    let sweep = run_sweep(&reported, args.sweep, &cfg, &mut library)?;
+    // The sweep times the single layer's fit against N: no coat is searched.
+    let single = FitConfig {
+        coat: CoatSearch::Off,
+        ..cfg
+    };
+    let sweep = run_sweep(&reported, args.sweep, &single, &mut library)?;
     write_page(args, &gpu, &reports, &sweep, started)?;
     print_means(&reports, started);
     Ok(if failed > 0 {
@@ -191,7 +206,7 @@ fn write_page(
 ) -> Result<()> {
     let out = &args.out;
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        for k in 0..3 {
+        for k in 0..scenes::N_MODELS {
             let images: Vec<_> = reports.iter().filter_map(|r| r.de[l][k].as_ref()).collect();
             if let Some(mean) = delta_e::DeltaE::mean_of(&images) {
                 false_colour::write_png(&mean, &out.join(html::mean_de_file(*lighting, k)))?;
@@ -207,6 +222,13 @@ fn write_page(
         side: args.resolution,
         env_spp: args.spp,
         resolution: args.fit_resolution,
+        coat: match args.coat.search(args.no_coat) {
+            CoatSearch::Auto => {
+                "a clear coat searched where the single layer's error is above 0.03"
+            }
+            CoatSearch::Always => "a clear coat searched for every material",
+            CoatSearch::Off => "no coat searched",
+        },
         env: args
             .env
             .as_ref()
@@ -231,7 +253,7 @@ fn print_means(reports: &[MaterialReport], started: Instant) {
             .map(|(m, v)| {
                 format!(
                     "{} {}",
-                    scenes::model_key(*m),
+                    m.key(),
                     v.map_or("–".into(), |v| format!("{v:.3}"))
                 )
             })

@@ -73,6 +73,151 @@ fn report_on_three_proxies_writes_every_image() {
     assert!(!ok && stderr.contains("not empty"), "{stderr}");
 }
 
+/// The mean ΔE of `model` under `lighting` (`point` or `env`) as the run prints it:
+/// `mean ΔE (point): tabulated 1.26, ggx 2.06, beckmann 5.99, coated 0.62`.
+fn printed_mean(stdout: &str, lighting: &str, model: &str) -> f64 {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with(&format!("mean ΔE ({lighting}):")))
+        .unwrap_or_else(|| panic!("no {lighting} means in {stdout}"));
+    line.split([':', ','])
+        .find_map(|part| part.trim().strip_prefix(&format!("{model} ")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {model} mean in `{line}`"))
+}
+
+/// A measurement made from a known coat (η 1.5, α 0.05, weight 1) over GGX α 0.3 gold, reported
+/// with `--coat always`: the fit keeps the coat, and the page shows its coated model (one more
+/// sphere per lighting, its ΔE images and error). The coated model is the measurement's own
+/// (the fit recovers it within 2 %: `crates/fit/tests/coat.rs`), so under the point light,
+/// where a pixel is f cos θ I / r² and nothing else differs, its ΔE is below half the single
+/// layer's, which cannot show the coat's sharp highlight over the rough base.
+#[test]
+fn report_of_a_coated_measurement_shows_its_coated_model() {
+    const TEST: &str = "report_of_a_coated_measurement_shows_its_coated_model";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    use facet_fit::model::coat::{Coat, CoatLayer, Coated};
+    use facet_fit::model::merl_grid::MerlTable;
+    use facet_fit::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
+    let dir = scratch("report_coated");
+    let truth = Coated {
+        layer: CoatLayer::new(Coat::new(1.5, 0.05, 1.0)).unwrap(),
+        base: MicrofacetBrdf {
+            name: "gold".into(),
+            ndf: Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Ggx, 0.3)),
+            fresnel: facet_fit::model::fresnel::Fresnel::GOLD,
+            diffuse: [0.0; 3],
+        },
+    };
+    MerlTable::sample(&truth)
+        .write(&dir.join("coated-gold.binary"))
+        .unwrap();
+    let (ok, stdout, stderr) = facet_in(
+        &dir,
+        &[
+            "report",
+            "coated-gold.binary",
+            "--coat",
+            "always",
+            "--out",
+            "page",
+            "--resolution",
+            "32",
+            "--spp",
+            "2",
+            "--sweep",
+            "0",
+        ],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    let html = std::fs::read_to_string(dir.join("page/index.html")).unwrap();
+    let sources = image_sources(&html);
+    // 5 renders and 4 ΔE images per lighting, 2 plots; the scale and 8 mean images.
+    assert_eq!(sources.len(), 2 * 9 + 2 + 1 + 8, "{sources:?}");
+    for src in &sources {
+        check_image(&dir.join("page").join(src));
+    }
+    for want in [
+        "point-coated.png",
+        "env-de-coated.png",
+        "<th>error coated</th>",
+    ] {
+        assert!(html.contains(want), "no {want} on the page");
+    }
+    let (coated, single) = (
+        printed_mean(&stdout, "point", "coated"),
+        printed_mean(&stdout, "point", "tabulated"),
+    );
+    eprintln!("mean ΔE (point) against the measurement: coated {coated:.3}, single {single:.3}");
+    assert!(coated < 0.5 * single, "ΔE coated {coated}, single {single}");
+}
+
+/// A fit JSON that kept a coat (attached here by hand: the fit's own record as the base under a
+/// coat of α 0.05, weight 1) stands for its coated model: that is the reference, and the single
+/// layer's tabulated model, rendered without the coat, differs from it visibly (a mean ΔE above
+/// 1 under the point light, where the coat adds a highlight 6 times narrower than the base's
+/// lobe and about as bright as its peak; rendered coated by mistake it would be 0).
+#[test]
+fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
+    const TEST: &str = "report_of_a_coated_fit_json_compares_with_its_coated_model";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_coated_json");
+    let (ok, _, stderr) = facet_in(
+        &dir,
+        &[
+            "fit",
+            "analytic:ggx?alpha=0.3&conductor=gold",
+            "--out",
+            "fits",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    let path = std::fs::read_dir(dir.join("fits"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .expect("a fit JSON");
+    let mut rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let base = rec.clone();
+    rec["coat"] = serde_json::json!({
+        "eta": 1.5, "alpha": 0.05, "weight": 1.0,
+        "error": 0.01, "ggx_error": null, "beckmann_error": null,
+        "base": base,
+    });
+    std::fs::write(dir.join("coated.json"), rec.to_string()).unwrap();
+    let (ok, stdout, stderr) = facet_in(
+        &dir,
+        &[
+            "report",
+            "coated.json",
+            "--out",
+            "page",
+            "--resolution",
+            "32",
+            "--spp",
+            "2",
+            "--sweep",
+            "0",
+        ],
+    );
+    assert!(ok, "{stdout}\n{stderr}");
+    let html = std::fs::read_to_string(dir.join("page/index.html")).unwrap();
+    assert!(html.contains("ΔE against the coated model"), "{html}");
+    // The coated model is the reference: it has no ΔE of its own.
+    assert!(!html.contains("de-coated.png"), "{html}");
+    let single = printed_mean(&stdout, "point", "tabulated");
+    eprintln!("mean ΔE (point) of the single layer against the coated model: {single:.3}");
+    assert!(
+        single > 1.0,
+        "ΔE of the single layer against the coated model: {single}"
+    );
+}
+
 /// A PNG decodes to a non-empty image; an SVG is an `<svg …>` document.
 fn check_image(path: &Path) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));

@@ -2,9 +2,9 @@
 //! the table), its images as PNG and SVG files in `img/` beside it.
 
 use super::false_colour::DE_MAX;
-use super::material::{MaterialReport, de_file, render_file, variants};
+use super::material::{MaterialReport, de_file, reference, render_file, variants};
 use super::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
-use super::scenes::{ENV_DEPTH, Lighting, POINT_SPP, Variant, model_key};
+use super::scenes::{ENV_DEPTH, Lighting, N_MODELS, POINT_SPP, Variant};
 use super::sweep::SweepPoint;
 use std::fmt::Write;
 
@@ -14,6 +14,8 @@ pub struct PageInfo {
     pub side: u32,
     pub env_spp: u32,
     pub resolution: usize,
+    /// When a coat was searched (`--coat`).
+    pub coat: &'static str,
     pub env: String,
     pub seconds: f64,
     pub version: &'static str,
@@ -24,8 +26,19 @@ pub fn mean_de_file(lighting: Lighting, model: usize) -> String {
     format!(
         "img/mean-{}-de-{}.png",
         lighting.key(),
-        model_key(Variant::MODELS[model])
+        Variant::MODELS[model].key()
     )
+}
+
+/// A model's short name in the table's headers.
+fn label(model: Variant) -> &'static str {
+    match model {
+        Variant::Model(facet_fit::model::material::ModelChoice::Tabulated) => "tab",
+        Variant::Model(facet_fit::model::material::ModelChoice::Ggx) => "GGX",
+        Variant::Model(facet_fit::model::material::ModelChoice::Beckmann) => "Beck",
+        Variant::Coated => "coated",
+        Variant::Measured => "measured",
+    }
 }
 
 const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;max-width:1400px}\
@@ -57,7 +70,7 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
 
 /// The mean over the set of each lighting's and model's mean ΔE (`None` where no material has
 /// one).
-pub fn set_means(materials: &[MaterialReport]) -> [[Option<f64>; 3]; 2] {
+pub fn set_means(materials: &[MaterialReport]) -> [[Option<f64>; N_MODELS]; 2] {
     std::array::from_fn(|l| {
         std::array::from_fn(|m| {
             let v: Vec<f64> = materials.iter().filter_map(|r| r.mean_de[l][m]).collect();
@@ -89,11 +102,12 @@ pub fn page(info: &PageInfo, materials: &[MaterialReport], sweep: &[SweepPoint])
 fn header(info: &PageInfo, n: usize) -> String {
     format!(
         "<h1>Facet report: {n} material(s)</h1>\n<p>Facet {}; adapter {}; {:.1} s in all. \
-         Fits: isotropic, N = {} polar nodes, a diffuse lobe with every model. Spheres {side}×{side} \
+         Fits: isotropic, N = {} polar nodes, a diffuse lobe with every model; {}. Spheres {side}×{side} \
          pixels: (a) one point light, no environment, depth 1, {POINT_SPP} spp (only the pixel \
          positions vary: each pixel is f cos θ I / r²); (b) the environment {}, depth {ENV_DEPTH}, \
          {} spp.</p>\n<p>ΔE: CIEDE2000 per pixel on the sphere (silhouette excluded) of each \
-         model against the measurement (or, for a fit JSON, against its tabulated model), on \
+         model against the measurement (or, for a fit JSON, against the model it stands for as \
+         a source: its coated tabulated model when it kept a coat, else its tabulated model), on \
          the colours the PNGs show: the tone map 1 − exp(−L) at exposure 0 read as linear \
          sRGB, to CIELAB (D65), by the <code>palette</code> crate. False colour: viridis from 0 \
          to {DE_MAX} (and above).</p>\n<img src=\"{SCALE_FILE}\" alt=\"ΔE colour scale\">\n",
@@ -101,6 +115,7 @@ fn header(info: &PageInfo, n: usize) -> String {
         escape(&info.adapter),
         info.seconds,
         info.resolution,
+        info.coat,
         escape(&info.env),
         info.env_spp,
         side = info.side,
@@ -109,30 +124,28 @@ fn header(info: &PageInfo, n: usize) -> String {
 
 fn summary(materials: &[MaterialReport]) -> String {
     let means = set_means(materials);
+    let with_coat = materials.iter().filter(|m| m.coated).count();
     let mut s = String::from("<section><h2>Database summary</h2>\n<p>Mean ΔE over the set: ");
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
         let _ = write!(s, "<b>{}</b>: ", lighting_name(*lighting));
         for (m, model) in Variant::MODELS.iter().enumerate() {
-            let _ = write!(s, "{} {}; ", model_key(*model), fmt_opt(means[l][m], 2));
+            let _ = write!(s, "{} {}; ", model.key(), fmt_opt(means[l][m], 2));
         }
     }
-    s += "</p>\n<table class=\"sortable\"><thead><tr><th>material</th>";
-    for h in [
-        "ΔE tab (point)",
-        "ΔE GGX (point)",
-        "ΔE Beck (point)",
-        "ΔE tab (env)",
-        "ΔE GGX (env)",
-        "ΔE Beck (env)",
-        "error tab",
-        "error GGX",
-        "error Beck",
-        "fit (s)",
-        "render (s)",
-    ] {
-        let _ = write!(s, "<th>{h}</th>");
+    let _ = write!(
+        s,
+        "the coated model's over the {with_coat} of {} material(s) whose fit kept a coat.</p>\n\
+         <table class=\"sortable\"><thead><tr><th>material</th>",
+        materials.len()
+    );
+    let lightings = Lighting::ALL.map(|l| format!(" ({})", l.key()));
+    for suffix in lightings.iter().map(String::as_str).chain([""]) {
+        let kind = if suffix.is_empty() { "error" } else { "ΔE" };
+        for model in Variant::MODELS {
+            let _ = write!(s, "<th>{kind} {}{suffix}</th>", label(model));
+        }
     }
-    s += "</tr></thead><tbody>\n";
+    s += "<th>fit (s)</th><th>render (s)</th></tr></thead><tbody>\n";
     for m in materials {
         let _ = write!(
             s,
@@ -161,7 +174,7 @@ fn summary(materials: &[MaterialReport]) -> String {
             if means[l][k].is_some() {
                 s += &figure(
                     &mean_de_file(*lighting, k),
-                    &format!("{} {}", model_key(*model), lighting.key()),
+                    &format!("{} {}", model.key(), lighting.key()),
                 );
             }
         }
@@ -177,13 +190,15 @@ fn lighting_name(l: Lighting) -> &'static str {
     }
 }
 
-/// The error metric of the tabulated, GGX and Beckmann models.
-fn errors(m: &MaterialReport) -> [Option<f64>; 3] {
+/// The error metric of each model ([`Variant::MODELS`] order): the tabulated, GGX and
+/// Beckmann single layers and the coated tabulated model.
+fn errors(m: &MaterialReport) -> [Option<f64>; N_MODELS] {
     let r = &m.record;
     [
         r.tabulated.error,
         r.ggx.as_ref().map(|p| p.error),
         r.beckmann.as_ref().map(|p| p.error),
+        r.coat.as_ref().map(|c| c.error),
     ]
 }
 
@@ -225,10 +240,10 @@ fn sweep_section(points: &[SweepPoint]) -> String {
 }
 
 fn material_section(m: &MaterialReport) -> String {
-    let reference = if m.measured {
-        "the measurement"
-    } else {
-        "the tabulated model (a fit JSON: no measurement to render)"
+    let reference = match reference(m.measured, m.coated) {
+        Variant::Measured => "the measurement",
+        Variant::Coated => "the coated model (a fit JSON: no measurement to render)",
+        _ => "the tabulated model (a fit JSON: no measurement to render)",
     };
     let mut s = format!(
         "<section id=\"{}\"><h2>{}</h2>\n<p>Input <code>{}</code>; ΔE against {reference}.</p>\n",
@@ -238,7 +253,7 @@ fn material_section(m: &MaterialReport) -> String {
     );
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
         let _ = writeln!(s, "<h3>{}</h3>", lighting_name(*lighting));
-        for v in variants(m.measured) {
+        for v in variants(m.measured, m.coated) {
             s += &figure(&render_file(&m.stem, *lighting, v), v.key());
         }
         s += "<br>\n";
@@ -246,7 +261,7 @@ fn material_section(m: &MaterialReport) -> String {
             if let Some(mean) = m.mean_de[l][k] {
                 s += &figure(
                     &de_file(&m.stem, *lighting, *model),
-                    &format!("ΔE {} (mean {mean:.2})", model_key(*model)),
+                    &format!("ΔE {} (mean {mean:.2})", model.key()),
                 );
             }
         }
@@ -267,13 +282,25 @@ fn record_table(m: &MaterialReport) -> String {
         p.as_ref()
             .map_or("–".into(), |p| format!("α {:.4}", p.alpha_x))
     };
+    let coated = r.coat.as_ref().map_or(String::new(), |c| {
+        format!(
+            "<tr><td>coated</td><td>{}</td><td>coat η {}, α {:.4}, weight {:.3} over the base's \
+             tabulated model (its own fit under the coat: N = {}, {} iterations)</td></tr>",
+            fmt_opt(e[3], 4),
+            c.coat.eta,
+            c.coat.alpha,
+            c.coat.weight,
+            c.base.resolution,
+            c.base.iterations
+        )
+    });
     format!(
         "<table><tr><th>model</th><th>error metric</th><th>parameters</th></tr>\
          <tr><td>tabulated</td><td>{}</td><td>N = {}, {} iterations</td></tr>\
          <tr><td>GGX</td><td>{}</td><td>{}</td></tr>\
-         <tr><td>Beckmann</td><td>{}</td><td>{}</td></tr></table>\n\
+         <tr><td>Beckmann</td><td>{}</td><td>{}</td></tr>{coated}</table>\n\
          <p>Fit times (ms): load {:.0}, extract {:.0}, Fresnel and diffuse {:.0}, fits {:.0}, \
-         total {:.0}; fit here {:.0} ms, renders {:.0} ms.</p>\n",
+         coat search {:.0}, total {:.0}; fit here {:.0} ms, renders {:.0} ms.</p>\n",
         fmt_opt(e[0], 4),
         r.resolution,
         r.iterations,
@@ -285,6 +312,7 @@ fn record_table(m: &MaterialReport) -> String {
         t.extract,
         t.fresnel,
         t.fit,
+        t.coat,
         t.total,
         m.fit_ms,
         m.render_ms

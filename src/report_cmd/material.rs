@@ -3,7 +3,7 @@
 //! measurement, or the tabulated model when there is none), and the plots of its NDF and F.
 
 use super::delta_e::{DeltaE, delta_e_image};
-use super::scenes::{Lighting, SphereRenderer, Variant, material, model_key, on_sphere};
+use super::scenes::{Lighting, N_MODELS, SphereRenderer, Variant, material, on_sphere};
 use super::subject::Subject;
 use super::{false_colour, plots};
 use anyhow::{Context, Result};
@@ -22,8 +22,10 @@ pub struct MaterialReport {
     pub input: String,
     /// The file stem of its images (unique in the report).
     pub stem: String,
-    /// Whether the reference is the measurement (else the tabulated model).
+    /// Whether the reference is the measurement (else the fit's own model, [`reference`]).
     pub measured: bool,
+    /// Whether the fit kept a coat (its coated model is then shown too).
+    pub coated: bool,
     /// The fit's record (errors, times).
     pub record: facet_fit::model::material::FitRecord,
     /// The fit's wall time here (or as recorded in a fit JSON), ms.
@@ -31,10 +33,10 @@ pub struct MaterialReport {
     /// The renders' wall time, ms.
     pub render_ms: f64,
     /// Mean ΔE per lighting ([`Lighting::ALL`] order) and model ([`Variant::MODELS`] order);
-    /// `None` for the reference itself.
-    pub mean_de: [[Option<f64>; 3]; 2],
+    /// `None` for the reference itself and for a model not shown.
+    pub mean_de: [[Option<f64>; N_MODELS]; 2],
     /// The ΔE images in the same order (kept for the database means).
-    pub de: [[Option<DeltaE>; 3]; 2],
+    pub de: [[Option<DeltaE>; N_MODELS]; 2],
 }
 
 /// The page-relative path of one render.
@@ -43,17 +45,16 @@ pub fn render_file(stem: &str, lighting: Lighting, variant: Variant) -> String {
 }
 
 /// The page-relative path of one ΔE image.
-pub fn de_file(stem: &str, lighting: Lighting, model: ModelChoice) -> String {
-    format!(
-        "{IMG}/{stem}-{}-de-{}.png",
-        lighting.key(),
-        model_key(model)
-    )
+pub fn de_file(stem: &str, lighting: Lighting, model: Variant) -> String {
+    format!("{IMG}/{stem}-{}-de-{}.png", lighting.key(), model.key())
 }
 
-/// The variants rendered for a subject: the measurement when there is one, and every model.
-pub fn variants(measured: bool) -> Vec<Variant> {
-    let models = Variant::MODELS.iter().map(|&m| Variant::Model(m));
+/// The variants rendered for a subject: the measurement when there is one, every single-layer
+/// model, and the coated model when the fit kept a coat.
+pub fn variants(measured: bool, coated: bool) -> Vec<Variant> {
+    let models = Variant::MODELS
+        .into_iter()
+        .filter(move |&m| m != Variant::Coated || coated);
     measured
         .then_some(Variant::Measured)
         .into_iter()
@@ -61,12 +62,13 @@ pub fn variants(measured: bool) -> Vec<Variant> {
         .collect()
 }
 
-/// The variant ΔE is measured against.
-fn reference(measured: bool) -> Variant {
-    if measured {
-        Variant::Measured
-    } else {
-        Variant::Model(ModelChoice::Tabulated)
+/// The variant ΔE is measured against: the measurement, else the model a fit JSON stands for
+/// as a source (its coated tabulated model when it kept a coat, else its tabulated model).
+pub fn reference(measured: bool, coated: bool) -> Variant {
+    match (measured, coated) {
+        (true, _) => Variant::Measured,
+        (false, true) => Variant::Coated,
+        (false, false) => Variant::Model(ModelChoice::Tabulated),
     }
 }
 
@@ -80,12 +82,13 @@ pub fn report_material(
     let t = std::time::Instant::now();
     let side = renderer.side();
     let mask = |x, y| on_sphere(side, x, y);
-    let mut mean_de = [[None; 3]; 2];
-    let mut de: [[Option<DeltaE>; 3]; 2] = Default::default();
+    let mut mean_de = [[None; N_MODELS]; 2];
+    let mut de: [[Option<DeltaE>; N_MODELS]; 2] = Default::default();
     let source = &subject.fit.record.source;
     let measured = subject.measurement.is_some();
+    let coated = subject.fit.coated.is_some();
     // Each material once, cloned per lighting.
-    let materials = variants(measured)
+    let materials = variants(measured, coated)
         .into_iter()
         .map(|v| {
             Ok((
@@ -107,21 +110,20 @@ pub fn report_material(
                 .with_context(|| format!("writing {}", path.display()))?;
             images.push((variant, image));
         }
-        let reference_variant = reference(measured);
+        let reference_variant = reference(measured, coated);
         let reference = &images
             .iter()
             .find(|(v, _)| *v == reference_variant)
             .expect("the reference is rendered")
             .1;
         for (mi, &model) in Variant::MODELS.iter().enumerate() {
-            if Variant::Model(model) == reference_variant {
+            if model == reference_variant {
                 continue;
             }
-            let image = &images
-                .iter()
-                .find(|(v, _)| *v == Variant::Model(model))
-                .expect("every model is rendered")
-                .1;
+            // A model not shown (the coated one of a fit without a coat) has no image.
+            let Some((_, image)) = images.iter().find(|(v, _)| *v == model) else {
+                continue;
+            };
             let d = delta_e_image(reference, image, &mask);
             false_colour::write_png(&d, &out.join(de_file(stem, lighting, model)))?;
             mean_de[li][mi] = Some(d.mean());
@@ -136,6 +138,7 @@ pub fn report_material(
         input: subject.input.clone(),
         stem: stem.to_owned(),
         measured,
+        coated,
         record: subject.fit.record.clone(),
         fit_ms: subject.fit_ms,
         render_ms,

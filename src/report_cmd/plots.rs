@@ -32,8 +32,9 @@ fn plot_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
     anyhow!("drawing a plot: {e:?}")
 }
 
-/// D(θh) at φ = 0 of the extracted NDF and of the GGX and Beckmann fits, θh in 0°–89°, on a
-/// log axis from 10⁻⁴ of the largest value.
+/// D(θh) at φ = 0 of the extracted NDF, of the GGX and Beckmann fits and, for a fit that kept a
+/// coat, of the base's extracted NDF under it; θh in 0°–89°, on a log axis from 10⁻⁴ of the
+/// largest value.
 pub fn write_ndf_plot(fit: &FittedMaterial, path: &Path) -> Result<()> {
     let thetas: Vec<f64> = (0..=178).map(|k| 0.5 * k as f64).collect();
     let h = |deg: f64| {
@@ -46,6 +47,13 @@ pub fn write_ndf_plot(fit: &FittedMaterial, path: &Path) -> Result<()> {
     }
     if let Some(m) = &fit.beckmann {
         curves.push(("Beckmann", RGBColor(31, 119, 180), m));
+    }
+    if let Some(c) = &fit.coated {
+        curves.push((
+            "base under the coat",
+            RGBColor(140, 140, 140),
+            &c.base.tabulated,
+        ));
     }
     let series: Vec<_> = curves
         .iter()

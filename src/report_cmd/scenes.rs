@@ -68,15 +68,23 @@ pub enum Variant {
     /// The measurement itself (a MERL-grid table sampled by the fit's tabulated NDF, or an RGL
     /// file by its own warps).
     Measured,
-    /// One of the fit's models, each with its diffuse lobe.
+    /// One of the fit's single-layer models, each with its diffuse lobe.
     Model(ModelChoice),
+    /// The fit's coated tabulated model: the coat over the base's tabulated model (only for a
+    /// fit that kept a coat).
+    Coated,
 }
 
+/// How many models the page can show ([`Variant::MODELS`]).
+pub const N_MODELS: usize = Variant::MODELS.len();
+
 impl Variant {
-    pub const MODELS: [ModelChoice; 3] = [
-        ModelChoice::Tabulated,
-        ModelChoice::Ggx,
-        ModelChoice::Beckmann,
+    /// The models, in the order of the page's columns.
+    pub const MODELS: [Variant; 4] = [
+        Variant::Model(ModelChoice::Tabulated),
+        Variant::Model(ModelChoice::Ggx),
+        Variant::Model(ModelChoice::Beckmann),
+        Variant::Coated,
     ];
 
     /// A short name for file names and the page.
@@ -84,6 +92,7 @@ impl Variant {
         match self {
             Variant::Measured => "measured",
             Variant::Model(m) => model_key(m),
+            Variant::Coated => "coated",
         }
     }
 }
@@ -97,8 +106,8 @@ pub fn model_key(m: ModelChoice) -> &'static str {
     }
 }
 
-/// The scene material of `variant`: the `measurement` of `source` (sampled by `fit`) or a model
-/// of `fit`.
+/// The scene material of `variant`: the `measurement` of `source` (sampled by `fit`), a
+/// single-layer model of `fit` (its coat, if it kept one, left off) or its coated model.
 pub fn material(
     variant: Variant,
     source: &str,
@@ -117,17 +126,37 @@ pub fn material(
             ..Default::default()
         },
         (Variant::Measured, None) => anyhow::bail!("{source}: no measurement to render"),
-        (Variant::Model(model), _) => Material {
-            name: model_key(model).into(),
-            facet: Some(FacetMaterial {
-                source: source.into(),
-                fit: fit.clone(),
-                model,
-                glint: None,
-            }),
-            ..Default::default()
-        },
+        (Variant::Model(model), _) => facet_material(source, single_layer(fit), model),
+        (Variant::Coated, _) if fit.coated.is_some() => {
+            facet_material(source, fit.clone(), ModelChoice::Tabulated)
+        }
+        (Variant::Coated, _) => anyhow::bail!("{source}: the fit kept no coat"),
     })
+}
+
+/// `model` of `fit` as the scene's material (a fit that kept a coat renders coated).
+fn facet_material(source: &str, fit: Arc<FittedMaterial>, model: ModelChoice) -> Material {
+    Material {
+        name: model_key(model).into(),
+        facet: Some(FacetMaterial {
+            source: source.into(),
+            fit,
+            model,
+            glint: None,
+        }),
+        ..Default::default()
+    }
+}
+
+/// `fit` without its coat: its single layer's models.
+fn single_layer(fit: &Arc<FittedMaterial>) -> Arc<FittedMaterial> {
+    if fit.coated.is_none() {
+        return fit.clone();
+    }
+    let mut single = FittedMaterial::clone(fit);
+    single.coated = None;
+    single.record.coat = None;
+    Arc::new(single)
 }
 
 /// The unit sphere at the origin made of `material`, the camera on +z, the point light for
