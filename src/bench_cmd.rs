@@ -15,11 +15,8 @@ use facet_fit::gpu::GpuFitter;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::Gpu;
-use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
 use facet_render::camera::CameraFrame;
-use facet_render::procedural::{self, Rng};
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf};
-use facet_render::trace::{GpuHit, RayTracer};
 use facet_render::{ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources};
 use glam::Vec3;
 use serde_json::{Value, json};
@@ -32,6 +29,7 @@ mod coat;
 mod lights;
 mod measured;
 mod shard;
+mod trace;
 
 #[derive(Parser, Clone, Debug)]
 pub struct BenchArgs {
@@ -54,6 +52,11 @@ pub struct BenchArgs {
     /// Only these sections (comma-separated; default: all).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub only: Vec<Section>,
+    /// The trace section times every traversal variant (workgroup sizes, persistent threads),
+    /// alternating them run by run, with GPU timestamps where the adapter has them (default:
+    /// the one every renderer uses, `per-ray/64`).
+    #[arg(long)]
+    pub trace_variants: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -261,7 +264,7 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     }
     if let Some(g) = &gpu {
         if on(Section::Trace) {
-            report["trace"] = trace(g, &sizes)?;
+            report["trace"] = trace::trace(g, &sizes, args.trace_variants)?;
         }
         if on(Section::Integrator) {
             let (integrator, stages, glint) = integrator(g, &sizes)?;
@@ -452,64 +455,6 @@ fn fit(gpu: Option<&Gpu>, sizes: &Sizes) -> Result<Value> {
             println!("  {label:<40} {name:<4} {ms:>10.1} ms   ({runs} runs; {used})");
             rows.push(json!({"case": label, "backend": name, "median_ms": ms, "runs": runs, "record_backend": used}));
         }
-    }
-    Ok(Value::Array(rows))
-}
-
-fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let tracer = RayTracer::new(d)?;
-    let n = sizes.rays.min(RayTracer::max_rays_per_dispatch(d) as u32);
-    let hits = facet_gpu::buffer::storage_zeroed(d, "hits", n as u64 * size_of::<GpuHit>() as u64);
-    let occluded = facet_gpu::buffer::storage_zeroed(d, "occluded", n as u64 * 4);
-    let mut rows = Vec::new();
-    println!(
-        "\ntrace: Mrays/s, {n} rays a dispatch, median of {}",
-        sizes.runs
-    );
-    for &tris in sizes.triangles {
-        let mesh = procedural::test_scene(tris, 1);
-        let bvh = Bvh::build(&mesh.positions, &mesh.indices, BvhConfig::medium());
-        let gpu_bvh = GpuBvh::upload(d, &bvh)?;
-        let (w, h) = (1024, n.div_ceil(1024));
-        let camera = procedural::camera_rays(
-            Vec3::new(-8.0, 6.0, 9.0),
-            Vec3::new(2.0, 2.0, -3.0),
-            60f32.to_radians(),
-            w,
-            h,
-        );
-        let random = procedural::random_rays(
-            n as usize,
-            Vec3::new(-9.9, 0.1, -9.9),
-            Vec3::new(9.9, 9.9, 9.9),
-            &mut Rng::new(5),
-        );
-        for (set, rays) in [("camera", camera), ("random", random)] {
-            let rays = facet_gpu::buffer::storage(d, "rays", &rays[..n as usize]);
-            for query in ["closest", "any"] {
-                let ms = median_ms(sizes.runs, || {
-                    let mut enc = d.create_command_encoder(&Default::default());
-                    if query == "closest" {
-                        tracer.encode_closest(d, &mut enc, &gpu_bvh, &rays, &hits, n);
-                    } else {
-                        tracer.encode_any(d, &mut enc, &gpu_bvh, &rays, &occluded, n);
-                    }
-                    q.submit([enc.finish()]);
-                    d.poll(wgpu::PollType::wait_indefinitely())?;
-                    Ok(())
-                })?;
-                let mrays = n as f64 / (ms * 1e3);
-                println!(
-                    "  {:>9} triangles {set:<7} {query:<8} {mrays:>10.1} Mrays/s   (BVH {} nodes, built in {:.0} ms)",
-                    tris,
-                    bvh.cwbvh.nodes.len(),
-                    bvh.build_ms
-                );
-                rows.push(json!({"triangles": tris, "rays": set, "query": query, "mrays_per_s": mrays, "ms": ms, "bvh_nodes": bvh.cwbvh.nodes.len(), "bvh_build_ms": bvh.build_ms}));
-            }
-        }
-        gpu.check_lost()?;
     }
     Ok(Value::Array(rows))
 }

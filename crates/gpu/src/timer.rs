@@ -51,6 +51,11 @@ impl GpuTimer {
         })
     }
 
+    /// Forgets the passes timed so far: the next [`GpuTimer::pass`] takes the first pair again.
+    pub fn reset(&mut self) {
+        self.used = 0;
+    }
+
     /// Milliseconds of each timed pass.
     pub fn read_ms(
         &self,

@@ -1,9 +1,11 @@
 //! Host driver of `shaders/render/trace.wgsl`: closest-hit and any-hit queries for a batch of
-//! rays against a [`GpuBvh`], one thread per ray. The CPU reference is
-//! [`Bvh::closest_hit`](crate::bvh::Bvh::closest_hit) / [`Bvh::occluded`](crate::bvh::Bvh::occluded).
+//! rays against a [`GpuBvh`], scheduled as a [`TraceVariant`] says (one thread per ray by
+//! default). The CPU reference is [`Bvh::closest_hit`](crate::bvh::Bvh::closest_hit) /
+//! [`Bvh::occluded`](crate::bvh::Bvh::occluded).
 
 use crate::bvh::GpuBvh;
 use bytemuck::{Pod, Zeroable};
+use facet_gpu::timer::GpuTimer;
 use facet_gpu::{GpuError, buffer, dispatch, shader};
 
 const SHADER: &str = "render/trace.wgsl";
@@ -61,21 +63,161 @@ impl GpuHit {
 /// (32, 16 and 4 bytes per element) a multiple of the 256-byte storage offset alignment.
 const CHUNK_ALIGN: u64 = 1024;
 
-/// The two pipelines of `trace.wgsl`.
+/// How the traversal kernel hands rays to threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceSchedule {
+    /// One thread per ray, as many workgroups as the rays need.
+    PerRay,
+    /// Persistent threads (Aila & Laine 2009): at most `groups` workgroups loop, each taking
+    /// the next workgroup-sized batch of rays with one atomic add until none are left.
+    Persistent {
+        /// Workgroups launched (fewer when the rays fill fewer batches).
+        groups: u32,
+    },
+}
+
+/// A traversal kernel's variant, chosen when its pipelines are built: the ideas issue 51 times on
+/// a real GPU, each checked against obvhs on the CPU (`crates/render/tests/bvh.rs`). The
+/// traversal itself (Ylitie et al. 2017's compressed wide BVH, octant-ordered children, the
+/// short stack of node groups) is the same in all of them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TraceVariant {
+    /// How rays reach threads.
+    pub schedule: TraceSchedule,
+    /// Threads per workgroup (WGSL override `WG`), 1 to the device's limit.
+    pub workgroup: u32,
+}
+
+impl TraceVariant {
+    /// One thread per ray in workgroups of `workgroup`.
+    pub const fn per_ray(workgroup: u32) -> Self {
+        TraceVariant {
+            schedule: TraceSchedule::PerRay,
+            workgroup,
+        }
+    }
+
+    /// Persistent threads: `groups` workgroups of `workgroup` threads.
+    pub const fn persistent(workgroup: u32, groups: u32) -> Self {
+        TraceVariant {
+            schedule: TraceSchedule::Persistent { groups },
+            workgroup,
+        }
+    }
+
+    /// The kernel every other user of the traversal gets.
+    pub const DEFAULT: TraceVariant = TraceVariant::per_ray(64);
+
+    /// The variants `facet bench --only trace --trace-variants` times side by side: workgroup
+    /// sizes about the SIMD widths (32 on NVIDIA, 64 on AMD), and persistent threads with one
+    /// warp per workgroup (the paper's) at two occupancies of a large GPU (an H100 has 132
+    /// SMs of 64 warps: 8448 warps) and with two warps.
+    pub const ALL: [TraceVariant; 7] = [
+        TraceVariant::DEFAULT,
+        TraceVariant::per_ray(32),
+        TraceVariant::per_ray(128),
+        TraceVariant::per_ray(256),
+        TraceVariant::persistent(32, 2048),
+        TraceVariant::persistent(32, 8192),
+        TraceVariant::persistent(64, 4096),
+    ];
+
+    /// A short name: `per-ray/64`, `persistent/32x2048`.
+    pub fn key(&self) -> String {
+        match self.schedule {
+            TraceSchedule::PerRay => format!("per-ray/{}", self.workgroup),
+            TraceSchedule::Persistent { groups } => {
+                format!("persistent/{}x{groups}", self.workgroup)
+            }
+        }
+    }
+
+    /// An error naming the variant when `device` cannot run it.
+    pub fn validate(&self, device: &wgpu::Device) -> Result<(), GpuError> {
+        let limits = device.limits();
+        let max = limits
+            .max_compute_invocations_per_workgroup
+            .min(limits.max_compute_workgroup_size_x);
+        let bad = |problem: String| Err(GpuError::Validation(format!("{}: {problem}", self.key())));
+        if !(1..=max).contains(&self.workgroup) {
+            return bad(format!(
+                "{} threads a workgroup, outside 1..={max}",
+                self.workgroup
+            ));
+        }
+        if self.schedule == (TraceSchedule::Persistent { groups: 0 }) {
+            return bad("no workgroups".into());
+        }
+        Ok(())
+    }
+}
+
+/// Which query a batch answers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TraceQuery {
+    /// The nearest hit ([`GpuHit`] per ray).
+    Closest,
+    /// Whether anything is hit (a u32, 1 or 0, per ray).
+    Any,
+}
+
+/// The two pipelines of `trace.wgsl` in one [`TraceVariant`].
 pub struct RayTracer {
     closest: wgpu::ComputePipeline,
     any: wgpu::ComputePipeline,
-    workgroup_size: u32,
+    variant: TraceVariant,
+    /// The persistent schedule's ray counter (none for one thread per ray).
+    next_ray: Option<wgpu::Buffer>,
+    /// Rays per dispatch.
+    chunk: u64,
 }
 
 impl RayTracer {
-    /// Builds the traversal pipeline on `device`.
+    /// Builds the traversal pipelines of [`TraceVariant::DEFAULT`] on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
+        Self::with_variant(device, TraceVariant::DEFAULT)
+    }
+
+    /// Builds the traversal pipelines of `variant` on `device`.
+    pub fn with_variant(device: &wgpu::Device, variant: TraceVariant) -> Result<Self, GpuError> {
+        variant.validate(device)?;
+        let (closest, any) = match variant.schedule {
+            TraceSchedule::PerRay => ("trace_closest_rays", "trace_any_rays"),
+            TraceSchedule::Persistent { .. } => {
+                ("trace_closest_persistent", "trace_any_persistent")
+            }
+        };
+        let constants = [("WG", variant.workgroup as f64)];
+        let next_ray = matches!(variant.schedule, TraceSchedule::Persistent { .. }).then(|| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("next ray"),
+                size: 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
         Ok(RayTracer {
-            closest: shader::compute_pipeline(device, SHADER, "trace_closest_rays", &[])?,
-            any: shader::compute_pipeline(device, SHADER, "trace_any_rays", &[])?,
-            workgroup_size: shader::workgroup_size(SHADER, "trace_closest_rays")?,
+            closest: shader::compute_pipeline(device, SHADER, closest, &constants)?,
+            any: shader::compute_pipeline(device, SHADER, any, &constants)?,
+            variant,
+            next_ray,
+            chunk: Self::max_rays_per_dispatch(device),
         })
+    }
+
+    /// The same tracer splitting batches into dispatches of at most `rays` (rounded down to a
+    /// multiple of 1024, at least 1024) rather than what the device's binding limit allows: for
+    /// tests of the split.
+    pub fn with_rays_per_dispatch(mut self, rays: u64) -> Self {
+        self.chunk = self
+            .chunk
+            .min((rays / CHUNK_ALIGN * CHUNK_ALIGN).max(CHUNK_ALIGN));
+        self
+    }
+
+    /// The variant its pipelines were built for.
+    pub fn variant(&self) -> TraceVariant {
+        self.variant
     }
 
     /// Most rays one dispatch takes: the ray binding (32 bytes a ray) within the device's
@@ -93,13 +235,7 @@ impl RayTracer {
         bvh: &GpuBvh,
         rays: &[GpuRay],
     ) -> Result<Vec<GpuHit>, GpuError> {
-        self.trace_batches(
-            device,
-            queue,
-            rays,
-            size_of::<GpuHit>(),
-            |enc, r, out, n| self.encode_closest(device, enc, bvh, r, out, n),
-        )
+        self.trace_batches(device, queue, bvh, TraceQuery::Closest, rays)
     }
 
     /// 1 where a triangle lies at t < tmax along the ray, else 0.
@@ -110,30 +246,32 @@ impl RayTracer {
         bvh: &GpuBvh,
         rays: &[GpuRay],
     ) -> Result<Vec<u32>, GpuError> {
-        self.trace_batches(device, queue, rays, size_of::<u32>(), |enc, r, out, n| {
-            self.encode_any(device, enc, bvh, r, out, n)
-        })
+        self.trace_batches(device, queue, bvh, TraceQuery::Any, rays)
     }
 
     fn trace_batches<T: Pod>(
         &self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
+        bvh: &GpuBvh,
+        query: TraceQuery,
         rays: &[GpuRay],
-        out_size: usize,
-        encode: impl Fn(&mut wgpu::CommandEncoder, &wgpu::Buffer, &wgpu::Buffer, u32),
     ) -> Result<Vec<T>, GpuError> {
         // One upload per chunk keeps host-side buffers within the per-buffer limit too.
-        let chunk = Self::max_rays_per_dispatch(device) as usize;
         let mut out = Vec::with_capacity(rays.len());
-        for part in rays.chunks(chunk) {
+        for part in rays.chunks(self.chunk as usize) {
             let ray_buf = buffer::storage(device, "rays", part);
             let out_buf =
-                buffer::storage_zeroed(device, "trace out", (part.len() * out_size) as u64);
+                buffer::storage_zeroed(device, "trace out", (part.len() * size_of::<T>()) as u64);
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("trace"),
             });
-            encode(&mut encoder, &ray_buf, &out_buf, part.len() as u32);
+            let batch = TraceBatch {
+                rays: &ray_buf,
+                out: &out_buf,
+                count: part.len() as u32,
+            };
+            self.encode(device, &mut encoder, bvh, query, batch, None);
             queue.submit([encoder.finish()]);
             out.extend(buffer::read::<T>(device, queue, &out_buf, part.len())?);
         }
@@ -152,16 +290,12 @@ impl RayTracer {
         hits: &wgpu::Buffer,
         count: u32,
     ) {
-        self.encode(
-            device,
-            encoder,
-            &self.closest,
-            bvh,
+        let batch = TraceBatch {
             rays,
-            (4, hits, size_of::<GpuHit>()),
-            true,
+            out: hits,
             count,
-        );
+        };
+        self.encode(device, encoder, bvh, TraceQuery::Closest, batch, None);
     }
 
     /// As [`RayTracer::encode_closest`] for any-hit queries: one u32 per ray into `occluded`.
@@ -174,65 +308,84 @@ impl RayTracer {
         occluded: &wgpu::Buffer,
         count: u32,
     ) {
-        self.encode(
-            device,
-            encoder,
-            &self.any,
-            bvh,
+        let batch = TraceBatch {
             rays,
-            (5, occluded, size_of::<u32>()),
-            false,
+            out: occluded,
             count,
-        );
+        };
+        self.encode(device, encoder, bvh, TraceQuery::Any, batch, None);
     }
 
-    /// One compute pass; several dispatches over sub-ranges when `count` exceeds what one ray
-    /// binding holds. `out` is (binding, buffer, bytes per ray). Layouts come from the shader,
-    /// so a binding an entry point does not use (any-hit never reads `bvh_primitives`) is left
-    /// out: `uses_primitives`.
-    #[allow(clippy::too_many_arguments)]
-    fn encode(
+    /// Encodes `query` for `batch`, one compute pass per dispatch (several when the batch
+    /// exceeds what one ray binding holds), each timed by `timer` when given. Layouts come from
+    /// the shader, so a binding an entry point does not use (any-hit never reads
+    /// `bvh_primitives`) is left out. A persistent schedule's counter is cleared before each
+    /// dispatch.
+    pub fn encode(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
-        pipeline: &wgpu::ComputePipeline,
         bvh: &GpuBvh,
-        rays: &wgpu::Buffer,
-        out: (u32, &wgpu::Buffer, usize),
-        uses_primitives: bool,
-        count: u32,
+        query: TraceQuery,
+        batch: TraceBatch<'_>,
+        mut timer: Option<&mut GpuTimer>,
     ) {
-        let (out_binding, out_buf, out_size) = out;
+        let (pipeline, out_binding, out_size) = match query {
+            TraceQuery::Closest => (&self.closest, 4, size_of::<GpuHit>()),
+            TraceQuery::Any => (&self.any, 5, size_of::<u32>()),
+        };
         let layout = pipeline.get_bind_group_layout(0);
-        let chunk = Self::max_rays_per_dispatch(device);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("trace"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(pipeline);
+        let wg = self.variant.workgroup;
         let mut start = 0u64;
-        while start < count as u64 {
-            let n = chunk.min(count as u64 - start);
+        while start < batch.count as u64 {
+            let n = self.chunk.min(batch.count as u64 - start);
             let mut entries = vec![
                 entry(0, bvh.nodes.as_entire_binding()),
                 entry(2, bvh.triangles.as_entire_binding()),
-                entry(3, sub_range(rays, start, n, size_of::<GpuRay>())),
-                entry(out_binding, sub_range(out_buf, start, n, out_size)),
+                entry(3, sub_range(batch.rays, start, n, size_of::<GpuRay>())),
+                entry(out_binding, sub_range(batch.out, start, n, out_size)),
             ];
-            if uses_primitives {
+            if query == TraceQuery::Closest {
                 entries.push(entry(1, bvh.primitives.as_entire_binding()));
+            }
+            if let Some(next_ray) = &self.next_ray {
+                encoder.clear_buffer(next_ray, 0, None);
+                entries.push(entry(6, next_ray.as_entire_binding()));
             }
             let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("trace"),
                 layout: &layout,
                 entries: &entries,
             });
+            let threads = match self.variant.schedule {
+                TraceSchedule::PerRay => n as u32,
+                // No more workgroups than batches.
+                TraceSchedule::Persistent { groups } => groups.min((n as u32).div_ceil(wg)) * wg,
+            };
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("trace"),
+                timestamp_writes: timer.as_deref_mut().and_then(GpuTimer::pass),
+            });
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
-            let (x, y) = dispatch::workgroups(n as u32, self.workgroup_size);
+            let (x, y) = dispatch::workgroups(threads, wg);
             pass.dispatch_workgroups(x, y, 1);
+            drop(pass);
             start += n;
         }
     }
+}
+
+/// Rays on the GPU and where their answers go: the first `count` WGSL `Ray`s of `rays`, and as
+/// many [`GpuHit`]s (closest hit) or u32s (any hit) of `out`.
+#[derive(Clone, Copy)]
+pub struct TraceBatch<'a> {
+    /// The rays.
+    pub rays: &'a wgpu::Buffer,
+    /// The answers.
+    pub out: &'a wgpu::Buffer,
+    /// How many.
+    pub count: u32,
 }
 
 fn entry(binding: u32, resource: wgpu::BindingResource<'_>) -> wgpu::BindGroupEntry<'_> {

@@ -9,7 +9,7 @@
 
 use facet_render::bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh};
 use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, GpuRay, RayTracer};
+use facet_render::trace::{GpuHit, GpuRay, RayTracer, TraceVariant};
 use glam::Vec3;
 
 fn scene_bvh(triangles: usize, config: BvhConfig) -> (procedural::Mesh, Bvh) {
@@ -242,11 +242,17 @@ fn close(a: f32, b: f32, rel: f32) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-30)
 }
 
-/// Closest hits and any-hit on the GPU against obvhs on the CPU, for one BVH and ray set.
-fn gpu_matches_cpu(gpu: &facet_gpu::Gpu, bvh: &Bvh, rays: &[GpuRay], label: &str) {
+/// Closest hits and any-hit on the GPU by `tracer` against obvhs on the CPU, for one BVH and
+/// ray set.
+fn gpu_matches_cpu(
+    gpu: &facet_gpu::Gpu,
+    tracer: &RayTracer,
+    bvh: &Bvh,
+    rays: &[GpuRay],
+    label: &str,
+) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let gpu_bvh = GpuBvh::upload(d, bvh).unwrap();
-    let tracer = RayTracer::new(d).unwrap();
 
     let start = std::time::Instant::now();
     let hits = tracer.trace_closest(d, q, &gpu_bvh, rays).unwrap();
@@ -255,7 +261,8 @@ fn gpu_matches_cpu(gpu: &facet_gpu::Gpu, bvh: &Bvh, rays: &[GpuRay], label: &str
     let cpu: Vec<_> = rays.iter().map(|r| cpu_closest(bvh, r)).collect();
     let cpu_s = start.elapsed().as_secs_f64();
     println!(
-        "{label}: {} triangles, {} rays: GPU {:.2} Mrays/s ({}), CPU {:.2} Mrays/s",
+        "{label}, {}: {} triangles, {} rays: GPU {:.2} Mrays/s ({}), CPU {:.2} Mrays/s",
+        tracer.variant().key(),
         bvh.triangles.len(),
         rays.len(),
         rays.len() as f64 / gpu_s * 1e-6,
@@ -347,12 +354,76 @@ fn gpu_traversal_matches_obvhs() {
     let (_, bvh) = scene_bvh(50_000, BvhConfig::medium());
     let rays = ray_set((256, 192), 65_536, 11);
     assert!(rays.len() >= 100_000);
-    gpu_matches_cpu(&gpu, &bvh, &rays, "medium");
+    let tracer = RayTracer::new(&gpu.device).unwrap();
+    gpu_matches_cpu(&gpu, &tracer, &bvh, &rays, "medium");
 
     let (_, split) = scene_bvh(50_000, BvhConfig::very_slow());
     assert!(split.cwbvh.uses_spatial_splits);
     let rays = ray_set((64, 48), 8_192, 12);
-    gpu_matches_cpu(&gpu, &split, &rays, "very slow (pre-split)");
+    gpu_matches_cpu(&gpu, &tracer, &split, &rays, "very slow (pre-split)");
+}
+
+/// Every traversal variant the bench times gives obvhs's hits: the workgroup sizes, and
+/// persistent threads with as many workgroups as the bench launches (here more than the
+/// batches: one batch each) and with 3 and 1 (each loops over many batches); one of them split
+/// into dispatches of 4096 rays, so that the ray counter must start again at each.
+#[test]
+fn every_trace_variant_matches_obvhs() {
+    let Some(gpu) = facet_gpu::gpu_for_tests("every_trace_variant_matches_obvhs") else {
+        return;
+    };
+    let d = &gpu.device;
+    let (_, bvh) = scene_bvh(50_000, BvhConfig::medium());
+    let rays = ray_set((96, 64), 12_000, 13);
+    let few = [
+        TraceVariant::persistent(32, 3),
+        TraceVariant::persistent(64, 1),
+    ];
+    for variant in TraceVariant::ALL.into_iter().chain(few) {
+        let tracer = RayTracer::with_variant(d, variant).unwrap();
+        gpu_matches_cpu(&gpu, &tracer, &bvh, &rays, "medium");
+    }
+    let split = RayTracer::with_variant(d, TraceVariant::persistent(32, 3))
+        .unwrap()
+        .with_rays_per_dispatch(4096);
+    gpu_matches_cpu(&gpu, &split, &bvh, &rays, "medium, 4096 rays a dispatch");
+    // One encode over several dispatches, the counter cleared between them in one encoder: the
+    // same hits as the batches above, one submission each.
+    let q = &gpu.queue;
+    let gpu_bvh = GpuBvh::upload(d, &bvh).unwrap();
+    let ray_buf = facet_gpu::buffer::storage(d, "rays", &rays);
+    let hit_buf = facet_gpu::buffer::storage_zeroed(d, "hits", (rays.len() * 16) as u64);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    split.encode_closest(
+        d,
+        &mut encoder,
+        &gpu_bvh,
+        &ray_buf,
+        &hit_buf,
+        rays.len() as u32,
+    );
+    q.submit([encoder.finish()]);
+    let once: Vec<GpuHit> = facet_gpu::buffer::read(d, q, &hit_buf, rays.len()).unwrap();
+    let batched = split.trace_closest(d, q, &gpu_bvh, &rays).unwrap();
+    let differ = once.iter().zip(&batched).filter(|(a, b)| a != b).count();
+    assert_eq!(differ, 0, "of {} rays", rays.len());
+}
+
+/// A variant the device cannot run is refused with its name, not built.
+#[test]
+fn a_trace_variant_past_the_device_limit_is_refused() {
+    let Some(gpu) = facet_gpu::gpu_for_tests("a_trace_variant_past_the_device_limit_is_refused")
+    else {
+        return;
+    };
+    let too_wide =
+        TraceVariant::per_ray(gpu.device.limits().max_compute_invocations_per_workgroup + 1);
+    let e = RayTracer::with_variant(&gpu.device, too_wide)
+        .err()
+        .expect("refused");
+    assert!(e.to_string().contains(&too_wide.key()), "{e}");
+    let none = TraceVariant::persistent(32, 0);
+    assert!(RayTracer::with_variant(&gpu.device, none).is_err());
 }
 
 #[test]
