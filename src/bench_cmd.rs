@@ -54,7 +54,8 @@ pub struct BenchArgs {
     pub only: Vec<Section>,
     /// The trace section times every traversal variant (workgroup sizes, persistent threads),
     /// alternating them run by run, with GPU timestamps where the adapter has them (default:
-    /// the one every renderer uses, `per-ray/64`).
+    /// the one every renderer uses, `per-ray/64`); the integrator section renders with each as
+    /// its extend stage too (`extend_variants`).
     #[arg(long)]
     pub trace_variants: bool,
 }
@@ -271,6 +272,9 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
             report["integrator"] = integrator;
             report["stages"] = stages;
             report["glint"] = glint;
+            if args.trace_variants {
+                report["extend_variants"] = trace::extend_variants(g, &sizes)?;
+            }
         }
         if on(Section::Viewer) {
             report["viewer"] = viewer(g, &sizes)?;

@@ -968,9 +968,10 @@ fn bench_smoke_reports_every_section() {
     positive(&r["viewer"]["msamples_per_s"], "viewer Msamples/s");
 }
 
-/// `facet bench --only trace --trace-variants`: every traversal variant on every case (camera
-/// and random rays × closest and any), positive rates, each against the default variant of the
-/// same case (itself: exactly 1), the clock GPU timestamps where the adapter has them.
+/// `facet bench --only trace,integrator --trace-variants`: every traversal variant on every
+/// case (camera and random rays × closest and any), positive rates, each against the default
+/// variant of the same case (itself: exactly 1), the clock GPU timestamps where the adapter has
+/// them; and the integrator with each variant as its extend stage.
 #[test]
 fn bench_times_every_trace_variant() {
     if facet_gpu::gpu_for_tests("bench_times_every_trace_variant").is_none() {
@@ -982,7 +983,7 @@ fn bench_times_every_trace_variant() {
         "bench",
         "--smoke",
         "--only",
-        "trace",
+        "trace,integrator",
         "--trace-variants",
         "--json",
         json.to_str().unwrap(),
@@ -1013,6 +1014,25 @@ fn bench_times_every_trace_variant() {
         "wall"
     };
     assert!(rows.iter().all(|row| row["clock"] == clock), "{clock}");
+    let extend = r["extend_variants"].as_array().unwrap();
+    let keys: Vec<String> = variants.iter().map(|v| v.key()).collect();
+    assert_eq!(
+        extend
+            .iter()
+            .map(|row| row["variant"].as_str().unwrap())
+            .collect::<Vec<_>>(),
+        keys
+    );
+    for row in extend {
+        let rate = row["msamples_per_s"].as_f64().unwrap();
+        assert!(rate.is_finite() && rate > 0.0, "{row}");
+        assert!(
+            row["extend_iteration_ms"]
+                .as_f64()
+                .is_some_and(|ms| ms > 0.0),
+            "{row}"
+        );
+    }
 }
 
 /// `--variance` writes STEM.variance.exr beside the image: the same size, finite, non-negative,

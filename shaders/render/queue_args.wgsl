@@ -2,10 +2,14 @@
 // arguments (2D as facet_gpu::dispatch::workgroups lays them out), and zeroed counters for the
 // next producers. One thread.
 
-// The stages' workgroup size, read from their WGSL by naga on the host.
+// The consuming stage's workgroup size.
 override STAGE_WG: u32;
 override FIRST: u32;
 override COUNT: u32;
+// A persistent consumer's: at most this many workgroups, and the counter it fetches batches
+// from, zeroed here (0xffffffff: none).
+override MAX_GROUPS: u32 = 0xffffffffu;
+override FETCH: u32 = 0xffffffffu;
 
 @group(0) @binding(0) var<storage, read_write> counters: array<u32>;
 @group(0) @binding(1) var<storage, read_write> sizes: array<u32>;
@@ -17,10 +21,13 @@ fn queue_args() {
         let n = counters[q];
         counters[q] = 0u;
         sizes[q] = n;
-        let groups = (n + STAGE_WG - 1u) / STAGE_WG;
+        let groups = min((n + STAGE_WG - 1u) / STAGE_WG, MAX_GROUPS);
         let x = min(groups, 65535u);
         args[3u * q] = x;
         args[3u * q + 1u] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
         args[3u * q + 2u] = 1u;
+    }
+    if (FETCH != 0xffffffffu) {
+        counters[FETCH] = 0u;
     }
 }

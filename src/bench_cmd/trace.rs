@@ -186,3 +186,70 @@ impl Case<'_> {
         Ok((wall, passes))
     }
 }
+
+/// The integrator on the demo scene without glints (the integrator section's first case) with
+/// each extend-stage variant: Msamples/s of whole renders, the variants taking turns run by
+/// run after one warm-up each, and the extend stage's time in one iteration of each.
+pub fn extend_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
+    let (w, h, spp) = sizes.render;
+    let image = facet_render::ImageConfig {
+        width: w,
+        height: h,
+        ..facet_render::ImageConfig::standard()
+    };
+    let sampling = facet_render::SampleConfig {
+        spp,
+        max_depth: 5,
+        ..facet_render::SampleConfig::standard()
+    };
+    let (scene, env) = super::demo_scene(false)?;
+    let res = facet_render::SceneResources::new(
+        gpu,
+        &scene,
+        Some(&env),
+        facet_render::ResourceConfig::standard(),
+    )?;
+    let camera = facet_render::camera::CameraFrame::new(&scene.camera)?;
+    let mut runs = Vec::new();
+    for v in TraceVariant::ALL {
+        let integrator = facet_render::Integrator::with_extend(&gpu.device, &res, v)?;
+        let wf = integrator.wavefront(gpu, &res, image)?;
+        runs.push((integrator, wf, Vec::new()));
+    }
+    println!(
+        "\nextend variants: the demo without glints at {w} × {h}, depth 5, {spp} spp, median of {}",
+        sizes.runs
+    );
+    for round in 0..=sizes.runs.max(1) {
+        for (integrator, wf, ms) in &mut runs {
+            wf.clear(gpu);
+            let stats = integrator.render_more(gpu, wf, &camera, &sampling, &mut |_| {})?;
+            // Round 0 warms up.
+            if round > 0 {
+                ms.push(stats.ms);
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    let mut base = None;
+    for (integrator, wf, ms) in &mut runs {
+        let ms = median(ms);
+        let msps = w as f64 * h as f64 * spp as f64 / (ms * 1e3);
+        let base = *base.get_or_insert(msps);
+        let (times, clock) =
+            integrator.profile_iteration(gpu, wf, &camera, &sampling, sizes.stage_warm)?;
+        let extend_ms = times.iter().find(|t| t.stage == "extend").map(|t| t.ms);
+        let key = integrator.extend_variant().key();
+        println!(
+            "  {key:<20} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; extend {:.3} ms of one iteration, {clock:?})",
+            msps / base,
+            extend_ms.unwrap_or(f64::NAN)
+        );
+        rows.push(json!({
+            "variant": key, "msamples_per_s": msps, "ms": ms, "vs_default": msps / base,
+            "extend_iteration_ms": extend_ms, "stage_clock": format!("{clock:?}").to_lowercase(),
+            "width": w, "height": h, "spp": spp, "depth": 5,
+        }));
+    }
+    Ok(Value::Array(rows))
+}

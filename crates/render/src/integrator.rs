@@ -17,12 +17,13 @@ use crate::config::{ImageConfig, RenderConfig, SampleConfig};
 use crate::error::RenderError;
 use crate::film::Image;
 use crate::gpu_types::GpuFrame;
-use crate::queues::Queue;
+use crate::queues::{FETCH_COUNTER, Queue};
 use crate::resources::SceneResources;
-use crate::stages::{Layouts, Stage, queue_args};
+use crate::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};
+use crate::trace::{TraceSchedule, TraceVariant};
 use crate::wavefront::Wavefront;
+use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
-use facet_gpu::{Gpu, shader};
 use std::time::Instant;
 
 /// Encodes one stage into the pass it is given.
@@ -96,13 +97,26 @@ pub struct Integrator {
     close_shade: wgpu::ComputePipeline,
     close_shadow: wgpu::ComputePipeline,
     n_queues: u32,
-    /// Workgroup size of the stages (read from their WGSL).
+    /// Workgroup size of the stages dispatched over every slot.
     wg: u32,
+    /// How the extend stage hands rays to threads.
+    extend_variant: TraceVariant,
 }
 
 impl Integrator {
     /// The pipelines for the material classes of `scene`.
     pub fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
+        Self::with_extend(device, scene, TraceVariant::DEFAULT)
+    }
+
+    /// [`Integrator::new`] with the extend stage scheduled as `extend` says (its workgroup
+    /// size; one thread per ray or persistent threads): the same image, at another speed.
+    pub fn with_extend(
+        device: &wgpu::Device,
+        scene: &SceneResources,
+        extend: TraceVariant,
+    ) -> Result<Self, RenderError> {
+        extend.validate(device)?;
         let layouts = Layouts::new(device);
         let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
             Stage::new(device, &layouts, file, entry, queue, extra)
@@ -134,7 +148,18 @@ impl Integrator {
             shade.push(s);
         }
         let n_queues = Queue::count(scene.glints.len() as u32);
-        let wg = shader::workgroup_size("render/extend.wgsl", "extend")?;
+        let wg = STAGE_WORKGROUP;
+        let extend_wg = [("WG", extend.workgroup as f64)];
+        let (extend_entry, extend_close) = match extend.schedule {
+            TraceSchedule::PerRay => ("extend", Vec::new()),
+            TraceSchedule::Persistent { groups } => (
+                "extend_persistent",
+                vec![
+                    ("MAX_GROUPS", groups as f64),
+                    ("FETCH", FETCH_COUNTER as f64),
+                ],
+            ),
+        };
         Ok(Integrator {
             logic: stage("render/logic.wgsl", "logic", None, &[])?,
             generate: stage(
@@ -143,23 +168,42 @@ impl Integrator {
                 Some(Queue::Generate),
                 &[],
             )?,
-            extend: stage("render/extend.wgsl", "extend", Some(Queue::Extend), &[])?,
+            extend: stage(
+                "render/extend.wgsl",
+                extend_entry,
+                Some(Queue::Extend),
+                &extend_wg,
+            )?,
             connect: stage("render/connect.wgsl", "connect", Some(Queue::Shadow), &[])?,
-            close_gen: queue_args(device, &layouts, Queue::Generate.index(), 1, wg)?,
-            close_extend: queue_args(device, &layouts, Queue::Extend.index(), 1, wg)?,
+            close_gen: queue_args(device, &layouts, Queue::Generate.index(), 1, wg, &[])?,
+            close_extend: queue_args(
+                device,
+                &layouts,
+                Queue::Extend.index(),
+                1,
+                extend.workgroup,
+                &extend_close,
+            )?,
             close_shade: queue_args(
                 device,
                 &layouts,
                 Queue::Diffuse.index(),
                 n_queues - Queue::Diffuse.index(),
                 wg,
+                &[],
             )?,
-            close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg)?,
+            close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg, &[])?,
             shade,
             layouts,
             n_queues,
             wg,
+            extend_variant: extend,
         })
+    }
+
+    /// How the extend stage hands rays to threads.
+    pub fn extend_variant(&self) -> TraceVariant {
+        self.extend_variant
     }
 
     /// Names of the stages built (shading stages once per class).
@@ -256,7 +300,7 @@ impl Integrator {
                 frame.tile_pixels = (pixels - base).min(w) as u32;
                 frame.sample_end = end;
                 wf.start_tile(&gpu.queue, &frame, begin);
-                stats.iterations += self.run_tile(gpu, wf, all_slots, sampling)?;
+                stats.iterations += self.run_tile(gpu, wf, all_slots, sampling, end - begin)?;
                 stats.samples += frame.tile_pixels as u64 * (end - begin) as u64;
                 let done = (pass as u64 * tiles + tile + 1) as f64 / (passes as u64 * tiles) as f64;
                 progress(done);
@@ -274,16 +318,30 @@ impl Integrator {
     }
 
     /// Runs the stage loop over the tile `wf` was started on until every slot is idle,
-    /// `iterations_per_check` iterations a submission; returns the iterations run.
+    /// `iterations_per_check` iterations a submission; returns the iterations run. A slot takes
+    /// at most max_depth + 2 iterations a sample (its bounces, the one that finishes it and
+    /// starts the next), so a tile of `samples` samples a slot that runs twice as long has
+    /// stopped making progress (a GPU fault): an error, not a hang.
     fn run_tile(
         &self,
         gpu: &Gpu,
         wf: &Wavefront,
         all_slots: (u32, u32),
         sampling: &SampleConfig,
+        samples: u32,
     ) -> Result<u64, RenderError> {
+        let checks = sampling.iterations_per_check as u64;
+        let limit = 2 * samples as u64 * (sampling.max_depth as u64 + 2) + 2 * checks + 8;
         let mut iterations = 0;
         loop {
+            if iterations > limit {
+                return Err(facet_gpu::GpuError::Validation(format!(
+                    "the wavefront made no progress in {iterations} iterations for {samples} \
+                     sample(s) a pixel of depth {}",
+                    sampling.max_depth
+                ))
+                .into());
+            }
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             {
                 let mut cpass = enc.begin_compute_pass(&Default::default());

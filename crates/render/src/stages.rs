@@ -7,6 +7,10 @@ use crate::bindings::{Group, pipeline_groups};
 use crate::queues::Queue;
 use facet_gpu::{GpuError, shader};
 
+/// Threads per workgroup of every stage (WGSL override `WG`), but the extend stage's, which
+/// its [`crate::trace::TraceVariant`] sets.
+pub const STAGE_WORKGROUP: u32 = 64;
+
 /// Bind group layouts shared by every stage, one per [`Group`].
 pub struct Layouts {
     /// In the order of [`Group::ALL`].
@@ -79,7 +83,9 @@ impl Stage {
         queue: Option<Queue>,
         extra_constants: &[(&str, f64)],
     ) -> Result<Stage, GpuError> {
+        // `extra_constants` come last: a WG there replaces the default.
         let mut constants: Vec<(&str, f64)> = Queue::constants().to_vec();
+        constants.push(("WG", STAGE_WORKGROUP as f64));
         constants.extend_from_slice(extra_constants);
         let groups = layouts.of_pipeline(file)?;
         Ok(Stage {
@@ -90,24 +96,28 @@ impl Stage {
     }
 }
 
-/// `queue_args.wgsl` for queues [first, first + count).
+/// `queue_args.wgsl` for queues [first, first + count), consumed by stages of `stage_wg`
+/// threads a workgroup; `extra_constants` (`MAX_GROUPS`, `FETCH`) for a persistent consumer.
 pub fn queue_args(
     device: &wgpu::Device,
     layouts: &Layouts,
     first: u32,
     count: u32,
     stage_wg: u32,
+    extra_constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, GpuError> {
     let file = "render/queue_args.wgsl";
+    let mut constants = vec![
+        ("FIRST", first as f64),
+        ("COUNT", count as f64),
+        ("STAGE_WG", stage_wg as f64),
+    ];
+    constants.extend_from_slice(extra_constants);
     pipeline(
         device,
         file,
         "queue_args",
         &layouts.of_pipeline(file)?,
-        &[
-            ("FIRST", first as f64),
-            ("COUNT", count as f64),
-            ("STAGE_WG", stage_wg as f64),
-        ],
+        &constants,
     )
 }
