@@ -73,6 +73,27 @@ fn report_on_three_proxies_writes_every_image() {
     assert!(!ok && stderr.contains("not empty"), "{stderr}");
 }
 
+/// `facet report ARGS… --out page` in `dir` at 32² pixels, 2 spp, no sweep: its stdout and
+/// `page/index.html`.
+fn small_report(dir: &Path, args: &[&str]) -> (String, String) {
+    let mut all = vec!["report"];
+    all.extend_from_slice(args);
+    all.extend([
+        "--out",
+        "page",
+        "--resolution",
+        "32",
+        "--spp",
+        "2",
+        "--sweep",
+        "0",
+    ]);
+    let (ok, stdout, stderr) = facet_in(dir, &all);
+    assert!(ok, "{stdout}\n{stderr}");
+    let html = std::fs::read_to_string(dir.join("page/index.html")).unwrap();
+    (stdout, html)
+}
+
 /// The mean ΔE of `model` under `lighting` (`point` or `env`) as the run prints it:
 /// `mean ΔE (point): tabulated 1.26, ggx 2.06, beckmann 5.99, coated 0.62`.
 fn printed_mean(stdout: &str, lighting: &str, model: &str) -> f64 {
@@ -114,25 +135,7 @@ fn report_of_a_coated_measurement_shows_its_coated_model() {
     MerlTable::sample(&truth)
         .write(&dir.join("coated-gold.binary"))
         .unwrap();
-    let (ok, stdout, stderr) = facet_in(
-        &dir,
-        &[
-            "report",
-            "coated-gold.binary",
-            "--coat",
-            "always",
-            "--out",
-            "page",
-            "--resolution",
-            "32",
-            "--spp",
-            "2",
-            "--sweep",
-            "0",
-        ],
-    );
-    assert!(ok, "{stdout}\n{stderr}");
-    let html = std::fs::read_to_string(dir.join("page/index.html")).unwrap();
+    let (stdout, html) = small_report(&dir, &["coated-gold.binary", "--coat", "always"]);
     let sources = image_sources(&html);
     // 5 renders and 4 ΔE images per lighting, 2 plots; the scale and 8 mean images.
     assert_eq!(sources.len(), 2 * 9 + 2 + 1 + 8, "{sources:?}");
@@ -190,23 +193,7 @@ fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
         "base": base,
     });
     std::fs::write(dir.join("coated.json"), rec.to_string()).unwrap();
-    let (ok, stdout, stderr) = facet_in(
-        &dir,
-        &[
-            "report",
-            "coated.json",
-            "--out",
-            "page",
-            "--resolution",
-            "32",
-            "--spp",
-            "2",
-            "--sweep",
-            "0",
-        ],
-    );
-    assert!(ok, "{stdout}\n{stderr}");
-    let html = std::fs::read_to_string(dir.join("page/index.html")).unwrap();
+    let (stdout, html) = small_report(&dir, &["coated.json"]);
     assert!(html.contains("ΔE against the coated model"), "{html}");
     // The coated model is the reference: it has no ΔE of its own.
     assert!(!html.contains("de-coated.png"), "{html}");

@@ -22,7 +22,7 @@ pub struct MaterialReport {
     pub input: String,
     /// The file stem of its images (unique in the report).
     pub stem: String,
-    /// Whether the reference is the measurement (else the fit's own model, [`reference`]).
+    /// Whether the reference is the measurement (else the fit's own model, [`reference()`]).
     pub measured: bool,
     /// Whether the fit kept a coat (its coated model is then shown too).
     pub coated: bool,
