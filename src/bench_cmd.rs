@@ -52,12 +52,13 @@ pub struct BenchArgs {
     /// Only these sections (comma-separated; default: all).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub only: Vec<Section>,
-    /// The trace section times every traversal variant (workgroup sizes, persistent threads),
-    /// alternating them run by run, with GPU timestamps where the adapter has them (default:
-    /// the one every renderer uses, `per-ray/64`); the integrator section renders with each as
-    /// its extend stage too (`extend_variants`).
+    /// Time every variant of the stages, alternating them run by run: the trace section every
+    /// traversal variant (workgroup sizes, persistent threads) with GPU timestamps where the
+    /// adapter has them; the integrator section (`stage_variants`) the demo with each as its
+    /// extend stage, and with glints with the glint queue sorted by footprint class and not
+    /// (default: only what every renderer uses).
     #[arg(long)]
-    pub trace_variants: bool,
+    pub variants: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -265,15 +266,15 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     }
     if let Some(g) = &gpu {
         if on(Section::Trace) {
-            report["trace"] = trace::trace(g, &sizes, args.trace_variants)?;
+            report["trace"] = trace::trace(g, &sizes, args.variants)?;
         }
         if on(Section::Integrator) {
             let (integrator, stages, glint) = integrator(g, &sizes)?;
             report["integrator"] = integrator;
             report["stages"] = stages;
             report["glint"] = glint;
-            if args.trace_variants {
-                report["extend_variants"] = trace::extend_variants(g, &sizes)?;
+            if args.variants {
+                report["stage_variants"] = trace::stage_variants(g, &sizes)?;
             }
         }
         if on(Section::Viewer) {

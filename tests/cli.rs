@@ -968,10 +968,10 @@ fn bench_smoke_reports_every_section() {
     positive(&r["viewer"]["msamples_per_s"], "viewer Msamples/s");
 }
 
-/// `facet bench --only trace,integrator --trace-variants`: every traversal variant on every
-/// case (camera and random rays × closest and any), positive rates, each against the default
-/// variant of the same case (itself: exactly 1), the clock GPU timestamps where the adapter has
-/// them; and the integrator with each variant as its extend stage.
+/// `facet bench --only trace,integrator --variants`: every traversal variant on every case
+/// (camera and random rays × closest and any), positive rates, each against the default variant
+/// of the same case (itself: exactly 1), the clock GPU timestamps where the adapter has them;
+/// the integrator with each as its extend stage, and with the glint queue sorted and not.
 #[test]
 fn bench_times_every_trace_variant() {
     if facet_gpu::gpu_for_tests("bench_times_every_trace_variant").is_none() {
@@ -984,7 +984,7 @@ fn bench_times_every_trace_variant() {
         "--smoke",
         "--only",
         "trace,integrator",
-        "--trace-variants",
+        "--variants",
         "--json",
         json.to_str().unwrap(),
     ]);
@@ -1014,24 +1014,25 @@ fn bench_times_every_trace_variant() {
         "wall"
     };
     assert!(rows.iter().all(|row| row["clock"] == clock), "{clock}");
-    let extend = r["extend_variants"].as_array().unwrap();
-    let keys: Vec<String> = variants.iter().map(|v| v.key()).collect();
-    assert_eq!(
-        extend
-            .iter()
-            .map(|row| row["variant"].as_str().unwrap())
-            .collect::<Vec<_>>(),
-        keys
-    );
-    for row in extend {
+    let stages = r["stage_variants"].as_array().unwrap();
+    let mut want: Vec<(String, bool)> = variants.iter().map(|v| (v.key(), false)).collect();
+    let default = facet_render::trace::TraceVariant::DEFAULT.key();
+    want.extend([(default.clone(), false), (default, true)]);
+    let got: Vec<(String, bool)> = stages
+        .iter()
+        .map(|row| {
+            (
+                row["extend"].as_str().unwrap().into(),
+                row["sort_glints"] == true,
+            )
+        })
+        .collect();
+    assert_eq!(got, want);
+    for row in stages {
         let rate = row["msamples_per_s"].as_f64().unwrap();
         assert!(rate.is_finite() && rate > 0.0, "{row}");
-        assert!(
-            row["extend_iteration_ms"]
-                .as_f64()
-                .is_some_and(|ms| ms > 0.0),
-            "{row}"
-        );
+        let ms = row["stage_iteration_ms"].as_f64().unwrap();
+        assert!(ms > 0.0, "{row}");
     }
 }
 

@@ -6,10 +6,12 @@
 override STAGE_WG: u32;
 override FIRST: u32;
 override COUNT: u32;
-// A persistent consumer's: at most this many workgroups, and the counter it fetches batches
-// from, zeroed here (0xffffffff: none).
+// A persistent consumer's cap on its workgroups, and counters [ZERO_FIRST, ZERO_FIRST +
+// ZERO_COUNT) zeroed here for the consumers (a persistent extend stage's fetch counter, the
+// glint stages' footprint histograms).
 override MAX_GROUPS: u32 = 0xffffffffu;
-override FETCH: u32 = 0xffffffffu;
+override ZERO_FIRST: u32 = 0u;
+override ZERO_COUNT: u32 = 0u;
 
 @group(0) @binding(0) var<storage, read_write> counters: array<u32>;
 @group(0) @binding(1) var<storage, read_write> sizes: array<u32>;
@@ -27,7 +29,7 @@ fn queue_args() {
         args[3u * q + 1u] = select(0u, (groups + x - 1u) / max(x, 1u), x > 0u);
         args[3u * q + 2u] = 1u;
     }
-    if (FETCH != 0xffffffffu) {
-        counters[FETCH] = 0u;
+    for (var c = ZERO_FIRST; c < ZERO_FIRST + ZERO_COUNT; c++) {
+        counters[c] = 0u;
     }
 }

@@ -196,3 +196,70 @@ fn shade_glint(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     shade(slot);
 }
+
+// Grouping by footprint (facet_render::StageVariants::sort_glints): the queue is counting-sorted
+// by a footprint class before shading, so that a warp walks footprints of alike size: a
+// histogram of the classes (glint_histogram), its exclusive prefix sums (glint_offsets), the
+// slots scattered to their class's run (glint_scatter) in the generate queue's region, free from
+// the shading stages until the next iteration's logic stage, then shaded from there
+// (shade_glint_sorted). The class is recomputed rather than stored; each path's random numbers
+// depend on its pixel and sample only, so the image is the same.
+
+// The first of this material's GLINT_SORT_KEYS histogram counters (facet_render::queues).
+override Q_SORT: u32;
+override GLINT_SORT_KEYS: u32;
+
+// 0 for a path at its last bounce (shade ends it), else 1 + the octave of the flakes under the
+// footprint, density × area (the walk's work grows with them until the filter's mean takes over).
+fn footprint_class(slot: u32) -> u32 {
+    if (info[slot].z >= frame.max_depth) {
+        return 0u;
+    }
+    let hit = path_get(R_HIT, slot);
+    let s = surface_at(bitcast<u32>(hit.y), hit.z, hit.w, -path_get(R_DIR, slot).xyz);
+    let b = bsdf_setup(s, slot);
+    let flakes = field.density * footprint_area(b.a, b.b);
+    return 1u + u32(clamp(floor(log2(max(flakes, 1.0))), 0.0, f32(GLINT_SORT_KEYS - 2u)));
+}
+
+@compute @workgroup_size(WG)
+fn glint_histogram(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let slot = queue_slot(Q_SHADE, thread_index(gid, nwg));
+    if (slot == 0xffffffffu) {
+        return;
+    }
+    atomicAdd(&counters[Q_SORT + footprint_class(slot)], 1u);
+}
+
+// Dispatched over the queue like the others: its first invocation does the (short) scan.
+@compute @workgroup_size(WG)
+fn glint_offsets(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x != 0u || gid.y != 0u) {
+        return;
+    }
+    var sum = 0u;
+    for (var k = 0u; k < GLINT_SORT_KEYS; k++) {
+        let n = atomicLoad(&counters[Q_SORT + k]);
+        atomicStore(&counters[Q_SORT + k], sum);
+        sum += n;
+    }
+}
+
+@compute @workgroup_size(WG)
+fn glint_scatter(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let slot = queue_slot(Q_SHADE, thread_index(gid, nwg));
+    if (slot == 0xffffffffu) {
+        return;
+    }
+    let at = atomicAdd(&counters[Q_SORT + footprint_class(slot)], 1u);
+    queues[Q_GEN * frame.wavefront + at] = slot;
+}
+
+@compute @workgroup_size(WG)
+fn shade_glint_sorted(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = thread_index(gid, nwg);
+    if (i >= sizes[Q_SHADE]) {
+        return;
+    }
+    shade(queues[Q_GEN * frame.wavefront + i]);
+}

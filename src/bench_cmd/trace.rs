@@ -1,5 +1,5 @@
 //! The trace section: closest- and any-hit rays a second through `trace.wgsl` against procedural
-//! scenes of the mode's sizes, camera and random rays. With `--trace-variants` every
+//! scenes of the mode's sizes, camera and random rays. With `--variants` every
 //! [`TraceVariant`] is timed side by side: within each case the variants take turns run by run
 //! (one warm-up each first), so that a clock drifting during the section touches them alike.
 //! Each run is timed by the wall clock (submit to idle) and, where the adapter has timestamp
@@ -9,6 +9,7 @@ use super::{Sizes, median};
 use anyhow::Result;
 use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
+use facet_render::StageVariants;
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
 use facet_render::procedural::{self, Rng};
 use facet_render::trace::{GpuHit, RayTracer, TraceBatch, TraceQuery, TraceVariant};
@@ -187,10 +188,41 @@ impl Case<'_> {
     }
 }
 
-/// The integrator on the demo scene without glints (the integrator section's first case) with
-/// each extend-stage variant: Msamples/s of whole renders, the variants taking turns run by
-/// run after one warm-up each, and the extend stage's time in one iteration of each.
-pub fn extend_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
+/// The integrator with each [`StageVariants`] on the demo scene at the integrator section's
+/// size: without glints, the extend stage in every [`TraceVariant`]; with glints, the glint
+/// stage's queue unsorted and grouped by footprint class. Within each scene the variants take
+/// turns run by run after one warm-up each; Msamples/s of whole renders, against the scene's
+/// first (the default), and the time in one iteration of the stages a variant changes.
+pub fn stage_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
+    let (w, h, spp) = sizes.render;
+    println!(
+        "\nstage variants: the demo at {w} × {h}, depth 5, {spp} spp, median of {}",
+        sizes.runs
+    );
+    let extend = TraceVariant::ALL.map(|extend| StageVariants {
+        extend,
+        ..StageVariants::DEFAULT
+    });
+    let sort = [false, true].map(|sort_glints| StageVariants {
+        sort_glints,
+        ..StageVariants::DEFAULT
+    });
+    let mut rows = Vec::new();
+    for (glints, variants, stage) in [(false, &extend[..], "extend"), (true, &sort[..], "glint")] {
+        rows.extend(compare(gpu, sizes, glints, variants, stage)?);
+    }
+    Ok(Value::Array(rows))
+}
+
+/// One scene's rows of [`stage_variants`]; `stage` names the stages whose time is reported
+/// (those whose name contains it).
+fn compare(
+    gpu: &Gpu,
+    sizes: &Sizes,
+    glints: bool,
+    variants: &[StageVariants],
+    stage: &str,
+) -> Result<Vec<Value>> {
     let (w, h, spp) = sizes.render;
     let image = facet_render::ImageConfig {
         width: w,
@@ -202,29 +234,21 @@ pub fn extend_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         max_depth: 5,
         ..facet_render::SampleConfig::standard()
     };
-    let (scene, env) = super::demo_scene(false)?;
-    let res = facet_render::SceneResources::new(
-        gpu,
-        &scene,
-        Some(&env),
-        facet_render::ResourceConfig::standard(),
-    )?;
+    let (scene, env) = super::demo_scene(glints)?;
+    let config = facet_render::ResourceConfig::standard();
+    let res = facet_render::SceneResources::new(gpu, &scene, Some(&env), config)?;
     let camera = facet_render::camera::CameraFrame::new(&scene.camera)?;
     let mut runs = Vec::new();
-    for v in TraceVariant::ALL {
-        let integrator = facet_render::Integrator::with_extend(&gpu.device, &res, v)?;
+    for &v in variants {
+        let integrator = facet_render::Integrator::with_variants(&gpu.device, &res, v)?;
         let wf = integrator.wavefront(gpu, &res, image)?;
         runs.push((integrator, wf, Vec::new()));
     }
-    println!(
-        "\nextend variants: the demo without glints at {w} × {h}, depth 5, {spp} spp, median of {}",
-        sizes.runs
-    );
+    // Round 0 warms up.
     for round in 0..=sizes.runs.max(1) {
         for (integrator, wf, ms) in &mut runs {
             wf.clear(gpu);
             let stats = integrator.render_more(gpu, wf, &camera, &sampling, &mut |_| {})?;
-            // Round 0 warms up.
             if round > 0 {
                 ms.push(stats.ms);
             }
@@ -238,18 +262,33 @@ pub fn extend_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         let base = *base.get_or_insert(msps);
         let (times, clock) =
             integrator.profile_iteration(gpu, wf, &camera, &sampling, sizes.stage_warm)?;
-        let extend_ms = times.iter().find(|t| t.stage == "extend").map(|t| t.ms);
-        let key = integrator.extend_variant().key();
+        let stage_ms: f64 = times
+            .iter()
+            .filter(|t| t.stage.contains(stage))
+            .map(|t| t.ms)
+            .sum();
+        let v = integrator.variants();
+        let key = format!(
+            "extend {}, glints {}",
+            v.extend.key(),
+            if v.sort_glints { "sorted" } else { "unsorted" }
+        );
         println!(
-            "  {key:<20} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; extend {:.3} ms of one iteration, {clock:?})",
+            "  {:<15} {key:<42} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; {stage} stages {stage_ms:.3} ms of one iteration, {clock:?})",
+            if glints {
+                "with glints"
+            } else {
+                "without glints"
+            },
             msps / base,
-            extend_ms.unwrap_or(f64::NAN)
         );
         rows.push(json!({
-            "variant": key, "msamples_per_s": msps, "ms": ms, "vs_default": msps / base,
-            "extend_iteration_ms": extend_ms, "stage_clock": format!("{clock:?}").to_lowercase(),
+            "glints": glints, "extend": v.extend.key(), "sort_glints": v.sort_glints,
+            "msamples_per_s": msps, "ms": ms, "vs_default": msps / base,
+            "stage": stage, "stage_iteration_ms": stage_ms,
+            "stage_clock": format!("{clock:?}").to_lowercase(),
             "width": w, "height": h, "spp": spp, "depth": 5,
         }));
     }
-    Ok(Value::Array(rows))
+    Ok(rows)
 }

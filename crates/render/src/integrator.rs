@@ -17,13 +17,13 @@ use crate::config::{ImageConfig, RenderConfig, SampleConfig};
 use crate::error::RenderError;
 use crate::film::Image;
 use crate::gpu_types::GpuFrame;
-use crate::queues::{FETCH_COUNTER, Queue};
+use crate::queues::{COUNTERS, FETCH_COUNTER, GLINT_SORT_KEYS, Queue, SORT_COUNTERS};
 use crate::resources::SceneResources;
 use crate::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};
 use crate::trace::{TraceSchedule, TraceVariant};
 use crate::wavefront::Wavefront;
-use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
+use facet_gpu::{Gpu, GpuError};
 use std::time::Instant;
 
 /// Encodes one stage into the pass it is given.
@@ -99,54 +99,50 @@ pub struct Integrator {
     n_queues: u32,
     /// Workgroup size of the stages dispatched over every slot.
     wg: u32,
-    /// How the extend stage hands rays to threads.
-    extend_variant: TraceVariant,
+    /// The variants its stages were built in.
+    variants: StageVariants,
+}
+
+/// How the integrator's stages schedule their work: variants chosen when its pipelines are
+/// built, each rendering the default's image to the bit at another speed (issue 51 times them on
+/// a real GPU: `facet bench --variants`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StageVariants {
+    /// How the extend stage hands rays to threads (its workgroup size; persistent threads).
+    pub extend: TraceVariant,
+    /// Group each glint stage's queue by footprint class before shading (a counting sort), so
+    /// that a warp walks footprints of alike size.
+    pub sort_glints: bool,
+}
+
+impl StageVariants {
+    /// What every renderer uses.
+    pub const DEFAULT: StageVariants = StageVariants {
+        extend: TraceVariant::DEFAULT,
+        sort_glints: false,
+    };
 }
 
 impl Integrator {
     /// The pipelines for the material classes of `scene`.
     pub fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
-        Self::with_extend(device, scene, TraceVariant::DEFAULT)
+        Self::with_variants(device, scene, StageVariants::DEFAULT)
     }
 
-    /// [`Integrator::new`] with the extend stage scheduled as `extend` says (its workgroup
-    /// size; one thread per ray or persistent threads): the same image, at another speed.
-    pub fn with_extend(
+    /// [`Integrator::new`] with its stages scheduled as `variants` says: the same image, at
+    /// another speed.
+    pub fn with_variants(
         device: &wgpu::Device,
         scene: &SceneResources,
-        extend: TraceVariant,
+        variants: StageVariants,
     ) -> Result<Self, RenderError> {
+        let extend = variants.extend;
         extend.validate(device)?;
         let layouts = Layouts::new(device);
         let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
             Stage::new(device, &layouts, file, entry, queue, extra)
         };
-        let mut shade = Vec::new();
-        for &q in &scene.queues_used {
-            let q_shade = [("Q_SHADE", q.index() as f64)];
-            let s = match q {
-                Queue::Diffuse => stage(
-                    "render/shade_diffuse.wgsl",
-                    "shade_diffuse",
-                    Some(q),
-                    &q_shade,
-                )?,
-                Queue::Analytic | Queue::Tabulated | Queue::Merl => stage(
-                    "render/shade_microfacet.wgsl",
-                    "shade_microfacet",
-                    Some(q),
-                    &microfacet_constants(q),
-                )?,
-                Queue::Rgl => stage("render/shade_rgl.wgsl", "shade_rgl", Some(q), &q_shade)?,
-                Queue::Glint(_) => {
-                    let mut c = facet_glint::gpu::flake_constants();
-                    c.push(q_shade[0]);
-                    stage("render/shade_glint.wgsl", "shade_glint", Some(q), &c)?
-                }
-                _ => continue,
-            };
-            shade.push(s);
-        }
+        let shade = shading_stages(device, &layouts, scene, variants.sort_glints)?;
         let n_queues = Queue::count(scene.glints.len() as u32);
         let wg = STAGE_WORKGROUP;
         let extend_wg = [("WG", extend.workgroup as f64)];
@@ -156,9 +152,20 @@ impl Integrator {
                 "extend_persistent",
                 vec![
                     ("MAX_GROUPS", groups as f64),
-                    ("FETCH", FETCH_COUNTER as f64),
+                    ("ZERO_FIRST", FETCH_COUNTER as f64),
+                    ("ZERO_COUNT", 1.0),
                 ],
             ),
+        };
+        // The glint stages' histograms start from 0 at every iteration.
+        let shade_close = [
+            ("ZERO_FIRST", SORT_COUNTERS as f64),
+            ("ZERO_COUNT", (COUNTERS - SORT_COUNTERS) as f64),
+        ];
+        let shade_close = if variants.sort_glints {
+            &shade_close[..]
+        } else {
+            &[]
         };
         Ok(Integrator {
             logic: stage("render/logic.wgsl", "logic", None, &[])?,
@@ -190,20 +197,20 @@ impl Integrator {
                 Queue::Diffuse.index(),
                 n_queues - Queue::Diffuse.index(),
                 wg,
-                &[],
+                shade_close,
             )?,
             close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg, &[])?,
             shade,
             layouts,
             n_queues,
             wg,
-            extend_variant: extend,
+            variants,
         })
     }
 
-    /// How the extend stage hands rays to threads.
-    pub fn extend_variant(&self) -> TraceVariant {
-        self.extend_variant
+    /// The variants its stages were built in.
+    pub fn variants(&self) -> StageVariants {
+        self.variants
     }
 
     /// Names of the stages built (shading stages once per class).
@@ -512,7 +519,8 @@ impl Integrator {
         each("close shade", &mut |p| close(p, &self.close_shade));
         for s in &self.shade {
             let name = match s.queue {
-                Some(Queue::Glint(k)) => format!("shade glint {k}"),
+                Some(Queue::Glint(k)) if s.name == "shade_glint" => format!("shade glint {k}"),
+                Some(Queue::Glint(k)) => format!("{} {k}", s.name.replace('_', " ")),
                 Some(q) => format!("shade {}", q.class_name()),
                 None => s.name.to_string(),
             };
@@ -521,6 +529,65 @@ impl Integrator {
         each("close shadow", &mut |p| close(p, &self.close_shadow));
         each("connect", &mut |p| run(p, &self.connect));
     }
+}
+
+/// The shading stages of `scene`'s material classes, in queue order: one per class, and for a
+/// glint material with `sort_glints` the three passes that group its queue by footprint class
+/// before the one that shades it.
+fn shading_stages(
+    device: &wgpu::Device,
+    layouts: &Layouts,
+    scene: &SceneResources,
+    sort_glints: bool,
+) -> Result<Vec<Stage>, GpuError> {
+    let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
+        Stage::new(device, layouts, file, entry, queue, extra)
+    };
+    let mut shade = Vec::new();
+    for &q in &scene.queues_used {
+        let q_shade = [("Q_SHADE", q.index() as f64)];
+        match q {
+            Queue::Diffuse => shade.push(stage(
+                "render/shade_diffuse.wgsl",
+                "shade_diffuse",
+                Some(q),
+                &q_shade,
+            )?),
+            Queue::Analytic | Queue::Tabulated | Queue::Merl => shade.push(stage(
+                "render/shade_microfacet.wgsl",
+                "shade_microfacet",
+                Some(q),
+                &microfacet_constants(q),
+            )?),
+            Queue::Rgl => shade.push(stage(
+                "render/shade_rgl.wgsl",
+                "shade_rgl",
+                Some(q),
+                &q_shade,
+            )?),
+            Queue::Glint(k) => {
+                let mut c = facet_glint::gpu::flake_constants();
+                c.push(q_shade[0]);
+                c.push(("Q_SORT", (SORT_COUNTERS + k * GLINT_SORT_KEYS) as f64));
+                c.push(("GLINT_SORT_KEYS", GLINT_SORT_KEYS as f64));
+                let entries: &[&'static str] = if sort_glints {
+                    &[
+                        "glint_histogram",
+                        "glint_offsets",
+                        "glint_scatter",
+                        "shade_glint_sorted",
+                    ]
+                } else {
+                    &["shade_glint"]
+                };
+                for &entry in entries {
+                    shade.push(stage("render/shade_glint.wgsl", entry, Some(q), &c)?);
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(shade)
 }
 
 /// The frame uniform, assembled here only: the image and the scene's part from `wf`, the

@@ -108,7 +108,7 @@ impl TraceVariant {
     /// The kernel every other user of the traversal gets.
     pub const DEFAULT: TraceVariant = TraceVariant::per_ray(64);
 
-    /// The variants `facet bench --only trace --trace-variants` times side by side: workgroup
+    /// The variants `facet bench --only trace --variants` times side by side: workgroup
     /// sizes about the SIMD widths (32 on NVIDIA, 64 on AMD), and persistent threads with one
     /// warp per workgroup (the paper's) at two occupancies of a large GPU (an H100 has 132
     /// SMs of 64 warps: 8448 warps) and with two warps.

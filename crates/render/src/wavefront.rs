@@ -11,7 +11,7 @@ use crate::error::RenderError;
 use crate::film::Image;
 use crate::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
 use crate::limits::{DeviceLimits, Planned, product};
-use crate::queues::FETCH_COUNTER;
+use crate::queues::{COUNTERS, FETCH_COUNTER};
 use crate::resources::SceneResources;
 use crate::stages::Layouts;
 use crate::tags::SlotState;
@@ -303,8 +303,8 @@ impl Buffers {
             frame: buffer::uniform(d, "frame", &GpuFrame::default()),
             paths: buffer::storage_zeroed(d, "paths", PATH_REGIONS * w * 16),
             info: buffer::storage_zeroed(d, "path info", w * 16),
-            // Every queue's, and the persistent extend stage's past them all.
-            counters: buffer::storage_zeroed(d, "queue counters", (FETCH_COUNTER as u64 + 1) * 4),
+            // Every queue's, then the persistent extend stage's and the glint histograms.
+            counters: buffer::storage_zeroed(d, "queue counters", COUNTERS as u64 * 4),
             sizes: buffer::storage_zeroed(d, "queue sizes", nq * 4),
             args: d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("queue dispatch args"),
