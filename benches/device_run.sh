@@ -6,8 +6,9 @@
 # the checkout's path where they were built). Results and
 # one log go to $OUT (default ./device_out). To stage (Vulkan loader packages from Debian's
 # libvulkan1 in .gpu/debs): cargo build --release, cargo bench --no-run, cargo test --release
-# --no-run -p facet-glint --test glint_flakes --test glint, and -p facet-fit --test gpu_fit,
-# copied and stripped into .gpu/bin.
+# --no-run -p facet-glint --test glint_flakes --test glint, -p facet-fit --test gpu_fit and
+# -p facet-render --test bvh --test integrator (every traversal, extend and glint variant against
+# obvhs and the default's image on the real GPU), copied and stripped into .gpu/bin as test-NAME.
 # Usage, from the repository root:
 #   bash benches/device_run.sh [MODE]        # MODE: facet bench --mode (default: default)
 set -u
@@ -40,7 +41,7 @@ step() { echo; echo "== $1 ($(date +%T))"; }
     step "glint_gpu_count (criterion)"
     timeout 45 $b/bench-glint --bench glint_gpu_count --warm-up-time 1 --measurement-time 3
     step "GPU tests"
-    for t in glint_flakes glint gpu_fit; do
+    for t in glint_flakes glint gpu_fit bvh integrator; do
         timeout 60 $b/test-$t --test-threads 8 2>&1 | tail -25
     done
     step "facet bench --mode $mode (fit)"
