@@ -104,8 +104,8 @@ pub struct Integrator {
 }
 
 /// How the integrator's stages schedule their work: variants chosen when its pipelines are
-/// built, each rendering the default's image to the bit at another speed (issue 51 times them on
-/// a real GPU: `facet bench --variants`).
+/// built, each rendering the default's image to the bit at another speed (`facet bench
+/// --variants` times them side by side).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StageVariants {
     /// How the extend stage hands rays to threads (its workgroup size; persistent threads).

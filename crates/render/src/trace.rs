@@ -76,8 +76,8 @@ pub enum TraceSchedule {
     },
 }
 
-/// A traversal kernel's variant, chosen when its pipelines are built: the ideas issue 51 times on
-/// a real GPU, each checked against obvhs on the CPU (`crates/render/tests/bvh.rs`). The
+/// A traversal kernel's variant, chosen when its pipelines are built, each checked against obvhs
+/// on the CPU (`crates/render/tests/bvh.rs`) and timed by `facet bench --variants`. The
 /// traversal itself (Ylitie et al. 2017's compressed wide BVH, octant-ordered children, the
 /// short stack of node groups) is the same in all of them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
