@@ -55,7 +55,7 @@ pub struct ReportArgs {
     #[arg(long, default_value_t = 90, value_parser = crate::args::resolution)]
     fit_resolution: usize,
     /// When the fits search a clear coat, as `facet fit --coat`: `auto` where the single
-    /// layer's tabulated error is above 0.03 (4–8 s more for such a material on two cores),
+    /// layer's tabulated error is above 0.03 (3–8 s more for such a material on two cores),
     /// `always`, or `off`. A fit that keeps a coat gets one more sphere, its coated model,
     /// beside the single layer's three; a fit JSON that kept one shows it whatever this says.
     #[arg(long, value_enum, default_value = "auto")]

@@ -26,6 +26,7 @@ use crate::model::rgb::Rgb;
 use crate::numerics::optim::brent;
 use crate::sources::merl::MerlBrdf;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// The coat's index of refraction: a clear lacquer's (car paints' coats are 1.45–1.55).
 pub const COAT_ETA: f64 = 1.5;
@@ -196,13 +197,17 @@ pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamp
         ..coat
     };
     // α searched at each of a few weights: the score has several minima on real paints, and
-    // at an α off the true one a lower weight hides the mismatch.
-    let coat = START_WEIGHTS
-        .iter()
+    // at an α off the true one a lower weight hides the mismatch. The searches are independent:
+    // run side by side (the fits inside them leave cores idle), the best taken in order.
+    let starts: Vec<(f64, Coat)> = START_WEIGHTS
+        .par_iter()
         .map(|&w| {
             let c = by_alpha(Coat::new(COAT_ETA, ALPHA_START, w), ALPHA_RANGE, 0.003);
             (score(c), c)
         })
+        .collect();
+    let coat = starts
+        .into_iter()
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, c)| c)
         .expect("START_WEIGHTS is not empty");
