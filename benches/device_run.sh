@@ -9,6 +9,10 @@
 # --no-run -p facet-glint --test glint_flakes --test glint, -p facet-fit --test gpu_fit and
 # -p facet-render --test bvh --test integrator (every traversal, extend and glint variant against
 # obvhs and the default's image on the real GPU), copied and stripped into .gpu/bin as test-NAME.
+# The working tree that travels is limited to 64 MiB, and these seven binaries take about 65 MB
+# stripped: pack them, and only them, into .gpu/bin.tar.gz (about 26 MB), which this script
+# unpacks into .gpu/bin:
+#   (cd .gpu/bin && tar -czf ../bin.tar.gz facet bench-glint test-*) && rm -rf .gpu/bin
 # Usage, from the repository root:
 #   bash benches/device_run.sh [MODE]        # MODE: facet bench --mode (default: default)
 set -u
@@ -30,6 +34,7 @@ if [[ -n $root && ! -e $root ]]; then mkdir -p "$(dirname "$root")" && ln -s "$P
 # Where the GPU tests record a skip (CARGO_TARGET_TMPDIR as built).
 [[ -n $root ]] && mkdir -p "$root/target/tmp"
 b=.gpu/bin
+if [[ -f .gpu/bin.tar.gz ]]; then mkdir -p "$b" && tar -xzf .gpu/bin.tar.gz -C "$b"; fi
 step() { echo; echo "== $1 ($(date +%T))"; }
 {
     command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,power.draw,temperature.gpu,utilization.gpu --format=csv
