@@ -488,11 +488,12 @@ fn demo_scene(glints: bool) -> Result<(Scene, Environment)> {
     Ok((scene, Environment::Map(Arc::new(map))))
 }
 
-fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
-    let (w, h, spp) = sizes.render;
+/// The integrator section's image and sampling: the mode's size and spp, depth 5.
+fn demo_render(sizes: &Sizes) -> (ImageConfig, SampleConfig) {
+    let (width, height, spp) = sizes.render;
     let image = ImageConfig {
-        width: w,
-        height: h,
+        width,
+        height,
         ..ImageConfig::standard()
     };
     let sampling = SampleConfig {
@@ -500,6 +501,12 @@ fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
         max_depth: 5,
         ..SampleConfig::standard()
     };
+    (image, sampling)
+}
+
+fn integrator(gpu: &Gpu, sizes: &Sizes) -> Result<(Value, Value, Value)> {
+    let (w, h, spp) = sizes.render;
+    let (image, sampling) = demo_render(sizes);
     let mut rows = Vec::new();
     let mut stages = json!({});
     // Msamples/s without glints, with glints (the filter on), and with the filter off.

@@ -224,16 +224,7 @@ fn compare(
     stage: &str,
 ) -> Result<Vec<Value>> {
     let (w, h, spp) = sizes.render;
-    let image = facet_render::ImageConfig {
-        width: w,
-        height: h,
-        ..facet_render::ImageConfig::standard()
-    };
-    let sampling = facet_render::SampleConfig {
-        spp,
-        max_depth: 5,
-        ..facet_render::SampleConfig::standard()
-    };
+    let (image, sampling) = super::demo_render(sizes);
     let (scene, env) = super::demo_scene(glints)?;
     let config = facet_render::ResourceConfig::standard();
     let res = facet_render::SceneResources::new(gpu, &scene, Some(&env), config)?;
