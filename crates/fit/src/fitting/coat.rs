@@ -18,15 +18,22 @@ use crate::fitting::{CoatSearch, FitConfig, Models};
 use crate::metric::grid::{GridSamples, error_metric};
 use crate::model::brdf::Brdf;
 use crate::model::coat::{Coat, CoatLayer, Coated};
+use crate::model::fresnel::dielectric;
+use crate::model::geometry::azimuth_between;
 use crate::model::material::{CoatRecord, CoatedModels, FittedMaterial};
 use crate::model::merl_grid::MerlTable;
-use crate::model::merl_grid::bin_directions;
-use crate::model::microfacet::MicrofacetBrdf;
+use crate::model::merl_grid::{
+    PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles, bin_directions, index,
+};
+use crate::model::microfacet::{
+    AnalyticNdf, MicrofacetBrdf, NdfKind, correlation, g2, lambda_from_alpha_tan,
+};
 use crate::model::rgb::Rgb;
 use crate::numerics::optim::brent;
 use crate::sources::merl::MerlBrdf;
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::{Mutex, OnceLock};
 
 /// The coat's index of refraction: a clear lacquer's (car paints' coats are 1.45–1.55).
 pub const COAT_ETA: f64 = 1.5;
@@ -78,16 +85,84 @@ impl CoatedFit {
 /// The data as the base must be under `layer`, at inside directions.
 pub struct SeenFromInside<'a> {
     /// The measurement on the MERL grid.
-    pub data: &'a MerlTable,
+    data: &'a MerlTable,
     /// The coat over the base.
-    pub layer: &'a CoatLayer,
+    layer: &'a CoatLayer,
+    /// The coat's lobe at the grid's bins.
+    lobe: LobeAtBins,
 }
 
 /// Where tan²θh / α_c² is below this the coat's lobe is subtracted on the grid (D_c above
 /// 1/101² of its peak); elsewhere at the point.
 const SHARP_LOBE: f64 = 100.0;
 
-impl SeenFromInside<'_> {
+/// The coat's lobe w F D G2 / (4 cos θi cos θo) at the MERL grid's bins, as
+/// [`CoatLayer::reflection`] gives it at [`bin_directions`], from tables: D per θh bin, F per θd
+/// bin (the bin's half vector and θd are exact), and the azimuthal correlation λ(φ) per bin,
+/// computed once for every candidate coat. The subtraction near the lobe's peak evaluates it at
+/// 8 corners of most cells of every candidate's table: the acos of φ dominated the search.
+struct LobeAtBins {
+    weight: f64,
+    alpha2: f64,
+    d: [f64; THETA_H_RES],
+    f: [f64; THETA_D_RES],
+}
+
+impl LobeAtBins {
+    fn new(coat: &Coat) -> Self {
+        let ndf = AnalyticNdf::isotropic(NdfKind::Ggx, coat.alpha);
+        LobeAtBins {
+            weight: coat.weight,
+            alpha2: coat.alpha * coat.alpha,
+            d: std::array::from_fn(|a| {
+                let (s, c) = bin_angles(a, 0, 0).theta_h.sin_cos();
+                ndf.d(DVec3::new(s, 0.0, c))
+            }),
+            f: std::array::from_fn(|b| dielectric(bin_angles(0, b, 0).theta_d.cos(), coat.eta)),
+        }
+    }
+
+    /// The lobe at bin (a, b, c); 0 where a direction is below the horizon.
+    fn at(&self, a: usize, b: usize, c: usize) -> f64 {
+        let (wi, wo) = bin_directions(a, b, c);
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return 0.0;
+        }
+        // Λ of GGX at α² tan²θ = α² (x² + y²) / z²
+        let lambda = |w: DVec3| {
+            let a2t2 = (w.x * w.x + w.y * w.y) * self.alpha2 / (w.z * w.z);
+            lambda_from_alpha_tan(NdfKind::Ggx, a2t2)
+        };
+        let g = g2(lambda(wi), lambda(wo), bin_correlation()[index(a, b, c)]);
+        self.weight * self.f[b] * self.d[a] * g / (4.0 * wi.z * wo.z)
+    }
+}
+
+/// λ(φ) of G2's correlation at every bin of the MERL grid, φ the azimuth between the bin's two
+/// directions (11.7 MB, built on first use).
+fn bin_correlation() -> &'static [f64] {
+    static TABLE: OnceLock<Vec<f64>> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        (0..SAMPLES)
+            .into_par_iter()
+            .map(|n| {
+                let (c, rest) = (n % PHI_D_RES, n / PHI_D_RES);
+                let (b, a) = (rest % THETA_D_RES, rest / THETA_D_RES);
+                debug_assert_eq!(index(a, b, c), n);
+                let (wi, wo) = bin_directions(a, b, c);
+                correlation(azimuth_between(wi, wo))
+            })
+            .collect()
+    })
+}
+
+impl<'a> SeenFromInside<'a> {
+    /// `data` as a base under `layer` must be.
+    pub fn new(data: &'a MerlTable, layer: &'a CoatLayer) -> Self {
+        let lobe = LobeAtBins::new(&layer.coat);
+        SeenFromInside { data, layer, lobe }
+    }
+
     /// The data less the coat's lobe at outside directions (i, o). Near the lobe's peak the
     /// lobe is subtracted at each grid sample before interpolating
     /// ([`MerlTable::lookup_interpolated_less`]): the grid's interpolation of a sharp lobe is
@@ -99,10 +174,8 @@ impl SeenFromInside<'_> {
             let r = self.layer.reflection(i, o);
             return Some(self.data.lookup_interpolated(i, o)?.map(|v| v - r));
         }
-        self.data.lookup_interpolated_less(i, o, |a, b, c| {
-            let (bi, bo) = bin_directions(a, b, c);
-            self.layer.reflection(bi, bo)
-        })
+        self.data
+            .lookup_interpolated_less(i, o, |a, b, c| self.lobe.at(a, b, c))
     }
 }
 
@@ -127,7 +200,7 @@ pub fn fit_base(
     cfg: &FitConfig,
     phi_stride: usize,
 ) -> Result<FittedMaterial, FitError> {
-    let seen = SeenFromInside { data, layer };
+    let seen = SeenFromInside::new(data, layer);
     let name = format!("{}-base", src.name());
     let table = MerlTable::from_fn_where(|_, _, k| k % phi_stride == 0, |wi, wo| seen.eval(wi, wo));
     let under = MerlBrdf::from_table(&name, table).map_err(|problem| FitError::Extraction {
@@ -178,7 +251,17 @@ fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &Gr
 /// weight, then α again within ±10 %.
 pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamples) -> Coat {
     let set = full.subsample(SEARCH_STRIDE);
-    let score = |coat: Coat| score(src, data, coat, cfg, &set);
+    // Each coat scored once: Brent's method starts each phase at a coat already scored.
+    let scored = Mutex::new(Vec::<(Coat, f64)>::new());
+    let score = |coat: Coat| {
+        let known = |s: &[(Coat, f64)]| s.iter().find(|(c, _)| *c == coat).map(|&(_, e)| e);
+        if let Some(e) = known(&scored.lock().expect("no panic holds it")) {
+            return e;
+        }
+        let e = score(src, data, coat, cfg, &set);
+        scored.lock().expect("no panic holds it").push((coat, e));
+        e
+    };
     // Brent's method in ln α on [lo, hi], to `tol` times |ln α| (about 3 ln α's bits).
     let by_alpha = |coat: Coat, (lo, hi): (f64, f64), tol: f64| Coat {
         alpha: brent(
@@ -256,4 +339,36 @@ pub fn fit_coat(
         error,
         models: CoatedModels { layer, base },
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tabulated lobe is [`CoatLayer::reflection`] at the bins' directions, to rounding
+    /// (relative 1e-12: D and F from the bins' exact angles, not from the normalised sum of
+    /// the two directions), for a sharp and a rough coat at grazing, backscattering and
+    /// forward bins, and 0 where a direction is below the horizon.
+    #[test]
+    fn the_lobe_at_bins_is_the_layers_reflection() {
+        for coat in [Coat::new(1.5, 0.004, 0.3), Coat::new(1.5, 0.4, 1.0)] {
+            let (layer, bins) = (CoatLayer::new(coat).unwrap(), LobeAtBins::new(&coat));
+            let (mut checked, mut below) = (0, 0);
+            for a in (0..THETA_H_RES).step_by(7).chain([THETA_H_RES - 1]) {
+                for b in (0..THETA_D_RES).step_by(11).chain([THETA_D_RES - 1]) {
+                    for c in (0..PHI_D_RES).step_by(13).chain([PHI_D_RES - 1]) {
+                        let (wi, wo) = bin_directions(a, b, c);
+                        let (got, want) = (bins.at(a, b, c), layer.reflection(wi, wo));
+                        assert!(
+                            (got - want).abs() <= 1e-12 * want.abs(),
+                            "{coat:?} at bin ({a}, {b}, {c}): {got} against {want}"
+                        );
+                        checked += 1;
+                        below += usize::from(wi.z <= 0.0 || wo.z <= 0.0);
+                    }
+                }
+            }
+            assert!(below > 0 && below < checked, "{below} of {checked} below");
+        }
+    }
 }
