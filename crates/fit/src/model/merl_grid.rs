@@ -157,29 +157,30 @@ impl MerlTable {
         f: impl Fn(DVec3, DVec3) -> Option<Rgb> + Sync,
     ) -> Self {
         let mut raw = vec![(-1.0f64).to_le_bytes(); 3 * SAMPLES];
-        let values: Vec<(usize, Rgb)> = (0..SAMPLES)
-            .into_par_iter()
-            .filter_map(|s| {
-                let (i, j, k) = (
-                    s / (PHI_D_RES * THETA_D_RES),
-                    s / PHI_D_RES % THETA_D_RES,
-                    s % PHI_D_RES,
-                );
-                if !keep(i, j, k) {
-                    return None;
+        // One θh row of the three channels at a time, written where it is computed.
+        const ROW: usize = THETA_D_RES * PHI_D_RES;
+        let (red, rest) = raw.split_at_mut(SAMPLES);
+        let (green, blue) = rest.split_at_mut(SAMPLES);
+        let rows = red.par_chunks_mut(ROW).zip(green.par_chunks_mut(ROW));
+        rows.zip(blue.par_chunks_mut(ROW))
+            .enumerate()
+            .for_each(|(i, ((r, g), b))| {
+                for s in 0..ROW {
+                    let (j, k) = (s / PHI_D_RES, s % PHI_D_RES);
+                    if !keep(i, j, k) {
+                        continue;
+                    }
+                    let (wi, wo) = bin_directions(i, j, k);
+                    if wi.z <= 0.0 || wo.z <= 0.0 {
+                        continue;
+                    }
+                    if let Some(v) = f(wi, wo) {
+                        r[s] = (v[0] / SCALE[0]).to_le_bytes();
+                        g[s] = (v[1] / SCALE[1]).to_le_bytes();
+                        b[s] = (v[2] / SCALE[2]).to_le_bytes();
+                    }
                 }
-                let (wi, wo) = bin_directions(i, j, k);
-                if wi.z <= 0.0 || wo.z <= 0.0 {
-                    return None;
-                }
-                f(wi, wo).map(|v| (s, v))
-            })
-            .collect();
-        for (s, v) in values {
-            for c in 0..3 {
-                raw[c * SAMPLES + s] = (v[c] / SCALE[c]).to_le_bytes();
-            }
-        }
+            });
         MerlTable {
             raw: Stored::Owned(raw),
         }
