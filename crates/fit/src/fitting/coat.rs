@@ -23,7 +23,7 @@ use crate::model::geometry::azimuth_between;
 use crate::model::material::{CoatRecord, CoatedModels, FittedMaterial};
 use crate::model::merl_grid::MerlTable;
 use crate::model::merl_grid::{
-    PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles, bin_directions, index,
+    GridPoint, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles, bin_directions, index,
 };
 use crate::model::microfacet::{
     AnalyticNdf, MicrofacetBrdf, NdfKind, correlation, g2, lambda_from_alpha_tan,
@@ -82,14 +82,89 @@ impl CoatedFit {
     }
 }
 
-/// The data as the base must be under `layer`, at inside directions.
-pub struct SeenFromInside<'a> {
+/// The data as the base must be under `layer`, at the inside directions of the grid's bins.
+struct SeenFromInside<'a> {
     /// The measurement on the MERL grid.
     data: &'a MerlTable,
     /// The coat over the base.
     layer: &'a CoatLayer,
     /// The coat's lobe at the grid's bins.
     lobe: LobeAtBins,
+    /// Where each inside bin's outside pair falls on the grid.
+    places: &'a GridPlaces,
+}
+
+/// Where the outside pair of each inside bin a table under the coat holds (every
+/// `phi_stride`-th φd bin) falls on the grid: it depends on η alone, so a search (one η)
+/// places its bins once for every candidate (14.6 MB at a stride of 4) and a single fit places
+/// them as it goes. Placing a pair (its θh, θd and φd) cost as much as the rest of a table.
+pub struct GridPlaces {
+    eta: f64,
+    phi_stride: usize,
+    placed: Option<Vec<Option<GridPoint>>>,
+}
+
+impl GridPlaces {
+    /// The bins of every `phi_stride`-th φd bin (a divisor of [`PHI_D_RES`]) under a coat of
+    /// index `eta`, placed now.
+    pub fn placed(eta: f64, phi_stride: usize) -> Self {
+        debug_assert!(PHI_D_RES.is_multiple_of(phi_stride));
+        let per_row = PHI_D_RES / phi_stride;
+        let mut places = GridPlaces {
+            eta,
+            phi_stride,
+            placed: None,
+        };
+        let placed = (0..THETA_H_RES * THETA_D_RES * per_row)
+            .into_par_iter()
+            .map(|n| {
+                let (ij, k) = (n / per_row, n % per_row * phi_stride);
+                places.place(ij / THETA_D_RES, ij % THETA_D_RES, k)
+            })
+            .collect();
+        places.placed = Some(placed);
+        places
+    }
+
+    /// Every bin under a coat of index `eta`, placed when asked.
+    pub fn on_demand(eta: f64) -> Self {
+        GridPlaces {
+            eta,
+            phi_stride: 1,
+            placed: None,
+        }
+    }
+
+    /// Bin (i, j, k)'s outside pair and its place; `None` for a bin the table does not hold,
+    /// below the horizon, or past the critical angle.
+    fn get(&self, i: usize, j: usize, k: usize) -> Option<(DVec3, DVec3, GridPoint)> {
+        if !k.is_multiple_of(self.phi_stride) {
+            return None;
+        }
+        let (wi, wo) = self.outside(i, j, k)?;
+        let at = match &self.placed {
+            Some(p) => {
+                p[(i * THETA_D_RES + j) * (PHI_D_RES / self.phi_stride) + k / self.phi_stride]?
+            }
+            None => GridPoint::of(wi, wo),
+        };
+        Some((wi, wo, at))
+    }
+
+    fn place(&self, i: usize, j: usize, k: usize) -> Option<GridPoint> {
+        self.outside(i, j, k).map(|(wi, wo)| GridPoint::of(wi, wo))
+    }
+
+    /// Bin (i, j, k)'s directions refracted out of the coat.
+    fn outside(&self, i: usize, j: usize, k: usize) -> Option<(DVec3, DVec3)> {
+        let (wi, wo) = bin_directions(i, j, k);
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return None;
+        }
+        // Refraction depends on η alone: any α and weight.
+        let coat = Coat::new(self.eta, ALPHA_START, 1.0);
+        Some((coat.refract_out(wi)?, coat.refract_out(wo)?))
+    }
 }
 
 /// Where tan²θh / α_c² is below this the coat's lobe is subtracted on the grid (D_c above
@@ -157,52 +232,57 @@ fn bin_correlation() -> &'static [f64] {
 }
 
 impl<'a> SeenFromInside<'a> {
-    /// `data` as a base under `layer` must be.
-    pub fn new(data: &'a MerlTable, layer: &'a CoatLayer) -> Self {
+    /// `data` as a base under `layer` must be, at the bins `places` holds.
+    fn new(data: &'a MerlTable, layer: &'a CoatLayer, places: &'a GridPlaces) -> Self {
+        debug_assert_eq!(places.eta, layer.coat.eta);
         let lobe = LobeAtBins::new(&layer.coat);
-        SeenFromInside { data, layer, lobe }
+        SeenFromInside {
+            data,
+            layer,
+            lobe,
+            places,
+        }
     }
 
-    /// The data less the coat's lobe at outside directions (i, o). Near the lobe's peak the
-    /// lobe is subtracted at each grid sample before interpolating
-    /// ([`MerlTable::lookup_interpolated_less`]): the grid's interpolation of a sharp lobe is
-    /// off by far more than a base's values.
-    fn less_coat(&self, i: DVec3, o: DVec3) -> Option<Rgb> {
+    /// The base's value at bin (i, j, k): the data less the coat's lobe at the bin's outside
+    /// pair, divided by T(θi) T(θo) / η², clamped at 0.
+    fn at_bin(&self, i: usize, j: usize, k: usize) -> Option<Rgb> {
+        let (wi, wo, at) = self.places.get(i, j, k)?;
+        let t = self.layer.base_factor(wi, wo);
+        Some(self.less_coat(wi, wo, &at)?.map(|v| (v / t).max(0.0)))
+    }
+
+    /// The data less the coat's lobe at outside directions (i, o), placed on the grid at `at`.
+    /// Near the lobe's peak the lobe is subtracted at each grid sample before interpolating
+    /// ([`MerlTable::interpolate_less`]): the grid's interpolation of a sharp lobe is off by
+    /// far more than a base's values.
+    fn less_coat(&self, i: DVec3, o: DVec3, at: &GridPoint) -> Option<Rgb> {
         let h = (i + o).normalize();
         let a2 = self.layer.coat.alpha * self.layer.coat.alpha;
         if (1.0 - h.z * h.z) / (h.z * h.z) > SHARP_LOBE * a2 {
             let r = self.layer.reflection(i, o);
-            return Some(self.data.lookup_interpolated(i, o)?.map(|v| v - r));
+            return Some(
+                self.data
+                    .interpolate_less(at, |_, _, _| 0.0)?
+                    .map(|v| v - r),
+            );
         }
         self.data
-            .lookup_interpolated_less(i, o, |a, b, c| self.lobe.at(a, b, c))
+            .interpolate_less(at, |a, b, c| self.lobe.at(a, b, c))
     }
 }
 
-impl Brdf for SeenFromInside<'_> {
-    fn name(&self) -> &str {
-        "under a coat"
-    }
-
-    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        let coat = &self.layer.coat;
-        let (i, o) = (coat.refract_out(wi)?, coat.refract_out(wo)?);
-        let t = self.layer.base_factor(i, o);
-        Some(self.less_coat(i, o)?.map(|v| (v / t).max(0.0)))
-    }
-}
-
-/// The base fitted under `layer` with `cfg`, on every `phi_stride`-th φd bin of the grid.
+/// The base fitted under `layer` with `cfg`, on the bins `places` holds.
 pub fn fit_base(
     src: &dyn Brdf,
     data: &MerlTable,
     layer: &CoatLayer,
     cfg: &FitConfig,
-    phi_stride: usize,
+    places: &GridPlaces,
 ) -> Result<FittedMaterial, FitError> {
-    let seen = SeenFromInside::new(data, layer);
+    let seen = SeenFromInside::new(data, layer, places);
     let name = format!("{}-base", src.name());
-    let table = MerlTable::from_fn_where(|_, _, k| k % phi_stride == 0, |wi, wo| seen.eval(wi, wo));
+    let table = MerlTable::from_bins(|i, j, k| seen.at_bin(i, j, k));
     let under = MerlBrdf::from_table(&name, table).map_err(|problem| FitError::Extraction {
         name: name.clone(),
         problem: format!("under a coat {:?}: {problem}", layer.coat),
@@ -227,7 +307,13 @@ pub fn coated_error(layer: &CoatLayer, base: &MicrofacetBrdf, set: &GridSamples)
 
 /// The search's score of one coat: the coated model's error on `set` with a cheap base fit;
 /// infinite where the data under the coat cannot be fitted.
-fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &GridSamples) -> f64 {
+fn score(
+    src: &dyn Brdf,
+    data: &MerlTable,
+    coat: Coat,
+    cfg: &FitConfig,
+    (places, set): (&GridPlaces, &GridSamples),
+) -> f64 {
     let Ok(layer) = CoatLayer::new(coat) else {
         return f64::INFINITY;
     };
@@ -241,7 +327,7 @@ fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &Gr
         ..*cfg
     };
     cheap.extract.resolution = SEARCH_RESOLUTION;
-    match fit_base(src, data, &layer, &cheap, SEARCH_PHI_STRIDE) {
+    match fit_base(src, data, &layer, &cheap, places) {
         Ok(base) => coated_error(&layer, &base.tabulated, set),
         Err(_) => f64::INFINITY,
     }
@@ -251,6 +337,7 @@ fn score(src: &dyn Brdf, data: &MerlTable, coat: Coat, cfg: &FitConfig, set: &Gr
 /// weight, then α again within ±10 %.
 pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamples) -> Coat {
     let set = full.subsample(SEARCH_STRIDE);
+    let places = GridPlaces::placed(COAT_ETA, SEARCH_PHI_STRIDE);
     // Each coat scored once: Brent's method starts each phase at a coat already scored.
     let scored = Mutex::new(Vec::<(Coat, f64)>::new());
     let score = |coat: Coat| {
@@ -258,7 +345,7 @@ pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamp
         if let Some(e) = known(&scored.lock().expect("no panic holds it")) {
             return e;
         }
-        let e = score(src, data, coat, cfg, &set);
+        let e = score(src, data, coat, cfg, (&places, &set));
         scored.lock().expect("no panic holds it").push((coat, e));
         e
     };
@@ -323,7 +410,8 @@ pub fn fit_coat(
         name: src.name().into(),
         problem,
     })?;
-    let Ok(base) = fit_base(src, &data, &layer, cfg, 1) else {
+    let places = GridPlaces::on_demand(coat.eta);
+    let Ok(base) = fit_base(src, &data, &layer, cfg, &places) else {
         return Ok(None);
     };
     let error = coated_error(&layer, &base.tabulated, full);

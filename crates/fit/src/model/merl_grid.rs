@@ -82,6 +82,35 @@ fn bin_coords(c: HalfDiff) -> [f64; 3] {
     ]
 }
 
+/// Where a pair (ωi, ωo) falls on the grid, in the sqrt-θh, θd, φd bin coordinates: the lower
+/// corner of the 8 samples [`MerlTable::lookup_interpolated`] weighs, and the fractions
+/// towards the upper one (φd wraps with period π).
+#[derive(Clone, Copy, Debug)]
+pub struct GridPoint {
+    lower: [u8; 3],
+    fraction: [f64; 3],
+}
+
+impl GridPoint {
+    /// The place of (wi, wo).
+    pub fn of(wi: DVec3, wo: DVec3) -> Self {
+        let x = bin_coords(to_half_diff(wi, wo));
+        let axis = |v: f64, n: usize| {
+            let v = v.clamp(0.0, (n - 1) as f64);
+            let i0 = (v as usize).min(n - 2);
+            (i0, v - i0 as f64)
+        };
+        let (h0, th) = axis(x[0], THETA_H_RES);
+        let (d0, td) = axis(x[1], THETA_D_RES);
+        let p0 = (x[2] as usize).min(PHI_D_RES - 1);
+        // Every bin index is below 256 (`PHI_D_RES` = 180 is the largest).
+        GridPoint {
+            lower: [h0 as u8, d0 as u8, p0 as u8],
+            fraction: [th, td, x[2] - p0 as f64],
+        }
+    }
+}
+
 /// The raw samples of a MERL file, exactly as stored.
 pub struct MerlTable {
     pub(crate) raw: Stored,
@@ -156,6 +185,20 @@ impl MerlTable {
         keep: impl Fn(usize, usize, usize) -> bool + Sync,
         f: impl Fn(DVec3, DVec3) -> Option<Rgb> + Sync,
     ) -> Self {
+        Self::from_bins(|i, j, k| {
+            if !keep(i, j, k) {
+                return None;
+            }
+            let (wi, wo) = bin_directions(i, j, k);
+            if wi.z <= 0.0 || wo.z <= 0.0 {
+                return None;
+            }
+            f(wi, wo)
+        })
+    }
+
+    /// A table of the values `f` gives each bin (θh, θd, φd) = (i, j, k); missing where `None`.
+    pub fn from_bins(f: impl Fn(usize, usize, usize) -> Option<Rgb> + Sync) -> Self {
         let mut raw = vec![(-1.0f64).to_le_bytes(); 3 * SAMPLES];
         // One θh row of the three channels at a time, written where it is computed.
         const ROW: usize = THETA_D_RES * PHI_D_RES;
@@ -167,14 +210,7 @@ impl MerlTable {
             .for_each(|(i, ((r, g), b))| {
                 for s in 0..ROW {
                     let (j, k) = (s / PHI_D_RES, s % PHI_D_RES);
-                    if !keep(i, j, k) {
-                        continue;
-                    }
-                    let (wi, wo) = bin_directions(i, j, k);
-                    if wi.z <= 0.0 || wo.z <= 0.0 {
-                        continue;
-                    }
-                    if let Some(v) = f(wi, wo) {
+                    if let Some(v) = f(i, j, k) {
                         r[s] = (v[0] / SCALE[0]).to_le_bytes();
                         g[s] = (v[1] / SCALE[1]).to_le_bytes();
                         b[s] = (v[2] / SCALE[2]).to_le_bytes();
@@ -314,16 +350,18 @@ impl MerlTable {
         wo: DVec3,
         g: impl Fn(usize, usize, usize) -> f64,
     ) -> Option<Rgb> {
-        let x = bin_coords(to_half_diff(wi, wo));
-        let axis = |v: f64, n: usize| {
-            let v = v.clamp(0.0, (n - 1) as f64);
-            let i0 = (v as usize).min(n - 2);
-            (i0, i0 + 1, v - i0 as f64)
-        };
-        let (h0, h1, th) = axis(x[0], THETA_H_RES);
-        let (d0, d1, td) = axis(x[1], THETA_D_RES);
-        let p0 = (x[2] as usize).min(PHI_D_RES - 1);
-        let (p1, tp) = ((p0 + 1) % PHI_D_RES, x[2] - p0 as f64);
+        self.interpolate_less(&GridPoint::of(wi, wo), g)
+    }
+
+    /// [`MerlTable::lookup_interpolated_less`] at a pair already placed on the grid.
+    pub fn interpolate_less(
+        &self,
+        at: &GridPoint,
+        g: impl Fn(usize, usize, usize) -> f64,
+    ) -> Option<Rgb> {
+        let [h0, d0, p0] = at.lower.map(usize::from);
+        let [th, td, tp] = at.fraction;
+        let (h1, d1, p1) = (h0 + 1, d0 + 1, (p0 + 1) % PHI_D_RES);
         let mut sum = [0.0; 3];
         let mut wsum = 0.0;
         for (i, wi) in [(h0, 1.0 - th), (h1, th)] {
