@@ -305,50 +305,76 @@ pub fn coated_error(layer: &CoatLayer, base: &MicrofacetBrdf, set: &GridSamples)
     )
 }
 
-/// The search's score of one coat: the coated model's error on `set` with a cheap base fit;
-/// infinite where the data under the coat cannot be fitted.
-fn score(
-    src: &dyn Brdf,
-    data: &MerlTable,
-    coat: Coat,
-    cfg: &FitConfig,
-    (places, set): (&GridPlaces, &GridSamples),
-) -> f64 {
-    let Ok(layer) = CoatLayer::new(coat) else {
-        return f64::INFINITY;
-    };
-    let mut cheap = FitConfig {
-        models: Models {
-            tabulated: true,
-            ggx: false,
-            beckmann: false,
-        },
-        refine: false,
-        ..*cfg
-    };
-    cheap.extract.resolution = SEARCH_RESOLUTION;
-    match fit_base(src, data, &layer, &cheap, places) {
-        Ok(base) => coated_error(&layer, &base.tabulated, set),
-        Err(_) => f64::INFINITY,
+/// The search's candidates on one source: each coat's score is the coated model's error on
+/// every [`SEARCH_STRIDE`]-th row of the source with a cheap base fit (infinite where the data
+/// under the coat cannot be fitted), computed once per coat.
+pub struct Scorer<'a> {
+    src: &'a dyn Brdf,
+    data: &'a MerlTable,
+    cfg: FitConfig,
+    set: GridSamples,
+    places: GridPlaces,
+    scored: Mutex<Vec<(Coat, f64)>>,
+}
+
+impl<'a> Scorer<'a> {
+    /// The scorer of `src` (`data` its table, `full` its samples) under fits made with `cfg`.
+    pub fn new(
+        src: &'a dyn Brdf,
+        data: &'a MerlTable,
+        cfg: &FitConfig,
+        full: &GridSamples,
+    ) -> Self {
+        let mut cheap = FitConfig {
+            models: Models {
+                tabulated: true,
+                ggx: false,
+                beckmann: false,
+            },
+            refine: false,
+            ..*cfg
+        };
+        cheap.extract.resolution = SEARCH_RESOLUTION;
+        Scorer {
+            src,
+            data,
+            cfg: cheap,
+            set: full.subsample(SEARCH_STRIDE),
+            places: GridPlaces::placed(COAT_ETA, SEARCH_PHI_STRIDE),
+            scored: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The score of `coat`, from the scores kept when it was scored before: Brent's method
+    /// starts each phase at a coat already scored.
+    pub fn score(&self, coat: Coat) -> f64 {
+        let known = |s: &[(Coat, f64)]| s.iter().find(|(c, _)| *c == coat).map(|&(_, e)| e);
+        if let Some(e) = known(&self.scored.lock().expect("no panic holds it")) {
+            return e;
+        }
+        let e = self.fit_and_score(coat);
+        self.scored
+            .lock()
+            .expect("no panic holds it")
+            .push((coat, e));
+        e
+    }
+
+    fn fit_and_score(&self, coat: Coat) -> f64 {
+        let Ok(layer) = CoatLayer::new(coat) else {
+            return f64::INFINITY;
+        };
+        match fit_base(self.src, self.data, &layer, &self.cfg, &self.places) {
+            Ok(base) => coated_error(&layer, &base.tabulated, &self.set),
+            Err(_) => f64::INFINITY,
+        }
     }
 }
 
 /// The coat that scores best: α at each of the weights 0.15, 0.5 and 1, the best of those, then its
 /// weight, then α again within ±10 %.
-pub fn search(src: &dyn Brdf, data: &MerlTable, cfg: &FitConfig, full: &GridSamples) -> Coat {
-    let set = full.subsample(SEARCH_STRIDE);
-    let places = GridPlaces::placed(COAT_ETA, SEARCH_PHI_STRIDE);
-    // Each coat scored once: Brent's method starts each phase at a coat already scored.
-    let scored = Mutex::new(Vec::<(Coat, f64)>::new());
-    let score = |coat: Coat| {
-        let known = |s: &[(Coat, f64)]| s.iter().find(|(c, _)| *c == coat).map(|&(_, e)| e);
-        if let Some(e) = known(&scored.lock().expect("no panic holds it")) {
-            return e;
-        }
-        let e = score(src, data, coat, cfg, (&places, &set));
-        scored.lock().expect("no panic holds it").push((coat, e));
-        e
-    };
+pub fn search(scorer: &Scorer) -> Coat {
+    let score = |coat: Coat| scorer.score(coat);
     // Brent's method in ln α on [lo, hi], to `tol` times |ln α| (about 3 ln α's bits).
     let by_alpha = |coat: Coat, (lo, hi): (f64, f64), tol: f64| Coat {
         alpha: brent(
@@ -405,7 +431,7 @@ pub fn fit_coat(
     single: f64,
 ) -> Result<Option<CoatedFit>, FitError> {
     let data = src.merl_table();
-    let coat = search(src, &data, cfg, full);
+    let coat = search(&Scorer::new(src, &data, cfg, full));
     let layer = CoatLayer::new(coat).map_err(|problem| FitError::Extraction {
         name: src.name().into(),
         problem,

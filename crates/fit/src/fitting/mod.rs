@@ -96,7 +96,7 @@ pub struct FitConfig {
 }
 
 /// When a fit searches a clear coat over a base ([`coat`]). The search costs about 50 cheap
-/// fits of the base (4–8 s on 2 cores), so by default it runs only where the single layer
+/// fits of the base (2–5 s on 2 cores), so by default it runs only where the single layer
 /// leaves an error a coat could lower.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CoatSearch {
