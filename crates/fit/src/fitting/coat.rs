@@ -2,7 +2,7 @@
 //! kept only where the coated model fits the source better.
 //!
 //! For a candidate coat the base is what the data must be under it, seen from inside
-//! ([`SeenFromInside`]: f_base(ωi', ωo') = η² (f(ωi, ωo) − coat lobe) / (T(θi) T(θo)) at the
+//! (`SeenFromInside`: f_base(ωi', ωo') = η² (f(ωi, ωo) − coat lobe) / (T(θi) T(θo)) at the
 //! outside directions of each inside pair; pairs past the critical angle have none and are
 //! missing), fitted by the same pipeline as any source. The candidate's score is the coated
 //! model's error on the source's own samples. The search: α by Brent's method in log α at each
@@ -306,7 +306,7 @@ pub fn coated_error(layer: &CoatLayer, base: &MicrofacetBrdf, set: &GridSamples)
 }
 
 /// The search's candidates on one source: each coat's score is the coated model's error on
-/// every [`SEARCH_STRIDE`]-th row of the source with a cheap base fit (infinite where the data
+/// every 16th row of the source with a cheap base fit (infinite where the data
 /// under the coat cannot be fitted), computed once per coat.
 pub struct Scorer<'a> {
     src: &'a dyn Brdf,
