@@ -23,7 +23,8 @@ use crate::model::geometry::azimuth_between;
 use crate::model::material::{CoatRecord, CoatedModels, FittedMaterial};
 use crate::model::merl_grid::MerlTable;
 use crate::model::merl_grid::{
-    GridPoint, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles, bin_directions, index,
+    GridPoint, PHI_D_RES, SAMPLES, THETA_D_RES, THETA_H_RES, bin_angles, bin_directions, bin_of,
+    index,
 };
 use crate::model::microfacet::{
     AnalyticNdf, MicrofacetBrdf, NdfKind, correlation, g2, lambda_from_alpha_tan,
@@ -99,7 +100,8 @@ struct SeenFromInside<'a> {
 /// places its bins once for every candidate (14.6 MB at a stride of 4) and a single fit places
 /// them as it goes. Placing a pair (its θh, θd and φd) cost as much as the rest of a table.
 pub struct GridPlaces {
-    eta: f64,
+    /// A coat of the η placed for (its α and weight play no part in refraction).
+    coat: Coat,
     phi_stride: usize,
     placed: Option<Vec<Option<GridPoint>>>,
 }
@@ -111,7 +113,7 @@ impl GridPlaces {
         debug_assert!(PHI_D_RES.is_multiple_of(phi_stride));
         let per_row = PHI_D_RES / phi_stride;
         let mut places = GridPlaces {
-            eta,
+            coat: Coat::new(eta, ALPHA_START, 1.0),
             phi_stride,
             placed: None,
         };
@@ -129,7 +131,7 @@ impl GridPlaces {
     /// Every bin under a coat of index `eta`, placed when asked.
     pub fn on_demand(eta: f64) -> Self {
         GridPlaces {
-            eta,
+            coat: Coat::new(eta, ALPHA_START, 1.0),
             phi_stride: 1,
             placed: None,
         }
@@ -161,9 +163,7 @@ impl GridPlaces {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return None;
         }
-        // Refraction depends on η alone: any α and weight.
-        let coat = Coat::new(self.eta, ALPHA_START, 1.0);
-        Some((coat.refract_out(wi)?, coat.refract_out(wo)?))
+        Some((self.coat.refract_out(wi)?, self.coat.refract_out(wo)?))
     }
 }
 
@@ -221,9 +221,7 @@ fn bin_correlation() -> &'static [f64] {
         (0..SAMPLES)
             .into_par_iter()
             .map(|n| {
-                let (c, rest) = (n % PHI_D_RES, n / PHI_D_RES);
-                let (b, a) = (rest % THETA_D_RES, rest / THETA_D_RES);
-                debug_assert_eq!(index(a, b, c), n);
+                let (a, b, c) = bin_of(n);
                 let (wi, wo) = bin_directions(a, b, c);
                 correlation(azimuth_between(wi, wo))
             })
@@ -234,7 +232,7 @@ fn bin_correlation() -> &'static [f64] {
 impl<'a> SeenFromInside<'a> {
     /// `data` as a base under `layer` must be, at the bins `places` holds.
     fn new(data: &'a MerlTable, layer: &'a CoatLayer, places: &'a GridPlaces) -> Self {
-        debug_assert_eq!(places.eta, layer.coat.eta);
+        debug_assert_eq!(places.coat.eta, layer.coat.eta);
         let lobe = LobeAtBins::new(&layer.coat);
         SeenFromInside {
             data,

@@ -12,7 +12,7 @@ use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::geometry::{HalfDiff, from_half_diff};
-use crate::model::merl_grid::{PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles};
+use crate::model::merl_grid::{PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles, bin_of};
 use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::rgb::Rgb;
 use crate::numerics::fast_log::{ln_1p, ln_1p_abs};
@@ -201,11 +201,8 @@ fn make_sample(s: usize, rot: u8, v: Rgb, cos_i: f64) -> GridSample {
 }
 
 fn sample_directions(s: usize, phi_h: f64) -> (DVec3, DVec3) {
-    let a = bin_angles(
-        s / (PHI_D_RES * THETA_D_RES),
-        s / PHI_D_RES % THETA_D_RES,
-        s % PHI_D_RES,
-    );
+    let (i, j, k) = bin_of(s);
+    let a = bin_angles(i, j, k);
     from_half_diff(HalfDiff { phi_h, ..a })
 }
 

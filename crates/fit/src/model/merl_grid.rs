@@ -41,6 +41,15 @@ pub const fn index(i: usize, j: usize, k: usize) -> usize {
     k + PHI_D_RES * (j + THETA_D_RES * i)
 }
 
+/// The bin (θh, θd, φd) of flat index `s`: [`index`]'s inverse.
+pub const fn bin_of(s: usize) -> (usize, usize, usize) {
+    (
+        s / (PHI_D_RES * THETA_D_RES),
+        s / PHI_D_RES % THETA_D_RES,
+        s % PHI_D_RES,
+    )
+}
+
 /// Angles of the sample in bin (i, j, k): its lower edge.
 pub fn bin_angles(i: usize, j: usize, k: usize) -> HalfDiff {
     let u = i as f64 / THETA_H_RES as f64;

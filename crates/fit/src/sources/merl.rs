@@ -13,7 +13,7 @@ use crate::model::brdf::Brdf;
 use crate::model::geometry::from_half_diff;
 use crate::model::merl_grid::{
     HEADER_BYTES, MAX_STORED, MIN_VALID_SAMPLES, MerlTable, PHI_D_RES, SAMPLES, Stored,
-    THETA_D_RES, THETA_H_RES, bin_angles, stored,
+    THETA_D_RES, THETA_H_RES, bin_angles, bin_of, stored,
 };
 use crate::model::rgb::Rgb;
 use crate::numerics::interp::fill_missing;
@@ -155,11 +155,7 @@ impl MerlTable {
         if let Some(at) = (0..raw.len()).position(|at| !(stored(&raw, at) <= MAX_STORED)) {
             let v = stored(&raw, at);
             let (c, s) = (at / SAMPLES, at % SAMPLES);
-            let (i, j, k) = (
-                s / (PHI_D_RES * THETA_D_RES),
-                s / PHI_D_RES % THETA_D_RES,
-                s % PHI_D_RES,
-            );
+            let (i, j, k) = bin_of(s);
             return Err(bad(format!(
                 "sample {s} of channel {} (θh bin {i}, θd bin {j}, φd bin {k}) is {:e}",
                 ["red", "green", "blue"][c],
@@ -241,11 +237,7 @@ impl MerlBrdf {
         // `up_to` of them: a measured table holds MIN_VALID_SAMPLES in its first row.
         let valid = |up_to: usize| {
             let seen = |s: usize| {
-                let (i, j, k) = (
-                    s / (PHI_D_RES * THETA_D_RES),
-                    s / PHI_D_RES % THETA_D_RES,
-                    s % PHI_D_RES,
-                );
+                let (i, j, k) = bin_of(s);
                 let (wi, wo) = from_half_diff(bin_angles(i, j, k));
                 wi.z > 0.0 && wo.z > 0.0
             };
