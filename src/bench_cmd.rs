@@ -53,10 +53,10 @@ pub struct BenchArgs {
     #[arg(long, value_enum, value_delimiter = ',')]
     pub only: Vec<Section>,
     /// Time every variant of the stages, alternating them run by run: the trace section every
-    /// traversal variant (workgroup sizes, persistent threads) with GPU timestamps where the
-    /// adapter has them; the integrator section (`stage_variants`) the demo with each as its
-    /// extend stage, and with glints with the glint queue sorted by footprint class and not
-    /// (default: only what every renderer uses).
+    /// traversal variant (workgroup sizes, persistent threads, the stack partly in workgroup
+    /// memory) with GPU timestamps where the adapter has them; the integrator section
+    /// (`stage_variants`) the demo with each as its extend stage, and with glints with the glint
+    /// queue sorted by footprint class and not (default: only what every renderer uses).
     #[arg(long)]
     pub variants: bool,
 }

@@ -330,18 +330,15 @@ fn every_repr_c_struct_is_checked() {
     );
 }
 
-/// The glint walk's stack holds what the quadtree needs and no more: 3 · MAX_DEPTH + 1 nodes
-/// (facet_glint::lit::STACK_DEPTH), written as a WGSL `const` because a private array's size
-/// cannot be an override.
-#[test]
-fn glint_stack_is_sized_to_the_tree() {
-    let src = facet_gpu::shader::raw_source("glint/lit.inc.wgsl").expect("lit.inc.wgsl");
+/// The value of `const NAME: u32 = …u;` in shader file `file`.
+fn wgsl_u32_const(file: &str, name: &str) -> u32 {
+    let src = facet_gpu::shader::raw_source(file).expect(file);
+    let prefix = format!("const {name}: u32 =");
     let line = src
         .lines()
-        .find(|l| l.trim_start().starts_with("const STACK: u32 ="))
-        .expect("a `const STACK: u32 = …u;` line");
-    let value: u32 = line
-        .split('=')
+        .find(|l| l.trim_start().starts_with(&prefix))
+        .unwrap_or_else(|| panic!("{file}: a `{prefix} …u;` line"));
+    line.split('=')
         .nth(1)
         .and_then(|v| {
             v.trim()
@@ -350,6 +347,26 @@ fn glint_stack_is_sized_to_the_tree() {
                 .parse()
                 .ok()
         })
-        .expect("an integer");
-    assert_eq!(value, facet_glint::lit::STACK_DEPTH);
+        .unwrap_or_else(|| panic!("{file}: {name} is not an integer"))
+}
+
+/// The glint walk's stack holds what the quadtree needs and no more: 3 · MAX_DEPTH + 1 nodes
+/// (facet_glint::lit::STACK_DEPTH), written as a WGSL `const` because a private array's size
+/// cannot be an override.
+#[test]
+fn glint_stack_is_sized_to_the_tree() {
+    assert_eq!(
+        wgsl_u32_const("glint/lit.inc.wgsl", "STACK"),
+        facet_glint::lit::STACK_DEPTH
+    );
+}
+
+/// The BVH traversal's stack has the depth the host's variants count with (a private array's
+/// size cannot be an override).
+#[test]
+fn bvh_stack_is_the_hosts() {
+    assert_eq!(
+        wgsl_u32_const("render/bvh.inc.wgsl", "BVH_STACK_SIZE"),
+        facet_render::trace::STACK_ENTRIES
+    );
 }

@@ -8,7 +8,9 @@
 //   var<storage, read> bvh_primitives: array<u32>;          // slot -> original triangle index
 //   var<storage, read> bvh_triangles: array<vec4<f32>>;     // slot -> 3 vertices (xyz, w unused)
 // (facet_render::bvh::GpuBvh holds the three buffers.) An empty scene is one zeroed node: it has
-// no children, so every ray misses.
+// no children, so every ray misses. The includer also declares `override WG: u32`, its workgroup
+// size, and an entry point that wants its stack's top in workgroup memory (BVH_WG_STACK > 0) sets
+// `bvh_lane` to its local invocation index before tracing.
 
 // obvhs's CwBvhNode, byte for byte (little endian). Worked example of the byte packing: child 5's
 // meta is byte 1 of child_meta[1], i.e. (child_meta[5 >> 2] >> (8 * (5 & 3))) & 0xff.
@@ -51,6 +53,16 @@ const BVH_MISS: u32 = 0xffffffffu;
 const BVH_NODE_TMIN: f32 = 0.0001;
 // obvhs TRAVERSAL_STACK_SIZE; CwBvh::validate asserts the depth stays below it.
 const BVH_STACK_SIZE: u32 = 32u;
+
+// The stack's first BVH_WG_STACK entries in workgroup memory rather than in the invocation's own
+// array (facet_render::trace::TraceVariant::wg_stack; 0, the default: none), entry e of lane l at
+// e * WG + l, so that a warp's lanes touch consecutive words. Used only by an invocation whose
+// entry point set bvh_lane: any other (a shading stage's shadow rays) keeps the whole stack its own.
+override BVH_WG_STACK: u32 = 0u;
+override BVH_WG_STACK_WORDS: u32 = max(1u, BVH_WG_STACK * WG);
+var<workgroup> bvh_wg_stack: array<vec2<u32>, BVH_WG_STACK_WORDS>;
+const BVH_NO_LANE: u32 = 0xffffffffu;
+var<private> bvh_lane: u32 = BVH_NO_LANE;
 
 // obvhs ray::safe_inverse: |x| <= f32::EPSILON (2^-23) -> signum(x) / EPSILON, where signum
 // reads the sign bit (signum(-0.0) = -1, unlike WGSL sign()).
@@ -156,6 +168,8 @@ fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: boo
 
     var stack: array<vec2<u32>, BVH_STACK_SIZE>;
     var sp = 0u;
+    // Entries below this depth live in workgroup memory.
+    let wg_depth = select(0u, BVH_WG_STACK, bvh_lane != BVH_NO_LANE);
     // Start with the root alone: bit 31 maps to slot 7 ^ octant with no imask bits below it, so
     // the relative index is 0.
     var current_group = vec2<u32>(0u, 0x80000000u);
@@ -183,7 +197,10 @@ fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: boo
             current_group.y &= ~(1u << child_bit);
             if ((current_group.y & 0xff000000u) != 0u) {
                 // A full stack drops the group (obvhs asserts the depth stays below 32).
-                if (sp < BVH_STACK_SIZE) {
+                if (sp < wg_depth) {
+                    bvh_wg_stack[sp * WG + bvh_lane] = current_group;
+                    sp += 1u;
+                } else if (sp < BVH_STACK_SIZE) {
                     stack[sp] = current_group;
                     sp += 1u;
                 }
@@ -205,7 +222,11 @@ fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: boo
                 break;
             }
             sp -= 1u;
-            current_group = stack[sp];
+            if (sp < wg_depth) {
+                current_group = bvh_wg_stack[sp * WG + bvh_lane];
+            } else {
+                current_group = stack[sp];
+            }
         }
     }
     return hit;

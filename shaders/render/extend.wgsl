@@ -9,7 +9,9 @@
 
 // One thread per queued ray.
 @compute @workgroup_size(WG)
-fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
+          @builtin(local_invocation_index) lid: u32) {
+    bvh_lane = lid;
     extend_slot(queue_slot(Q_EXTEND, thread_index(gid, nwg)));
 }
 
@@ -21,6 +23,7 @@ var<workgroup> batch_start: u32;
 
 @compute @workgroup_size(WG)
 fn extend_persistent(@builtin(local_invocation_index) lid: u32) {
+    bvh_lane = lid;
     let n = sizes[Q_EXTEND];
     loop {
         if (lid == 0u) {

@@ -27,7 +27,9 @@ struct Ray {
 @group(0) @binding(6) var<storage, read_write> next_ray: atomic<u32>;
 
 @compute @workgroup_size(WG)
-fn trace_closest_rays(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn trace_closest_rays(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
+        @builtin(local_invocation_index) lid: u32) {
+    bvh_lane = lid;
     let i = gid.x + gid.y * nwg.x * WG;
     if (i >= arrayLength(&rays)) {
         return;
@@ -37,7 +39,9 @@ fn trace_closest_rays(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(nu
 }
 
 @compute @workgroup_size(WG)
-fn trace_any_rays(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+fn trace_any_rays(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
+        @builtin(local_invocation_index) lid: u32) {
+    bvh_lane = lid;
     let i = gid.x + gid.y * nwg.x * WG;
     if (i >= arrayLength(&rays)) {
         return;
@@ -62,6 +66,7 @@ fn next_batch(lid: u32) -> u32 {
 
 @compute @workgroup_size(WG)
 fn trace_closest_persistent(@builtin(local_invocation_index) lid: u32) {
+    bvh_lane = lid;
     let n = arrayLength(&rays);
     for (var start = next_batch(lid); start < n; start = next_batch(lid)) {
         let i = start + lid;
@@ -74,6 +79,7 @@ fn trace_closest_persistent(@builtin(local_invocation_index) lid: u32) {
 
 @compute @workgroup_size(WG)
 fn trace_any_persistent(@builtin(local_invocation_index) lid: u32) {
+    bvh_lane = lid;
     let n = arrayLength(&rays);
     for (var start = next_batch(lid); start < n; start = next_batch(lid)) {
         let i = start + lid;

@@ -64,7 +64,7 @@ pub fn trace(gpu: &Gpu, sizes: &Sizes, all_variants: bool) -> Result<Value> {
                     let key = tracer.variant().key();
                     let query = format!("{query:?}").to_lowercase();
                     println!(
-                        "  {tris:>9} triangles {set:<7} {query:<8} {key:<20} {rate:>10.1} Mrays/s  {:>5.2}×   (wall {:.3} ms; BVH {} nodes, built in {:.0} ms)",
+                        "  {tris:>9} triangles {set:<7} {query:<8} {key:<30} {rate:>10.1} Mrays/s  {:>5.2}×   (wall {:.3} ms; BVH {} nodes, built in {:.0} ms)",
                         rate / base,
                         t.wall_ms,
                         bvh.cwbvh.nodes.len(),
@@ -265,7 +265,7 @@ fn compare(
             if v.sort_glints { "sorted" } else { "unsorted" }
         );
         println!(
-            "  {:<15} {key:<42} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; {stage} stages {stage_ms:.3} ms of one iteration, {clock:?})",
+            "  {:<15} {key:<54} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; {stage} stages {stage_ms:.3} ms of one iteration, {clock:?})",
             if glints {
                 "with glints"
             } else {

@@ -145,7 +145,7 @@ impl Integrator {
         let shade = shading_stages(device, &layouts, scene, variants.sort_glints)?;
         let n_queues = Queue::count(scene.glints.len() as u32);
         let wg = STAGE_WORKGROUP;
-        let extend_wg = [("WG", extend.workgroup as f64)];
+        let extend_wg = extend.constants();
         let (extend_entry, extend_close) = match extend.schedule {
             TraceSchedule::PerRay => ("extend", Vec::new()),
             TraceSchedule::Persistent { groups } => (

@@ -86,7 +86,15 @@ pub struct TraceVariant {
     pub schedule: TraceSchedule,
     /// Threads per workgroup (WGSL override `WG`), 1 to the device's limit.
     pub workgroup: u32,
+    /// Entries at the bottom of each thread's traversal stack kept in workgroup (shared)
+    /// memory rather than in the thread's own array, which a GPU keeps in local memory when it
+    /// is indexed at run time (WGSL override `BVH_WG_STACK`, 0 to [`STACK_ENTRIES`]; 0: none).
+    /// A node group is 8 bytes: a workgroup takes `8 · wg_stack · workgroup` bytes.
+    pub wg_stack: u32,
 }
+
+/// The traversal stack's depth (obvhs's `TRAVERSAL_STACK_SIZE`, WGSL `BVH_STACK_SIZE`).
+pub const STACK_ENTRIES: u32 = 32;
 
 impl TraceVariant {
     /// One thread per ray in workgroups of `workgroup`.
@@ -94,6 +102,7 @@ impl TraceVariant {
         TraceVariant {
             schedule: TraceSchedule::PerRay,
             workgroup,
+            wg_stack: 0,
         }
     }
 
@@ -102,17 +111,42 @@ impl TraceVariant {
         TraceVariant {
             schedule: TraceSchedule::Persistent { groups },
             workgroup,
+            wg_stack: 0,
         }
+    }
+
+    /// The same variant with the bottom `entries` of each thread's stack in workgroup memory.
+    pub const fn with_wg_stack(self, entries: u32) -> Self {
+        TraceVariant {
+            wg_stack: entries,
+            ..self
+        }
+    }
+
+    /// The override constants of its pipelines (`WG`, `BVH_WG_STACK`).
+    pub fn constants(&self) -> [(&'static str, f64); 2] {
+        [
+            ("WG", self.workgroup as f64),
+            ("BVH_WG_STACK", self.wg_stack as f64),
+        ]
+    }
+
+    /// Bytes of workgroup memory its stack takes.
+    pub fn wg_stack_bytes(&self) -> u64 {
+        8 * self.wg_stack as u64 * self.workgroup as u64
     }
 
     /// The kernel every other user of the traversal gets.
     pub const DEFAULT: TraceVariant = TraceVariant::per_ray(64);
 
     /// The variants `facet bench --only trace --variants` times side by side: workgroup
-    /// sizes about the SIMD widths (32 on NVIDIA, 64 on AMD), and persistent threads with one
+    /// sizes about the SIMD widths (32 on NVIDIA, 64 on AMD); persistent threads with one
     /// warp per workgroup (the paper's) at two occupancies of a large GPU (an H100 has 132
-    /// SMs of 64 warps: 8448 warps) and with two warps.
-    pub const ALL: [TraceVariant; 7] = [
+    /// SMs of 64 warps: 8448 warps) and with two warps; the stack's bottom 8 entries in
+    /// workgroup memory (a descent pushes at most once a level, so 8 entries hold the first 8
+    /// levels' pushes; 2 KiB a workgroup of 32), and the whole stack there (8 KiB a workgroup
+    /// of 32, which bounds occupancy).
+    pub const ALL: [TraceVariant; 11] = [
         TraceVariant::DEFAULT,
         TraceVariant::per_ray(32),
         TraceVariant::per_ray(128),
@@ -120,15 +154,23 @@ impl TraceVariant {
         TraceVariant::persistent(32, 2048),
         TraceVariant::persistent(32, 8192),
         TraceVariant::persistent(64, 4096),
+        TraceVariant::per_ray(32).with_wg_stack(8),
+        TraceVariant::per_ray(64).with_wg_stack(8),
+        TraceVariant::per_ray(32).with_wg_stack(STACK_ENTRIES),
+        TraceVariant::persistent(32, 8192).with_wg_stack(8),
     ];
 
-    /// A short name: `per-ray/64`, `persistent/32x2048`.
+    /// A short name: `per-ray/64`, `persistent/32x2048`, `per-ray/32/wg-stack-8`.
     pub fn key(&self) -> String {
-        match self.schedule {
+        let schedule = match self.schedule {
             TraceSchedule::PerRay => format!("per-ray/{}", self.workgroup),
             TraceSchedule::Persistent { groups } => {
                 format!("persistent/{}x{groups}", self.workgroup)
             }
+        };
+        match self.wg_stack {
+            0 => schedule,
+            n => format!("{schedule}/wg-stack-{n}"),
         }
     }
 
@@ -147,6 +189,20 @@ impl TraceVariant {
         }
         if self.schedule == (TraceSchedule::Persistent { groups: 0 }) {
             return bad("no workgroups".into());
+        }
+        if self.wg_stack > STACK_ENTRIES {
+            return bad(format!(
+                "{} stack entries in workgroup memory, past the stack's {STACK_ENTRIES}",
+                self.wg_stack
+            ));
+        }
+        // The persistent schedule's batch start (4 bytes) beside the stack.
+        let shared = self.wg_stack_bytes() + 4;
+        if shared > limits.max_compute_workgroup_storage_size as u64 {
+            return bad(format!(
+                "{shared} bytes of workgroup memory, past the device's {}",
+                limits.max_compute_workgroup_storage_size
+            ));
         }
         Ok(())
     }
@@ -187,7 +243,7 @@ impl RayTracer {
                 ("trace_closest_persistent", "trace_any_persistent")
             }
         };
-        let constants = [("WG", variant.workgroup as f64)];
+        let constants = variant.constants();
         let next_ray = matches!(variant.schedule, TraceSchedule::Persistent { .. }).then(|| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("next ray"),

@@ -9,7 +9,7 @@
 
 use facet_render::bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh};
 use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, GpuRay, RayTracer, TraceVariant};
+use facet_render::trace::{GpuHit, GpuRay, RayTracer, STACK_ENTRIES, TraceVariant};
 use glam::Vec3;
 
 fn scene_bvh(triangles: usize, config: BvhConfig) -> (procedural::Mesh, Bvh) {
@@ -366,7 +366,9 @@ fn gpu_traversal_matches_obvhs() {
 /// Every traversal variant the bench times gives obvhs's hits: the workgroup sizes, and
 /// persistent threads with as many workgroups as the bench launches (here more than the
 /// batches: one batch each) and with 3 and 1 (each loops over many batches); one of them split
-/// into dispatches of 4096 rays, so that the ray counter must start again at each.
+/// into dispatches of 4096 rays, so that the ray counter must start again at each. The stack
+/// partly in workgroup memory also with 1 and 2 entries there, so that most pushes go past them
+/// (the tree is 7 levels deep; a descent pushes at most once a level).
 #[test]
 fn every_trace_variant_matches_obvhs() {
     let Some(gpu) = facet_gpu::gpu_for_tests("every_trace_variant_matches_obvhs") else {
@@ -378,6 +380,8 @@ fn every_trace_variant_matches_obvhs() {
     let few = [
         TraceVariant::persistent(32, 3),
         TraceVariant::persistent(64, 1),
+        TraceVariant::per_ray(64).with_wg_stack(2),
+        TraceVariant::persistent(32, 3).with_wg_stack(1),
     ];
     for variant in TraceVariant::ALL.into_iter().chain(few) {
         let tracer = RayTracer::with_variant(d, variant).unwrap();
@@ -424,6 +428,15 @@ fn a_trace_variant_past_the_device_limit_is_refused() {
     assert!(e.to_string().contains(&too_wide.key()), "{e}");
     let none = TraceVariant::persistent(32, 0);
     assert!(RayTracer::with_variant(&gpu.device, none).is_err());
+    let deep = TraceVariant::per_ray(32).with_wg_stack(STACK_ENTRIES + 1);
+    assert!(RayTracer::with_variant(&gpu.device, deep).is_err());
+    // The whole stack of every thread of the widest workgroup: past any device's shared memory.
+    let max = gpu.device.limits().max_compute_invocations_per_workgroup;
+    let big = TraceVariant::per_ray(max).with_wg_stack(STACK_ENTRIES);
+    let e = RayTracer::with_variant(&gpu.device, big)
+        .err()
+        .expect("refused");
+    assert!(e.to_string().contains("workgroup memory"), "{e}");
 }
 
 #[test]
