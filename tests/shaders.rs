@@ -13,10 +13,17 @@ fn every_wgsl_file_validates() {
         shader::validate(name, &src).unwrap_or_else(|e| panic!("{e}"));
         println!("{name}: valid");
     }
+    // The traversal variants' swapped includes, in both files that trace.
+    let mut expanded: Vec<String> = Vec::new();
+    for v in facet_render::trace::TraceVariant::ALL {
+        for name in ["render/trace.wgsl", "render/extend.wgsl"] {
+            let src = shader::expand_with(name, v.swaps()).unwrap();
+            shader::validate(name, &src).unwrap_or_else(|e| panic!("{} {e}", v.key()));
+            expanded.push(src);
+        }
+    }
     // Every include-only file is validated as part of some pipeline file.
-    let expanded: Vec<String> = shader::pipeline_files()
-        .map(|n| shader::expand(n).unwrap())
-        .collect();
+    expanded.extend(shader::pipeline_files().map(|n| shader::expand(n).unwrap()));
     for (name, src) in shader::SHADERS
         .iter()
         .filter(|(n, _)| n.ends_with(".inc.wgsl"))

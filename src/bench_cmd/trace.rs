@@ -17,13 +17,24 @@ use glam::Vec3;
 use serde_json::{Value, json};
 use std::time::Instant;
 
+/// Every [`TraceVariant`] `device` can run, each one it cannot named on the terminal.
+fn runnable_variants(device: &wgpu::Device) -> Vec<TraceVariant> {
+    let runnable = TraceVariant::runnable(device);
+    for v in TraceVariant::ALL.iter().filter(|v| !runnable.contains(v)) {
+        if let Err(e) = v.validate(device) {
+            println!("  not timed: {e}");
+        }
+    }
+    runnable
+}
+
 /// The section's rows, printed as they come.
 pub fn trace(gpu: &Gpu, sizes: &Sizes, all_variants: bool) -> Result<Value> {
     let d = &gpu.device;
-    let variants: &[TraceVariant] = if all_variants {
-        &TraceVariant::ALL
+    let variants = if all_variants {
+        runnable_variants(d)
     } else {
-        &[TraceVariant::DEFAULT]
+        vec![TraceVariant::DEFAULT]
     };
     let tracers = variants
         .iter()
@@ -199,10 +210,13 @@ pub fn stage_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         "\nstage variants: the demo at {w} × {h}, depth 5, {spp} spp, median of {}",
         sizes.runs
     );
-    let extend = TraceVariant::ALL.map(|extend| StageVariants {
-        extend,
-        ..StageVariants::DEFAULT
-    });
+    let extend: Vec<StageVariants> = runnable_variants(&gpu.device)
+        .into_iter()
+        .map(|extend| StageVariants {
+            extend,
+            ..StageVariants::DEFAULT
+        })
+        .collect();
     let sort = [false, true].map(|sort_glints| StageVariants {
         sort_glints,
         ..StageVariants::DEFAULT

@@ -175,8 +175,11 @@ impl Integrator {
                 Some(Queue::Generate),
                 &[],
             )?,
-            extend: stage(
+            extend: Stage::swapping(
+                device,
+                &layouts,
                 "render/extend.wgsl",
+                extend.swaps(),
                 extend_entry,
                 Some(Queue::Extend),
                 &extend_wg,

@@ -5,6 +5,7 @@
 
 use crate::bindings::{Group, pipeline_groups};
 use crate::queues::Queue;
+use facet_gpu::shader::IncludeSwap;
 use facet_gpu::{GpuError, shader};
 
 /// Threads per workgroup of every stage (WGSL override `WG`), but the extend stage's, which
@@ -51,6 +52,7 @@ pub struct Stage {
 fn pipeline(
     device: &wgpu::Device,
     file: &str,
+    swaps: &[IncludeSwap],
     entry: &str,
     groups: &[&wgpu::BindGroupLayout],
     constants: &[(&str, f64)],
@@ -64,7 +66,8 @@ fn pipeline(
         bind_group_layouts: &groups,
         immediate_size: 0,
     });
-    let built = shader::compute_pipeline_with_layout(device, file, entry, Some(&layout), constants);
+    let built =
+        shader::compute_pipeline_variant(device, file, swaps, entry, Some(&layout), constants);
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(GpuError::Validation(format!(
             "the adapter cannot build the render stage {entry}: {e}"
@@ -83,6 +86,19 @@ impl Stage {
         queue: Option<Queue>,
         extra_constants: &[(&str, f64)],
     ) -> Result<Stage, GpuError> {
+        Self::swapping(device, layouts, file, &[], entry, queue, extra_constants)
+    }
+
+    /// [`Stage::new`] with the includes a variant swaps.
+    pub fn swapping(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        file: &str,
+        swaps: &[IncludeSwap],
+        entry: &'static str,
+        queue: Option<Queue>,
+        extra_constants: &[(&str, f64)],
+    ) -> Result<Stage, GpuError> {
         // `extra_constants` come last: a WG there replaces the default.
         let mut constants: Vec<(&str, f64)> = Queue::constants().to_vec();
         constants.push(("WG", STAGE_WORKGROUP as f64));
@@ -90,7 +106,7 @@ impl Stage {
         let groups = layouts.of_pipeline(file)?;
         Ok(Stage {
             name: entry,
-            pipeline: pipeline(device, file, entry, &groups, &constants)?,
+            pipeline: pipeline(device, file, swaps, entry, &groups, &constants)?,
             queue,
         })
     }
@@ -116,6 +132,7 @@ pub fn queue_args(
     pipeline(
         device,
         file,
+        &[],
         "queue_args",
         &layouts.of_pipeline(file)?,
         &constants,

@@ -5,6 +5,7 @@
 
 use crate::bvh::GpuBvh;
 use bytemuck::{Pod, Zeroable};
+use facet_gpu::shader::IncludeSwap;
 use facet_gpu::timer::GpuTimer;
 use facet_gpu::{GpuError, buffer, dispatch, shader};
 
@@ -91,7 +92,19 @@ pub struct TraceVariant {
     /// is indexed at run time (WGSL override `BVH_WG_STACK`, 0 to [`STACK_ENTRIES`]; 0: none).
     /// A node group is 8 bytes: a workgroup takes `8 · wg_stack · workgroup` bytes.
     pub wg_stack: u32,
+    /// Postponed triangle tests (Ylitie et al. 2017): a thread about to test triangles pushes
+    /// them and visits nodes first while fewer than this percentage of its subgroup's threads
+    /// are at their triangle tests (0: never, the default; 1 to 100). Needs a device with
+    /// `wgpu::Features::SUBGROUP`; swaps [`POSTPONE_SWAP`] into the traversal.
+    pub postpone: u32,
 }
+
+/// The include a [`TraceVariant`] with `postpone` swaps into the traversal: subgroup ballots in
+/// place of the default's "never".
+pub const POSTPONE_SWAP: IncludeSwap = (
+    "render/bvh_postpone.inc.wgsl",
+    "render/bvh_postpone_subgroup.inc.wgsl",
+);
 
 /// The traversal stack's depth (obvhs's `TRAVERSAL_STACK_SIZE`, WGSL `BVH_STACK_SIZE`).
 pub const STACK_ENTRIES: u32 = 32;
@@ -103,6 +116,7 @@ impl TraceVariant {
             schedule: TraceSchedule::PerRay,
             workgroup,
             wg_stack: 0,
+            postpone: 0,
         }
     }
 
@@ -112,6 +126,7 @@ impl TraceVariant {
             schedule: TraceSchedule::Persistent { groups },
             workgroup,
             wg_stack: 0,
+            postpone: 0,
         }
     }
 
@@ -123,12 +138,34 @@ impl TraceVariant {
         }
     }
 
-    /// The override constants of its pipelines (`WG`, `BVH_WG_STACK`).
-    pub fn constants(&self) -> [(&'static str, f64); 2] {
-        [
+    /// The same variant with its triangle tests postponed below `percent` of a subgroup.
+    pub const fn with_postpone(self, percent: u32) -> Self {
+        TraceVariant {
+            postpone: percent,
+            ..self
+        }
+    }
+
+    /// The override constants of its pipelines (`WG`, `BVH_WG_STACK`, and
+    /// `BVH_POSTPONE_BELOW` where it postpones).
+    pub fn constants(&self) -> Vec<(&'static str, f64)> {
+        let mut c = vec![
             ("WG", self.workgroup as f64),
             ("BVH_WG_STACK", self.wg_stack as f64),
-        ]
+        ];
+        if self.postpone > 0 {
+            c.push(("BVH_POSTPONE_BELOW", self.postpone as f64));
+        }
+        c
+    }
+
+    /// The includes its pipelines swap.
+    pub fn swaps(&self) -> &'static [IncludeSwap] {
+        if self.postpone > 0 {
+            &[POSTPONE_SWAP]
+        } else {
+            &[]
+        }
     }
 
     /// Bytes of workgroup memory its stack takes.
@@ -145,8 +182,10 @@ impl TraceVariant {
     /// SMs of 64 warps: 8448 warps) and with two warps; the stack's bottom 8 entries in
     /// workgroup memory (a descent pushes at most once a level, so 8 entries hold the first 8
     /// levels' pushes; 2 KiB a workgroup of 32), and the whole stack there (8 KiB a workgroup
-    /// of 32, which bounds occupancy).
-    pub const ALL: [TraceVariant; 11] = [
+    /// of 32, which bounds occupancy); triangle tests postponed below 20 % of a subgroup (one
+    /// threshold to start from), alone and with the shared stack. A device without subgroup operations runs
+    /// all but the postponing ones ([`TraceVariant::runnable`]).
+    pub const ALL: [TraceVariant; 14] = [
         TraceVariant::DEFAULT,
         TraceVariant::per_ray(32),
         TraceVariant::per_ray(128),
@@ -158,20 +197,35 @@ impl TraceVariant {
         TraceVariant::per_ray(64).with_wg_stack(8),
         TraceVariant::per_ray(32).with_wg_stack(STACK_ENTRIES),
         TraceVariant::persistent(32, 8192).with_wg_stack(8),
+        TraceVariant::per_ray(64).with_postpone(20),
+        TraceVariant::per_ray(32).with_postpone(20),
+        TraceVariant::per_ray(32).with_wg_stack(8).with_postpone(20),
     ];
 
-    /// A short name: `per-ray/64`, `persistent/32x2048`, `per-ray/32/wg-stack-8`.
+    /// The variants of [`TraceVariant::ALL`] that `device` can run.
+    pub fn runnable(device: &wgpu::Device) -> Vec<TraceVariant> {
+        Self::ALL
+            .into_iter()
+            .filter(|v| v.validate(device).is_ok())
+            .collect()
+    }
+
+    /// A short name: `per-ray/64`, `persistent/32x2048`, `per-ray/32/wg-stack-8`,
+    /// `per-ray/64/postpone-20`.
     pub fn key(&self) -> String {
-        let schedule = match self.schedule {
+        let mut key = match self.schedule {
             TraceSchedule::PerRay => format!("per-ray/{}", self.workgroup),
             TraceSchedule::Persistent { groups } => {
                 format!("persistent/{}x{groups}", self.workgroup)
             }
         };
-        match self.wg_stack {
-            0 => schedule,
-            n => format!("{schedule}/wg-stack-{n}"),
+        if self.wg_stack > 0 {
+            key += &format!("/wg-stack-{}", self.wg_stack);
         }
+        if self.postpone > 0 {
+            key += &format!("/postpone-{}", self.postpone);
+        }
+        key
     }
 
     /// An error naming the variant when `device` cannot run it.
@@ -195,6 +249,12 @@ impl TraceVariant {
                 "{} stack entries in workgroup memory, past the stack's {STACK_ENTRIES}",
                 self.wg_stack
             ));
+        }
+        if self.postpone > 100 {
+            return bad(format!("postponed below {} % of a subgroup", self.postpone));
+        }
+        if self.postpone > 0 && !device.features().contains(wgpu::Features::SUBGROUP) {
+            return bad("postponing needs subgroup operations, which the device lacks".into());
         }
         // The persistent schedule's batch start (4 bytes) beside the stack.
         let shared = self.wg_stack_bytes() + 4;
@@ -252,9 +312,13 @@ impl RayTracer {
                 mapped_at_creation: false,
             })
         });
+        let pipeline = |entry| {
+            let swaps = variant.swaps();
+            shader::compute_pipeline_variant(device, SHADER, swaps, entry, None, &constants)
+        };
         Ok(RayTracer {
-            closest: shader::compute_pipeline(device, SHADER, closest, &constants)?,
-            any: shader::compute_pipeline(device, SHADER, any, &constants)?,
+            closest: pipeline(closest)?,
+            any: pipeline(any)?,
             variant,
             next_ray,
             chunk: Self::max_rays_per_dispatch(device),
