@@ -1015,15 +1015,19 @@ fn bench_times_every_trace_variant() {
     };
     assert!(rows.iter().all(|row| row["clock"] == clock), "{clock}");
     let stages = r["stage_variants"].as_array().unwrap();
-    let mut want: Vec<(String, bool)> = variants.iter().map(|v| (v.key(), false)).collect();
+    let mut want: Vec<(String, bool, bool)> =
+        variants.iter().map(|v| (v.key(), false, false)).collect();
     let default = facet_render::trace::TraceVariant::DEFAULT.key();
-    want.extend([(default.clone(), false), (default, true)]);
-    let got: Vec<(String, bool)> = stages
+    for (sorted, descent) in [(false, false), (true, false), (false, true), (true, true)] {
+        want.push((default.clone(), sorted, descent));
+    }
+    let got: Vec<(String, bool, bool)> = stages
         .iter()
         .map(|row| {
             (
                 row["extend"].as_str().unwrap().into(),
                 row["sort_glints"] == true,
+                row["glint_descent"] == true,
             )
         })
         .collect();

@@ -164,59 +164,97 @@ struct LitNode {
 
 var<private> lit_stack: array<LitNode, STACK>;
 
+// Walks take their top levels breadth-first (descend_lit; facet_render's
+// StageVariants::glint_descent) at 1; at 0, the default, the test folds away.
+override GLINT_DESCENT: u32 = 0u;
+
 // Only the first nc chains are live (llvmpipe caps each loop's iterations per invocation, so
 // loops run over live chains only).
-fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<u32, CHAINS>, keys_in: array<vec2<u32>, CHAINS>, nc: u32) -> array<u32, CHAINS> {
+fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root: array<u32, CHAINS>, keys_in: array<vec2<u32>, CHAINS>, nc: u32) -> array<u32, CHAINS> {
     var acc: array<u32, CHAINS>;
-    var root = root_in;
     var keys = keys_in;
     if (!any_lit(root)) {
         return acc;
     }
     lit_stack[0] = LitNode(0u, 0u, 0u, field.root_count, root);
     var top = 1u;
+    if (GLINT_DESCENT != 0u) {
+        descend_lit(center, inv, ext, &keys, nc, &acc, &top);
+    }
     while (top > 0u) {
         top -= 1u;
-        var nd = lit_stack[top];
-        let size = 1.0 / f32(1u << nd.level);
-        let lo = vec2<f32>(f32(nd.ix), f32(nd.iy)) * size;
-        let hi = lo + size;
-        if (hi.x < center.x - ext.x || lo.x > center.x + ext.x || hi.y < center.y - ext.y || lo.y > center.y + ext.y) {
-            continue;
+        visit_lit(lit_stack[top], center, inv, ext, &keys, nc, &acc, &top);
+    }
+    return acc;
+}
+
+// The fixed-shape descent (issue 51): down to the level whose nodes are at least as wide as the
+// footprint's box, the box meets at most 2 × 2 nodes a level, so those levels are walked one at
+// a time in four fixed slots, the same loop for every invocation however its footprint lies;
+// the stack takes the nodes left at that level. The same nodes are visited and split with the
+// same draws as by the depth-first walk alone, so the counts are the same (only the order of
+// adding them differs).
+fn descend_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, nc: u32, acc: ptr<function, array<u32, CHAINS>>, top: ptr<function, u32>) {
+    // Nodes of level L are 2^-L wide: L = floor(-log2(the box's width)), within 0..MAX_DEPTH.
+    let width = 2.0 * max(ext.x, ext.y);
+    let levels = u32(clamp(floor(-log2(width)), 0.0, f32(MAX_DEPTH)));
+    var window: array<LitNode, 4>;
+    for (var l = 0u; l < levels; l++) {
+        let n = *top;
+        if (n == 0u || n > 4u) {
+            break;
         }
-        let s00 = inv * (lo - center);
-        let s10 = inv * (vec2<f32>(hi.x, lo.y) - center);
-        let s01 = inv * (vec2<f32>(lo.x, hi.y) - center);
-        let s11 = inv * (hi - center);
-        if (max(max(dot(s00, s00), dot(s10, s10)), max(dot(s01, s01), dot(s11, s11))) <= 1.0) {
-            acc = add_lit(acc, nd.lit);
-            continue;
-        }
-        let h = node_hash(nd.level, nd.ix, nd.iy);
-        if (nd.n <= LEAF_FLAKES || nd.level == MAX_DEPTH) {
-            // Each chain's lit flakes: a keyed run of the leaf's (leaf_run_start), only their
-            // positions hashed.
-            for (var c = 0u; c < nc; c++) {
-                if (nd.lit[c] == 0u) {
-                    continue;
-                }
-                let start = leaf_run_start(h, nd.n, keys[c]);
-                for (var j = 0u; j < nd.lit[c]; j++) {
-                    var k = start + j;
-                    k = select(k, k - nd.n, k >= nd.n);
-                    let st = inv * (flake_uv(leaf_flake_id(h, k), lo, size) - center);
-                    acc[c] += select(0u, 1u, dot(st, st) <= 1.0);
-                }
+        for (var s = 0u; s < 4u; s++) {
+            if (s < n) {
+                window[s] = lit_stack[s];
             }
-            continue;
         }
+        *top = 0u;
+        for (var s = 0u; s < 4u; s++) {
+            if (s < n) {
+                visit_lit(window[s], center, inv, ext, keys, nc, acc, top);
+            }
+        }
+    }
+}
+
+// One node of the walk: nothing outside the footprint's box; its lit count inside the
+// footprint; its lit flakes tested at a leaf; else split, the children the box reaches pushed.
+// (No early return: a return inside a loop's inlined call costs a compiler flag tested after
+// every block, 10 % of the walk on llvmpipe.)
+fn visit_lit(nd: LitNode, center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, nc: u32, acc: ptr<function, array<u32, CHAINS>>, top: ptr<function, u32>) {
+    let size = 1.0 / f32(1u << nd.level);
+    let lo = vec2<f32>(f32(nd.ix), f32(nd.iy)) * size;
+    let hi = lo + size;
+    if (hi.x < center.x - ext.x || lo.x > center.x + ext.x || hi.y < center.y - ext.y || lo.y > center.y + ext.y) {
+        // Outside the box.
+    } else if (corners_inside(lo, hi, center, inv)) {
+        *acc = add_lit(*acc, nd.lit);
+    } else if (nd.n <= LEAF_FLAKES || nd.level == MAX_DEPTH) {
+        // Each chain's lit flakes: a keyed run of the leaf's (leaf_run_start), only their
+        // positions hashed.
+        let h = node_hash(nd.level, nd.ix, nd.iy);
+        for (var c = 0u; c < nc; c++) {
+            if (nd.lit[c] == 0u) {
+                continue;
+            }
+            let start = leaf_run_start(h, nd.n, (*keys)[c]);
+            for (var j = 0u; j < nd.lit[c]; j++) {
+                var k = start + j;
+                k = select(k, k - nd.n, k >= nd.n);
+                let st = inv * (flake_uv(leaf_flake_id(h, k), lo, size) - center);
+                (*acc)[c] += select(0u, 1u, dot(st, st) <= 1.0);
+            }
+        }
+    } else {
+        let h = node_hash(nd.level, nd.ix, nd.iy);
         let cn = split_counts(nd.level, nd.ix, nd.iy, nd.n, h);
         // The halves the footprint's box reaches (left: x below the node's midline).
         let mid = lo + 0.5 * size;
         let halves = vec2<bool>(mid.x >= center.x - ext.x, mid.x <= center.x + ext.x);
         var child: array<array<u32, CHAINS>, 4>;
         for (var c = 0u; c < nc; c++) {
-            let l = split_lit(h, cn, nd.lit[c], keys[c], halves);
+            let l = split_lit(h, cn, nd.lit[c], (*keys)[c], halves);
             child[0][c] = l.x;
             child[1][c] = l.y;
             child[2][c] = l.z;
@@ -227,13 +265,21 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root_in: array<
         for (var k = 0u; k < 4u; k++) {
             let inx = select(mid.x >= center.x - ext.x, mid.x <= center.x + ext.x, (k & 1u) == 1u);
             let iny = select(mid.y >= center.y - ext.y, mid.y <= center.y + ext.y, (k >> 1u) == 1u);
-            if (cn[k] > 0u && inx && iny && any_lit(child[k]) && top < STACK) {
-                lit_stack[top] = LitNode(nd.level + 1u, 2u * nd.ix + (k & 1u), 2u * nd.iy + (k >> 1u), cn[k], child[k]);
-                top += 1u;
+            if (cn[k] > 0u && inx && iny && any_lit(child[k]) && *top < STACK) {
+                lit_stack[*top] = LitNode(nd.level + 1u, 2u * nd.ix + (k & 1u), 2u * nd.iy + (k >> 1u), cn[k], child[k]);
+                *top += 1u;
             }
         }
     }
-    return acc;
+}
+
+// Whether the node [lo, hi] lies inside the footprint: its four corners within the ellipse.
+fn corners_inside(lo: vec2<f32>, hi: vec2<f32>, center: vec2<f32>, inv: mat2x2<f32>) -> bool {
+    let s00 = inv * (lo - center);
+    let s10 = inv * (vec2<f32>(hi.x, lo.y) - center);
+    let s01 = inv * (vec2<f32>(lo.x, hi.y) - center);
+    let s11 = inv * (hi - center);
+    return max(max(dot(s00, s00), dot(s10, s10)), max(dot(s01, s01), dot(s11, s11))) <= 1.0;
 }
 
 // One axis of the blend (facet_glint::lit::blend_axis): (cell, neighbour across the nearer

@@ -217,10 +217,14 @@ pub fn stage_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
             ..StageVariants::DEFAULT
         })
         .collect();
-    let sort = [false, true].map(|sort_glints| StageVariants {
-        sort_glints,
-        ..StageVariants::DEFAULT
-    });
+    // The glint stage as it is, sorted, with the fixed-shape descent, and with both.
+    let sort = [(false, false), (true, false), (false, true), (true, true)].map(
+        |(sort_glints, glint_descent)| StageVariants {
+            sort_glints,
+            glint_descent,
+            ..StageVariants::DEFAULT
+        },
+    );
     let mut rows = Vec::new();
     for (glints, variants, stage) in [(false, &extend[..], "extend"), (true, &sort[..], "glint")] {
         rows.extend(compare(gpu, sizes, glints, variants, stage)?);
@@ -274,9 +278,10 @@ fn compare(
             .sum();
         let v = integrator.variants();
         let key = format!(
-            "extend {}, glints {}",
+            "extend {}, glints {}{}",
             v.extend.key(),
-            if v.sort_glints { "sorted" } else { "unsorted" }
+            if v.sort_glints { "sorted" } else { "unsorted" },
+            if v.glint_descent { ", descent" } else { "" }
         );
         println!(
             "  {:<15} {key:<54} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; {stage} stages {stage_ms:.3} ms of one iteration, {clock:?})",
@@ -289,6 +294,7 @@ fn compare(
         );
         rows.push(json!({
             "glints": glints, "extend": v.extend.key(), "sort_glints": v.sort_glints,
+            "glint_descent": v.glint_descent,
             "msamples_per_s": msps, "ms": ms, "vs_default": msps / base,
             "stage": stage, "stage_iteration_ms": stage_ms,
             "stage_clock": format!("{clock:?}").to_lowercase(),

@@ -9,15 +9,12 @@ use facet_fit::fitting::{CoatSearch, FitConfig, fit_material};
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
-use facet_fit::sources::nbrdf::NbrdfLibrary;
-use std::path::Path;
+
+mod common;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let lib = match args.first().filter(|a| a.as_str() != "-") {
-        Some(p) => NbrdfLibrary::open(Path::new(p)).unwrap(),
-        None => NbrdfLibrary::embedded(),
-    };
+    let lib = common::library(args.first());
     let filter = args.get(1).cloned().unwrap_or_default();
     let mut rows = Vec::new();
     for name in lib.names().filter(|n| n.contains(&filter)) {

@@ -10,47 +10,14 @@
 
 use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::metric::grid::{GridSamples, error_metric};
-use facet_fit::model::brdf::Brdf;
-use facet_fit::model::material::FittedMaterial;
 use facet_fit::model::merl_grid::MerlTable;
-use facet_fit::model::rgb::Rgb;
 use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
-use glam::DVec3;
-use std::path::Path;
 use std::time::Instant;
 
-/// Channel `c` of a source, grey (the same value in R, G and B).
-struct Channel<'a>(&'a dyn Brdf, usize);
-
-impl Brdf for Channel<'_> {
-    fn name(&self) -> &str {
-        self.0.name()
-    }
-    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        self.0.eval(wi, wo).map(|v| [v[self.1]; 3])
-    }
-    fn backscatter(&self, theta: f64, phi: f64) -> Option<Rgb> {
-        self.0.backscatter(theta, phi).map(|v| [v[self.1]; 3])
-    }
-}
-
-/// Channel c of fit c's tabulated model, for each c.
-struct PerChannel([FittedMaterial; 3]);
-
-impl Brdf for PerChannel {
-    fn name(&self) -> &str {
-        "per channel"
-    }
-    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        let mut out = [0.0; 3];
-        for (c, fit) in self.0.iter().enumerate() {
-            out[c] = fit.tabulated.eval(wi, wo)?[c];
-        }
-        Some(out)
-    }
-}
+mod common;
+use common::{Channel, PerChannel};
 
 struct Row {
     name: String,
@@ -72,17 +39,14 @@ fn row(lib: &NbrdfLibrary, name: &str, cfg: &FitConfig) -> Row {
     Row {
         name: name.to_owned(),
         single: error_metric(&single.tabulated, &set),
-        per_channel: error_metric(&PerChannel(fits), &set),
+        per_channel: error_metric(&PerChannel(fits.map(|f| f.tabulated)), &set),
         ms: [t_single, t_per],
     }
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let lib = match args.first() {
-        Some(p) => NbrdfLibrary::open(Path::new(p)).unwrap(),
-        None => NbrdfLibrary::embedded(),
-    };
+    let lib = common::library(args.first());
     let filter = args.get(1).cloned().unwrap_or_default();
     let cfg = FitConfig::isotropic();
     let names: Vec<String> = lib

@@ -113,6 +113,9 @@ pub struct StageVariants {
     /// Group each glint stage's queue by footprint class before shading (a counting sort), so
     /// that a warp walks footprints of alike size.
     pub sort_glints: bool,
+    /// Walk each glint footprint's top levels breadth-first, four fixed slots a level, before
+    /// the depth-first walk (WGSL `GLINT_DESCENT`): the same counts, another loop shape.
+    pub glint_descent: bool,
 }
 
 impl StageVariants {
@@ -120,6 +123,7 @@ impl StageVariants {
     pub const DEFAULT: StageVariants = StageVariants {
         extend: TraceVariant::DEFAULT,
         sort_glints: false,
+        glint_descent: false,
     };
 }
 
@@ -142,7 +146,7 @@ impl Integrator {
         let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
             Stage::new(device, &layouts, file, entry, queue, extra)
         };
-        let shade = shading_stages(device, &layouts, scene, variants.sort_glints)?;
+        let shade = shading_stages(device, &layouts, scene, variants)?;
         let n_queues = Queue::count(scene.glints.len() as u32);
         let wg = STAGE_WORKGROUP;
         let extend_wg = extend.constants();
@@ -535,13 +539,13 @@ impl Integrator {
 }
 
 /// The shading stages of `scene`'s material classes, in queue order: one per class, and for a
-/// glint material with `sort_glints` the three passes that group its queue by footprint class
-/// before the one that shades it.
+/// glint material with `variants.sort_glints` the three passes that group its queue by
+/// footprint class before the one that shades it.
 fn shading_stages(
     device: &wgpu::Device,
     layouts: &Layouts,
     scene: &SceneResources,
-    sort_glints: bool,
+    variants: StageVariants,
 ) -> Result<Vec<Stage>, GpuError> {
     let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
         Stage::new(device, layouts, file, entry, queue, extra)
@@ -573,7 +577,8 @@ fn shading_stages(
                 c.push(q_shade[0]);
                 c.push(("Q_SORT", (SORT_COUNTERS + k * GLINT_SORT_KEYS) as f64));
                 c.push(("GLINT_SORT_KEYS", GLINT_SORT_KEYS as f64));
-                let entries: &[&'static str] = if sort_glints {
+                c.push(("GLINT_DESCENT", u32::from(variants.glint_descent) as f64));
+                let entries: &[&'static str] = if variants.sort_glints {
                     &[
                         "glint_histogram",
                         "glint_offsets",

@@ -480,7 +480,8 @@ fn extend_variants_render_the_same_image() {
 /// sphere that the first reflects (larger footprints on later bounces), several tiles. The walks
 /// stay short: past llvmpipe's cap of 65 535 iterations of a loop, where a walk ends depends on
 /// the invocations run beside it, sorted or not (with a density of 10⁸ and a threshold of 10⁴ on
-/// the second sphere, 11 of its 4096 pixels differ).
+/// the second sphere, 11 of its 4096 pixels differ). The same for the fixed-shape descent
+/// (`glint_descent`), alone and with the sorting.
 #[test]
 fn sorted_glints_render_the_same_image() {
     let Some(gpu) = gpu_for_tests("sorted_glints_render_the_same_image") else {
@@ -509,12 +510,26 @@ fn sorted_glints_render_the_same_image() {
     let histograms = stages.iter().filter(|&&s| s == "glint_histogram").count();
     assert_eq!(histograms, 2, "{stages:?}");
     assert!(plain.pixels.iter().flatten().any(|&v| v > 0.0));
-    let differ = sorted
-        .pixels
-        .iter()
-        .zip(&plain.pixels)
-        .filter(|(a, b)| a != b);
-    assert_eq!(differ.count(), 0, "pixels differ");
+    let descent = |sort_glints| {
+        image(StageVariants {
+            sort_glints,
+            glint_descent: true,
+            ..StageVariants::DEFAULT
+        })
+        .0
+    };
+    for (label, other) in [
+        ("sorted", sorted),
+        ("descent", descent(false)),
+        ("sorted, descent", descent(true)),
+    ] {
+        let differ = other
+            .pixels
+            .iter()
+            .zip(&plain.pixels)
+            .filter(|(a, b)| a != b);
+        assert_eq!(differ.count(), 0, "{label}: pixels differ");
+    }
 }
 
 /// A scene built in code with a NaN vertex or an index out of range is refused with a message,
