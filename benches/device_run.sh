@@ -39,8 +39,12 @@ step() { echo; echo "== $1 ($(date +%T))"; }
 {
     command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,power.draw,temperature.gpu,utilization.gpu --format=csv
     echo "cores: $(nproc)"
+    # Two runs, two JSONs: a section past its timeout loses only its own figures (14 traversal
+    # variants, 18 integrators with --variants).
+    step "facet bench --mode $mode (trace, every variant)"
+    timeout 150 $b/facet bench --mode "$mode" --only trace --variants --json "$out/bench_trace.json"
     step "facet bench --mode $mode (GPU sections)"
-    timeout 200 $b/facet bench --mode "$mode" --only integrator,dpf,trace,viewer,noise --variants --json "$out/bench_gpu.json"
+    timeout 200 $b/facet bench --mode "$mode" --only integrator,dpf,viewer,noise --variants --json "$out/bench_gpu.json"
     step "facet demo"
     timeout 45 $b/facet demo --out /tmp/facet_demo && cp /tmp/facet_demo/demo.png "$out/demo.png"
     step "glint_gpu_count (criterion)"
