@@ -159,12 +159,11 @@ fn bvh_push(stack: ptr<function, array<vec2<u32>, BVH_STACK_SIZE>>, sp: ptr<func
             wg_depth: u32, group: vec2<u32>) {
     if (BVH_WG_STACK > 0u && *sp < wg_depth) {
         bvh_wg_stack[*sp * WG + bvh_lane] = group;
+        *sp += 1u;
     } else if (*sp < BVH_STACK_SIZE) {
         (*stack)[*sp] = group;
-    } else {
-        return;
+        *sp += 1u;
     }
-    *sp += 1u;
 }
 
 // The traversal of obvhs's traverse! macro. A group is (base index, bit mask): the node group's

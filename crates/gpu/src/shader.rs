@@ -63,25 +63,33 @@ fn expand_from<'a>(
 ) -> Result<String, GpuError> {
     let mut body = String::new();
     let mut seen = HashSet::new();
-    let mut from = Expansion {
+    let mut expansion = Expansion {
         source,
         swaps,
         seen: &mut seen,
     };
-    from.expand_into(name, &mut body, 0)?;
+    expansion.expand_into(name, &mut body, 0)?;
     if let Some((gone, _)) = swaps.iter().find(|(f, _)| !seen.contains(*f)) {
         return Err(GpuError::Shader {
             name: name.to_owned(),
             message: format!("includes no {gone} for a variant to swap"),
         });
     }
-    // Directives first, each once.
+    Ok(hoist_directives(body))
+}
+
+/// `body` with its directives first, each once (`enable subgroups;` as [`SUBGROUPS_ENABLED`]).
+fn hoist_directives(body: String) -> String {
     let mut directives = Vec::new();
     let mut rest = String::with_capacity(body.len());
     for line in body.lines() {
         if is_directive(line) {
-            if !directives.contains(&line.trim()) {
-                directives.push(line.trim());
+            let d = match line.trim() {
+                "enable subgroups;" => SUBGROUPS_ENABLED,
+                other => other,
+            };
+            if !directives.contains(&d) {
+                directives.push(d);
             }
         } else {
             rest.push_str(line);
@@ -89,16 +97,9 @@ fn expand_from<'a>(
         }
     }
     if directives.is_empty() {
-        return Ok(body);
+        return body;
     }
-    let directives: Vec<&str> = directives
-        .into_iter()
-        .map(|d| match d {
-            "enable subgroups;" => SUBGROUPS_ENABLED,
-            other => other,
-        })
-        .collect();
-    Ok(directives.join("\n") + "\n" + &rest)
+    directives.join("\n") + "\n" + &rest
 }
 
 /// What an expansion keeps of `enable subgroups;`, at its top.
