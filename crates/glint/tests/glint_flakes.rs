@@ -367,18 +367,11 @@ fn gpu_counts_match_cpu_counts() {
             }
             qs.push(GlintQuery::pair(&fp, p, coords));
         }
-        let g: Vec<f64> = counter
-            .count(&gpu, &field, &cfg, &qs)
-            .unwrap()
-            .into_iter()
-            .flatten()
-            .collect();
-        let by_descent: Vec<f64> = descent
-            .count(&gpu, &field, &cfg, &qs)
-            .unwrap()
-            .into_iter()
-            .flatten()
-            .collect();
+        let counts = |c: &GlintCounter| -> Vec<f64> {
+            let pairs = c.count(&gpu, &field, &cfg, &qs).unwrap();
+            pairs.into_iter().flatten().collect()
+        };
+        let (g, by_descent) = (counts(&counter), counts(&descent));
         let moved = g.iter().zip(&by_descent).filter(|(a, b)| a != b).count();
         assert_eq!(moved, 0, "blend {blend}: the descent moved {moved} counts");
         let n = g.len();
