@@ -190,7 +190,8 @@ impl Gpu {
     }
 
     /// The device descriptor [`Gpu::new`] asks an adapter for: its own limits, and timestamp
-    /// queries and subgroup operations where it has them. For code that creates the device itself (eframe).
+    /// queries and subgroup operations where it has them. For code that creates the device
+    /// itself (eframe).
     pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         wgpu::DeviceDescriptor {
             label: Some("facet"),

@@ -183,8 +183,8 @@ impl TraceVariant {
     /// workgroup memory (a descent pushes at most once a level, so 8 entries hold the first 8
     /// levels' pushes; 2 KiB a workgroup of 32), and the whole stack there (8 KiB a workgroup
     /// of 32, which bounds occupancy); triangle tests postponed below 20 % of a subgroup (one
-    /// threshold to start from), alone and with the shared stack. A device without subgroup operations runs
-    /// all but the postponing ones ([`TraceVariant::runnable`]).
+    /// threshold to start from), alone and with the shared stack. A device without subgroup
+    /// operations runs all but the postponing ones ([`TraceVariant::runnable`]).
     pub const ALL: [TraceVariant; 14] = [
         TraceVariant::DEFAULT,
         TraceVariant::per_ray(32),

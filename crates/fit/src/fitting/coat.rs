@@ -95,15 +95,18 @@ struct SeenFromInside<'a> {
     places: &'a GridPlaces,
 }
 
-/// Where the outside pair of each inside bin a table under the coat holds (every
-/// `phi_stride`-th φd bin) falls on the grid: it depends on η alone, so a search (one η)
-/// places its bins once for every candidate (14.6 MB at a stride of 4) and a single fit places
-/// them as it goes. Placing a pair (its θh, θd and φd) cost as much as the rest of a table.
+/// An inside bin's outside pair and where it falls on the grid.
+type Placed = (DVec3, DVec3, GridPoint);
+
+/// The outside pair of each inside bin a table under the coat holds (every `phi_stride`-th φd
+/// bin) and where it falls on the grid: they depend on η alone, so a search (one η) refracts
+/// and places its bins once for every candidate (32 MB at a stride of 4) and a single fit as it
+/// goes. Placing a pair (its θh, θd and φd) cost as much as the rest of a table.
 pub struct GridPlaces {
     /// A coat of the η placed for (its α and weight play no part in refraction).
     coat: Coat,
     phi_stride: usize,
-    placed: Option<Vec<Option<GridPoint>>>,
+    placed: Option<Vec<Option<Placed>>>,
 }
 
 impl GridPlaces {
@@ -139,31 +142,26 @@ impl GridPlaces {
 
     /// Bin (i, j, k)'s outside pair and its place; `None` for a bin the table does not hold,
     /// below the horizon, or past the critical angle.
-    fn get(&self, i: usize, j: usize, k: usize) -> Option<(DVec3, DVec3, GridPoint)> {
+    fn get(&self, i: usize, j: usize, k: usize) -> Option<Placed> {
         if !k.is_multiple_of(self.phi_stride) {
             return None;
         }
-        let (wi, wo) = self.outside(i, j, k)?;
-        let at = match &self.placed {
+        match &self.placed {
             Some(p) => {
-                p[(i * THETA_D_RES + j) * (PHI_D_RES / self.phi_stride) + k / self.phi_stride]?
+                p[(i * THETA_D_RES + j) * (PHI_D_RES / self.phi_stride) + k / self.phi_stride]
             }
-            None => GridPoint::of(wi, wo),
-        };
-        Some((wi, wo, at))
+            None => self.place(i, j, k),
+        }
     }
 
-    fn place(&self, i: usize, j: usize, k: usize) -> Option<GridPoint> {
-        self.outside(i, j, k).map(|(wi, wo)| GridPoint::of(wi, wo))
-    }
-
-    /// Bin (i, j, k)'s directions refracted out of the coat.
-    fn outside(&self, i: usize, j: usize, k: usize) -> Option<(DVec3, DVec3)> {
+    /// Bin (i, j, k)'s directions refracted out of the coat, and their place on the grid.
+    fn place(&self, i: usize, j: usize, k: usize) -> Option<Placed> {
         let (wi, wo) = bin_directions(i, j, k);
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return None;
         }
-        Some((self.coat.refract_out(wi)?, self.coat.refract_out(wo)?))
+        let (wi, wo) = (self.coat.refract_out(wi)?, self.coat.refract_out(wo)?);
+        Some((wi, wo, GridPoint::of(wi, wo)))
     }
 }
 
@@ -369,8 +367,8 @@ impl<'a> Scorer<'a> {
     }
 }
 
-/// The coat that scores best: α at each of the weights 0.15, 0.5 and 1, the best of those, then its
-/// weight, then α again within ±10 %.
+/// The coat that scores best: α at each of the weights 0.15, 0.5 and 1, the best of those,
+/// then its weight, then α again within ±10 %.
 pub fn search(scorer: &Scorer) -> Coat {
     let score = |coat: Coat| scorer.score(coat);
     // Brent's method in ln α on [lo, hi], to `tol` times |ln α| (about 3 ln α's bits).

@@ -346,23 +346,13 @@ impl MerlTable {
     /// bin coordinates; φd wraps with period π; missing corners are left out and the weights of
     /// the others renormalised.
     pub fn lookup_interpolated(&self, wi: DVec3, wo: DVec3) -> Option<Rgb> {
-        self.lookup_interpolated_less(wi, wo, |_, _, _| 0.0)
+        self.interpolate_less(&GridPoint::of(wi, wo), |_, _, _| 0.0)
     }
 
-    /// [`MerlTable::lookup_interpolated`] of the table less `g` sampled at the same bins
-    /// (θh, θd, φd) = (i, j, k): the interpolation of value − g(bin). A sharp lobe known in
-    /// closed form, subtracted on the grid before interpolating, leaves a remainder that
-    /// interpolates as well as the rest of the table.
-    pub fn lookup_interpolated_less(
-        &self,
-        wi: DVec3,
-        wo: DVec3,
-        g: impl Fn(usize, usize, usize) -> f64,
-    ) -> Option<Rgb> {
-        self.interpolate_less(&GridPoint::of(wi, wo), g)
-    }
-
-    /// [`MerlTable::lookup_interpolated_less`] at a pair already placed on the grid.
+    /// [`MerlTable::lookup_interpolated`] at a pair already placed on the grid, of the table
+    /// less `g` sampled at the same bins (θh, θd, φd) = (i, j, k): the interpolation of
+    /// value − g(bin). A sharp lobe known in closed form, subtracted on the grid before
+    /// interpolating, leaves a remainder that interpolates as well as the rest of the table.
     pub fn interpolate_less(
         &self,
         at: &GridPoint,
