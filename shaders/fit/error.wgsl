@@ -6,7 +6,8 @@
 
 #include "fit/grid.inc.wgsl"
 
-// ln(1 + x_data) of the source as the CPU stores it: row r, channel c at (3 r + c) · PADDED.
+// ln(1 + x_data/ε) of the source as the CPU stores it (ε of the fit's metric; F and ρd/π come
+// divided by ε): row r, channel c at (3 r + c) · PADDED.
 @group(0) @binding(5) var<storage, read> log_x: array<f32>;
 // F per θd bin (rgb), then ρd/π.
 @group(0) @binding(6) var<storage, read> fresnel: array<vec4<f32>>;

@@ -821,6 +821,8 @@ mod tests {
             separation_rounds: 1,
             refine_rounds: 0,
             coat: None,
+            metric: crate::metric::Metric::Log,
+            other_metric: None,
             timings_ms: Default::default(),
         }
     }

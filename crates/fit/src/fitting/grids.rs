@@ -32,7 +32,7 @@ impl Grids {
     /// The grids of `src`, or an error naming it when it has no valid sample or a value the
     /// passes cannot sum.
     pub fn new(src: &dyn Brdf, cfg: &FitConfig) -> Result<Self, FitError> {
-        let full = GridSamples::new(src);
+        let full = GridSamples::for_metric(src, cfg.metric);
         check(src, &full)?;
         // The diffuse lobe is solved on the isotropic grid, on the CPU.
         let diffuse = cfg.diffuse && !cfg.anisotropic && full.iso.is_some();

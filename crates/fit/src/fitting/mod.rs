@@ -27,10 +27,15 @@ use crate::fitting::evaluator::Evaluator;
 use crate::fitting::grids::Grids;
 use crate::fitting::refine::model_of;
 use crate::fitting::tabulated::TabulatedFit;
+use crate::metric::Metric;
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::FresnelTable;
 use crate::model::fresnel_curves::FresnelChoice;
-use crate::model::material::{FitRecord, FittedMaterial, ParamRecord, TabulatedRecord, Timings};
+use crate::metric::grid::{GridSamples, microfacet_error};
+use crate::model::material::{
+    FitRecord, FittedMaterial, MetricErrors, ParamRecord, TabulatedRecord, Timings,
+};
+use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::microfacet::NdfKind;
 use crate::model::rgb::Rgb;
 use std::sync::Arc;
@@ -93,6 +98,8 @@ pub struct FitConfig {
     /// When to search a clear coat over a base ([`coat`]), kept where the coated model fits
     /// better (diffuse fits only).
     pub coat: CoatSearch,
+    /// The objective every step minimises ([`Metric`]).
+    pub metric: Metric,
 }
 
 /// When a fit searches a clear coat over a base ([`coat`]). The search costs about 50 cheap
@@ -120,6 +127,7 @@ impl FitConfig {
             refine: true,
             fresnel: FresnelChoice::Table,
             coat: CoatSearch::Auto,
+            metric: Metric::Perceptual,
         }
     }
 
@@ -130,12 +138,14 @@ impl FitConfig {
         ..Self::isotropic()
     };
 
-    /// The paper's pipeline: isotropic, one specular lobe, F averaged, no refinement.
+    /// The paper's pipeline: isotropic, one specular lobe, F averaged, no refinement, the
+    /// paper's metric.
     pub const fn single_lobe() -> Self {
         FitConfig {
             diffuse: false,
             refine: false,
             coat: CoatSearch::Off,
+            metric: Metric::Log,
             ..Self::isotropic()
         }
     }
@@ -151,6 +161,7 @@ impl FitConfig {
             refine: false,
             fresnel: FresnelChoice::Table,
             coat: CoatSearch::Off,
+            metric: Metric::Perceptual,
         }
     }
 }
@@ -277,7 +288,10 @@ fn fit_with(
         total: 0.0,
     };
     let material = fit.material(source, tab, ggx, beckmann, timings, start)?;
-    fit.with_coat(material, start)
+    let mut material = fit.with_coat(material, start)?;
+    material.record.other_metric = Some(fit.other_metric_errors(&material));
+    material.record.timings_ms.total = ms(start);
+    Ok(material)
 }
 
 /// The analytic fit with the lowest error: the refinement's other start.
@@ -292,6 +306,21 @@ fn best_analytic<'p>(
 }
 
 impl Fit<'_> {
+    /// The models' errors in the metric the fit did not minimise, recorded beside its own.
+    fn other_metric_errors(&self, m: &FittedMaterial) -> MetricErrors {
+        let metric = self.cfg.metric.other();
+        let set = GridSamples::for_metric(self.src, metric);
+        let error = |model: &MicrofacetBrdf| microfacet_error(model, &set);
+        MetricErrors {
+            metric,
+            tabulated: m.record.tabulated.error.map(|_| error(&m.tabulated)),
+            ggx: m.ggx.as_ref().map(error),
+            beckmann: m.beckmann.as_ref().map(error),
+            coated: (m.coated.as_ref())
+                .map(|c| coat::coated_error(&c.layer, &c.base.tabulated, &set)),
+        }
+    }
+
     /// The coat step ([`coat`]) where the settings ask for it and the single layer's tabulated
     /// error is known: the material with the coat attached when one fits better.
     fn with_coat(&self, mut m: FittedMaterial, start: Instant) -> Result<FittedMaterial, FitError> {
@@ -361,6 +390,8 @@ impl Fit<'_> {
             separation_rounds: tab.separation_rounds,
             refine_rounds: tab.refine_rounds,
             coat: None,
+            metric: cfg.metric,
+            other_metric: None,
             timings_ms: timings,
         };
         FittedMaterial::from_parts(record, Arc::new(tab.ndf)).map_err(|problem| {

@@ -27,7 +27,7 @@ impl ErrorMetric {
         })
     }
 
-    /// The mean of |ln(1 + x_model) − ln(1 + x_data)| over the samples and the three channels
+    /// The mean of |ln(1 + x_model/ε) − ln(1 + x_data/ε)| over the samples and the three channels
     /// of a model given as tables (D, Λ cos θ, F per θd bin, ρd/π): the bins' sums on the GPU
     /// (f32), added on the CPU (f64).
     pub fn mean(
@@ -36,10 +36,11 @@ impl ErrorMetric {
         samples: &GpuSamples,
         model: &IsoTables,
     ) -> Result<f64, GpuError> {
-        // F per θd bin, then ρd/π.
+        // F per θd bin, then ρd/π, over ε: the pass forms ln(1 + x_model/ε).
+        let s = samples.scale as f64;
         let fresnel: Vec<[f32; 4]> = (model.fresnel.iter())
             .chain([&model.diffuse])
-            .map(|f| [f[0] as f32, f[1] as f32, f[2] as f32, 0.0])
+            .map(|f| [(f[0] * s) as f32, (f[1] * s) as f32, (f[2] * s) as f32, 0.0])
             .collect();
         let fresnel =
             gpu.scoped(|| buffer::storage(&gpu.device, "fresnel and diffuse", &fresnel))?;

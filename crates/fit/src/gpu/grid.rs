@@ -44,8 +44,11 @@ impl GpuGrid {
 pub struct GpuSamples {
     pub(super) mu: wgpu::Buffer,
     pub(super) corr: wgpu::Buffer,
-    /// ln(1 + x) of every row and channel, as the CPU stores it.
+    /// ln(1 + x/ε) of every row and channel, as the CPU stores it.
     pub(super) log_x: wgpu::Buffer,
+    /// 1/ε of the metric ([`crate::metric::Metric`]): a model's F and ρd/π are multiplied by
+    /// it before a pass forms ln(1 + x_model/ε).
+    pub(super) scale: f32,
     /// One bit a bin, ceil(PADDED / 32) words a row.
     pub(super) valid: wgpu::Buffer,
     /// Valid samples: the metric's divisor over three channels.
@@ -79,6 +82,7 @@ impl GpuSamples {
             corr: grid.corr.clone(),
             log_x: buffer::storage(&gpu.device, "grid ln(1 + x)", log_x),
             valid: buffer::storage(&gpu.device, "grid validity", &valid),
+            scale: set.scale(),
             count: iso.count,
         })
     }

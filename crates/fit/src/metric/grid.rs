@@ -8,6 +8,7 @@
 //! direct evaluation.
 
 use crate::metric::iso::{CoarseSamples, IsoSamples};
+use crate::metric::Metric;
 use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
@@ -34,7 +35,7 @@ pub struct GridSample {
     pub j: u8,
     /// x = f_r cos θi per channel.
     pub x: [f32; 3],
-    /// ln(1 + x) per channel.
+    /// ln(1 + x/ε) per channel, ε of the set's metric ([`GridSamples::scale`] = 1/ε).
     pub log_x: [f32; 3],
 }
 
@@ -47,6 +48,8 @@ pub struct GridSamples {
     samples: OnceLock<Vec<GridSample>>,
     /// The compact form of an isotropic source's samples.
     pub(crate) iso: Option<IsoSamples>,
+    /// 1/ε of the metric the samples are stored for ([`Metric`]): `log_x` is ln(1 + x/ε).
+    scale: f32,
 }
 
 impl GridSamples {
@@ -54,11 +57,18 @@ impl GridSamples {
     /// source the grid is laid at four azimuths φh ∈ {0°, 45°, 90°, 135°}, every second θd and
     /// φd bin, to keep the sample count that of one full grid.
     pub fn new(src: &dyn Brdf) -> Self {
+        Self::for_metric(src, Metric::Log)
+    }
+
+    /// [`Self::new`] in the space of `metric`: its errors are that metric's.
+    pub fn for_metric(src: &dyn Brdf, metric: Metric) -> Self {
+        let scale = metric.scale();
         if src.is_isotropic() {
             return GridSamples {
                 rotations: vec![0.0],
                 samples: OnceLock::new(),
-                iso: Some(IsoSamples::new(src)),
+                iso: Some(IsoSamples::new(src, scale)),
+                scale,
             };
         }
         let rotations: Vec<f64> = (0..4).map(|r| r as f64 * PI / 4.0).collect();
@@ -75,14 +85,20 @@ impl GridSamples {
                     return None;
                 }
                 let v = src.eval(wi, wo)?;
-                Some(make_sample(s, r as u8, v, wi.z))
+                Some(make_sample(s, r as u8, v, wi.z, scale))
             })
             .collect();
         GridSamples {
             rotations,
             samples: OnceLock::from(samples),
             iso: None,
+            scale,
         }
+    }
+
+    /// 1/ε of the metric the samples are stored for.
+    pub fn scale(&self) -> f32 {
+        self.scale
     }
 
     /// A cheaper set for parameter searches: every `stride`-th (θh, θd) row holding samples,
@@ -93,6 +109,7 @@ impl GridSamples {
                 rotations: self.rotations.clone(),
                 samples: OnceLock::new(),
                 iso: Some(iso.subsample(stride)),
+                scale: self.scale,
             };
         }
         GridSamples {
@@ -105,6 +122,7 @@ impl GridSamples {
                     .collect::<Vec<_>>(),
             ),
             iso: None,
+            scale: self.scale,
         }
     }
 
@@ -117,6 +135,7 @@ impl GridSamples {
                 rotations: self.rotations.clone(),
                 samples: OnceLock::new(),
                 iso: Some(iso.diagonal(stride)),
+                scale: self.scale,
             },
             None => self.subsample(stride),
         }
@@ -129,8 +148,9 @@ impl GridSamples {
     }
 
     /// The valid samples, in MERL bin order for each rotation. For an isotropic source they are
-    /// built from the compact form on first use (x from ln(1 + x), to f32 precision).
+    /// built from the compact form on first use (x from ln(1 + x/ε), to f32 precision).
     pub fn samples(&self) -> &[GridSample] {
+        let eps = 1.0 / self.scale as f64;
         self.samples.get_or_init(|| {
             let iso = self
                 .iso
@@ -144,7 +164,7 @@ impl GridSamples {
                     rot: 0,
                     i: (s / (PHI_D_RES * THETA_D_RES)) as u8,
                     j: (s / PHI_D_RES % THETA_D_RES) as u8,
-                    x: log_x.map(|l| (l as f64).exp_m1() as f32),
+                    x: log_x.map(|l| ((l as f64).exp_m1() * eps) as f32),
                     log_x,
                 })
                 .collect()
@@ -188,7 +208,7 @@ impl GridSamples {
     }
 }
 
-fn make_sample(s: usize, rot: u8, v: Rgb, cos_i: f64) -> GridSample {
+fn make_sample(s: usize, rot: u8, v: Rgb, cos_i: f64, scale: f32) -> GridSample {
     let x = v.map(|f| (f * cos_i) as f32);
     GridSample {
         bin: s as u32,
@@ -196,7 +216,7 @@ fn make_sample(s: usize, rot: u8, v: Rgb, cos_i: f64) -> GridSample {
         i: (s / (PHI_D_RES * THETA_D_RES)) as u8,
         j: (s / PHI_D_RES % THETA_D_RES) as u8,
         x,
-        log_x: x.map(ln_1p),
+        log_x: x.map(|x| ln_1p(x * scale)),
     }
 }
 
@@ -222,6 +242,7 @@ impl IsoTables {
                 log_diff(
                     std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * wi.z),
                     s,
+                    set.scale,
                 )
             })
             .sum()
@@ -254,7 +275,7 @@ pub fn error_metric(model: &dyn Brdf, set: &GridSamples) -> f64 {
     let (sum, count) = set
         .samples()
         .par_iter()
-        .filter_map(|s| x_direct(model, set, s).map(|x| log_diff(x, s)))
+        .filter_map(|s| x_direct(model, set, s).map(|x| log_diff(x, s, set.scale)))
         .fold(|| (0.0, 0usize), |(a, n), e| (a + e, n + 1))
         .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     sum / (3 * count.max(1)) as f64
@@ -455,10 +476,11 @@ pub fn tables_error(tables: &IsoTables, set: &GridSamples) -> f64 {
     tables.log_error_sum(set) / (3 * set.len().max(1)) as f64
 }
 
+/// Σ_c |ln(1 + x_c/ε) − ln(1 + x_data,c/ε)| of a sample, `scale` = 1/ε.
 #[inline]
-fn log_diff(x: Rgb, s: &GridSample) -> f64 {
+fn log_diff(x: Rgb, s: &GridSample, scale: f32) -> f64 {
     (0..3)
-        .map(|c| (ln_1p_abs(x[c] as f32) - s.log_x[c]).abs())
+        .map(|c| (ln_1p_abs(x[c] as f32 * scale) - s.log_x[c]).abs())
         .sum::<f32>() as f64
 }
 

@@ -1,6 +1,7 @@
 //! The passes over the MERL grid that every fit asks for: the error metric (mean
-//! |ln(1 + x_model) − ln(1 + x_data)|, x = f_r cos θi), the Fresnel average and the linear
-//! solves for F and a diffuse albedo, on the CPU (the GPU twins are in [`crate::gpu`]).
+//! |ln(1 + x_model/ε) − ln(1 + x_data/ε)|, x = f_r cos θi, ε set by the [`Metric`]), the
+//! Fresnel average and the linear solves for F and a diffuse albedo, on the CPU (the GPU twins
+//! are in [`crate::gpu`]).
 
 pub mod grid;
 pub(crate) mod iso;
@@ -8,3 +9,5 @@ pub mod iso_tables;
 pub(crate) mod lambda_table;
 pub(crate) mod merl_geometry;
 pub(crate) mod sums;
+
+pub use crate::model::metric::Metric;

@@ -6,6 +6,7 @@ use crate::model::brdf::Brdf;
 use crate::model::coat::{Coat, CoatLayer, Coated};
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::fresnel_curves::FresnelFits;
+use crate::model::metric::Metric;
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::model::rgb::Rgb;
 use crate::model::tabulated::{NdfTables, Stretch, TabulatedNdf};
@@ -154,8 +155,34 @@ pub struct FitRecord {
     /// what they are; this is a second, coated model.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coat: Option<CoatRecord>,
+    /// The objective the fit minimised: every `error` above is in it (`log` in records
+    /// written before it was recorded, the paper's metric).
+    #[serde(default = "paper_metric")]
+    pub metric: Metric,
+    /// The same models' errors in the other metric (absent in older records).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub other_metric: Option<MetricErrors>,
     /// How long each phase took.
     pub timings_ms: Timings,
+}
+
+fn paper_metric() -> Metric {
+    Metric::Log
+}
+
+/// A fit's models' errors in one metric.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MetricErrors {
+    /// The metric.
+    pub metric: Metric,
+    /// The tabulated model's error.
+    pub tabulated: Option<f64>,
+    /// The GGX model's, where fitted.
+    pub ggx: Option<f64>,
+    /// The Beckmann model's, where fitted.
+    pub beckmann: Option<f64>,
+    /// The coated tabulated model's, where the fit kept a coat.
+    pub coated: Option<f64>,
 }
 
 /// A coat kept by the fit ([`crate::model::coat`]): its parameters, the coated models' errors

@@ -1,6 +1,7 @@
 //! The models: the [`brdf::Brdf`] trait every source and fit implements, the shading-frame
 //! geometry, microfacet NDFs (GGX, Beckmann, tabulated with its stretch and visible-normal
-//! sampling), Fresnel tables and curves, a clear coat over a base ([`coat`]), analytic specifications and the fit record
+//! sampling), Fresnel tables and curves, a clear coat over a base ([`coat`]), analytic specifications, the fit's objective
+//! ([`metric::Metric`]) and the fit record
 //! ([`material::FittedMaterial`]) that the renderer reads. Nothing here fits anything.
 
 pub mod albedo;
@@ -12,6 +13,7 @@ pub mod fresnel_curves;
 pub mod geometry;
 pub mod material;
 pub mod merl_grid;
+pub mod metric;
 pub mod microfacet;
 pub mod rgb;
 pub mod tabulated;

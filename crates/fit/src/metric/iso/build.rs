@@ -16,8 +16,9 @@ use std::mem::MaybeUninit;
 use std::sync::Arc;
 
 impl IsoSamples {
-    /// The samples of an isotropic source from its MERL table.
-    pub fn new(src: &dyn Brdf) -> Self {
+    /// The samples of an isotropic source from its MERL table, in the space of the metric
+    /// whose scale is `scale` (1/ε: ln(1 + x/ε) is stored).
+    pub fn new(src: &dyn Brdf, scale: f32) -> Self {
         let table = src.merl_table();
         let geo = merl_geometry();
         let per_i = THETA_D_RES;
@@ -48,7 +49,7 @@ impl IsoSamples {
                     sum_coarse_x,
                     count,
                 };
-                build_rows(rows, channels, geo)
+                build_rows(rows, channels, geo, scale)
             })
             .collect::<Vec<_>>()
             .into_iter()
@@ -63,6 +64,7 @@ impl IsoSamples {
         let data = IsoData {
             slot: Vec::new(),
             log_x,
+            scale,
             x: Vec::new(),
             valid,
             sum_x,
@@ -88,19 +90,24 @@ struct RowsOut<'a> {
 
 /// Fills rows from the MERL channels (AVX-512 or AVX2 where the CPU has it, as the passes);
 /// returns the first sample out of range.
-fn build_rows(out: RowsOut, raw: [&[[u8; 8]]; 3], geo: &MerlGeometry) -> Option<(usize, [f32; 3])> {
+fn build_rows(
+    out: RowsOut,
+    raw: [&[[u8; 8]]; 3],
+    geo: &MerlGeometry,
+    scale: f32,
+) -> Option<(usize, [f32; 3])> {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU has AVX-512F, checked just above.
-            return unsafe { build_rows_avx512(out, raw, geo) };
+            return unsafe { build_rows_avx512(out, raw, geo, scale) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2, checked just above.
-            return unsafe { build_rows_avx2(out, raw, geo) };
+            return unsafe { build_rows_avx2(out, raw, geo, scale) };
         }
     }
-    build_rows_baseline(out, raw, geo)
+    build_rows_baseline(out, raw, geo, scale)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -109,8 +116,9 @@ fn build_rows_avx512(
     out: RowsOut,
     raw: [&[[u8; 8]]; 3],
     geo: &MerlGeometry,
+    scale: f32,
 ) -> Option<(usize, [f32; 3])> {
-    build_rows_baseline(out, raw, geo)
+    build_rows_baseline(out, raw, geo, scale)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -119,8 +127,9 @@ fn build_rows_avx2(
     out: RowsOut,
     raw: [&[[u8; 8]]; 3],
     geo: &MerlGeometry,
+    scale: f32,
 ) -> Option<(usize, [f32; 3])> {
-    build_rows_baseline(out, raw, geo)
+    build_rows_baseline(out, raw, geo, scale)
 }
 
 #[inline(always)]
@@ -128,6 +137,7 @@ fn build_rows_baseline(
     out: RowsOut,
     raw: [&[[u8; 8]]; 3],
     geo: &MerlGeometry,
+    scale: f32,
 ) -> Option<(usize, [f32; 3])> {
     let mut bad = None;
     let sums = out.sum_x.iter_mut().zip(out.sum_coarse_x.iter_mut());
@@ -172,9 +182,9 @@ fn build_rows_baseline(
             }
             sum_coarse[c] = sum_f64(&coarse);
             let at = (3 * n + c) * PADDED;
-            // ln(1 + 0) = 0 on the padding.
+            // ln(1 + x/ε), ln(1 + 0) = 0 on the padding.
             for (o, x) in out.log_x[at..at + PADDED].iter_mut().zip(row) {
-                o.write(ln_1p(x));
+                o.write(ln_1p(x * scale));
             }
         }
         for (o, v) in out.valid[n * PADDED..(n + 1) * PADDED]

@@ -1,4 +1,5 @@
-//! The error metric's pass: Σ over samples and channels of |ln(1 + x_model) − ln(1 + x_data)|,
+//! The error metric's pass: Σ over samples and channels of
+//! |ln(1 + x_model/ε) − ln(1 + x_data/ε)| (ε = 1/`scale` of the set, [`crate::metric::Metric`]),
 //! for a model or for one model with several F tables.
 
 use super::ideal::formed_ideal;
@@ -54,8 +55,10 @@ impl<const N: usize, const M: usize, const P: usize> RowPass for ErrorSum<'_, N,
     fn row(&self, acc: &mut f64, r: usize, p: usize) {
         let (t, data) = (self.tables, &self.set.data);
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
-        let f = t.fresnel[j].map(|f| f as f32 * t.d32[i]);
-        let kd = t.diffuse.map(|k| k as f32);
+        // F D and ρd/π in the metric's space (x/ε)
+        let s = data.scale;
+        let f = t.fresnel[j].map(|f| f as f32 * t.d32[i] * s);
+        let kd = t.diffuse.map(|k| k as f32 * s);
         *acc += match self.cached {
             Some(c) => row_error(data, r, f, kd, c.row(p)),
             None => row_error(data, r, f, kd, &formed_ideal::<N, M, P>(t, r)),
@@ -87,9 +90,10 @@ impl<const N: usize, const M: usize, const P: usize> RowPass for ErrorSums<'_, N
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let ideal = formed_ideal::<N, M, P>(t, r);
         acc.resize(self.fresnels.len(), 0.0);
-        let kd = t.diffuse.map(|k| k as f32);
+        let s = self.set.data.scale;
+        let kd = t.diffuse.map(|k| k as f32 * s);
         for (a, fresnel) in acc.iter_mut().zip(self.fresnels) {
-            let f = fresnel[j].map(|f| f as f32 * t.d32[i]);
+            let f = fresnel[j].map(|f| f as f32 * t.d32[i] * s);
             *a += row_error(&self.set.data, r, f, kd, &ideal);
         }
     }
@@ -102,8 +106,8 @@ impl<const N: usize, const M: usize, const P: usize> RowPass for ErrorSums<'_, N
     }
 }
 
-/// Σ over a row's valid bins and channels of |ln(1 + x_model) − ln(1 + x_data)|, with
-/// x_model = fd_c (G2 / (4 cos θo)) + kd_c cos θi: `fd` is F D of the row, `kd` ρd/π.
+/// Σ over a row's valid bins and channels of |ln(1 + x_model/ε) − ln(1 + x_data/ε)|, with
+/// x_model/ε = fd_c (G2 / (4 cos θo)) + kd_c cos θi: `fd` is F D / ε of the row, `kd` ρd/(π ε).
 #[inline(always)]
 fn row_error<const N: usize, const M: usize, const P: usize>(
     data: &IsoData<N, M, P>,

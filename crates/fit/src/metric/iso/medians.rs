@@ -45,7 +45,8 @@ pub(super) type Histograms = [[f64; MEDIAN_BUCKETS + 2]; 4];
 
 /// The weighted median of the scales at which a θh bin's samples are matched. With D of bin i
 /// scaled by s, a sample's model is x(s) = s a + b (a = F D G2 / (4 cos θo), b = ρd/π cos θi)
-/// and its error |ln(1 + s a + b) − ln(1 + x)|, whose slope in s is ±w, w = a / (1 + s a + b),
+/// and its error |ln(1 + (s a + b)/ε) − ln(1 + x/ε)| (ε = 1/`scale` of the set), whose slope
+/// in s is ±w, w = a / (ε + s a + b),
 /// changing sign at s* = (x − b) / a. The bin's error is least where the weight of the samples
 /// with s* below s equals that of those above: the weighted median of the s*, with w taken at
 /// the current s = 1. The pass gathers per bin the histogram of ln s* weighted by w.
@@ -77,6 +78,7 @@ impl<const N: usize, const M: usize, const P: usize> RowPass for BinMedians<'_, 
         let ideal = self.ideals.row(p);
         let (valid, mu_i) = (data.valid(r), data.mu_i(r));
         let per_bucket = MEDIAN_BUCKETS as f32 / (2.0 * self.span);
+        let eps = 1.0 / data.scale;
         let mut at = [0i32; P];
         let mut w = [0.0f32; P];
         for c in 0..3 {
@@ -94,8 +96,9 @@ impl<const N: usize, const M: usize, const P: usize> RowPass for BinMedians<'_, 
                 // SAFETY: y is in [0, B + 1] (a NaN became 0 in `max`). Signed: AVX2 converts
                 // f32 to i32 in vectors, not to u32.
                 at[k] = unsafe { y.to_int_unchecked::<i32>() };
-                // w = a / (1 + a + b), masked bins and a ≤ 0 weigh nothing
-                let wk = a / (1.0 + a + b);
+                // w = a / (ε + a + b) (∝ a / (1 + (a + b)/ε)), masked bins and a ≤ 0 weigh
+                // nothing
+                let wk = a / (eps + a + b);
                 w[k] = if valid[k] && a > 0.0 { wk } else { 0.0 };
             }
             if acc.last().is_none_or(|(b, _)| *b != i) {

@@ -56,9 +56,12 @@ pub(crate) struct IsoData<const N: usize = ROW, const M: usize = MU_ROW, const P
     /// ([`IsoSamples::coarse`], [`IsoSamples::subsample`]) stores those alone: fresh memory
     /// costs a fit more to fill (the kernel zeroes every new page) than to read.
     slot: Vec<u32>,
-    /// ln(1 + x) per bin, slot s channel c at `(3 s + c) · P`; 0 where invalid and on the
-    /// padding.
+    /// ln(1 + x/ε) per bin (the metric's space: ε = 1/`scale`), slot s channel c at
+    /// `(3 s + c) · P`; 0 where invalid and on the padding.
     log_x: Vec<f32>,
+    /// 1/ε, the metric's scale ([`crate::metric::Metric`]): every pass forms
+    /// ln(1 + `scale` x_model) against `log_x`. x and its sums are stored unscaled.
+    pub scale: f32,
     /// x itself, laid out as `log_x`, on copies of some rows, where the diffuse solves'
     /// weighted sums read it in every pass; empty on the whole grid, whose x is recovered from
     /// ln(1 + x) where a pass needs it ([`exp_m1`], to 3e-6 relative), so that the grid's
@@ -98,14 +101,15 @@ impl<const N: usize, const M: usize, const P: usize> IsoData<N, M, P> {
     }
 
     /// x of row `r`, channel `c` (0 where invalid and on the padding): stored, or recovered
-    /// from ln(1 + x).
+    /// from ln(1 + x/ε).
     #[inline(always)]
     fn x(&self, r: usize, c: usize) -> [f32; P] {
         if self.x.is_empty() {
             let log_x = self.log_x(r, c);
+            let eps = 1.0 / self.scale;
             let mut x = [0.0f32; P];
             for k in 0..P {
-                x[k] = exp_m1(log_x[k]);
+                x[k] = exp_m1(log_x[k]) * eps;
             }
             return x;
         }

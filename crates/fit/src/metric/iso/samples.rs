@@ -28,6 +28,7 @@ impl IsoSamples {
     ) -> IsoSamples<N2, M2, P2> {
         debug_assert_eq!(N2 * stride, ROW);
         let (full, stored) = (&*self.data, self.rows.len());
+        let eps = 1.0 / full.scale;
         let mut log_x = vec![0.0f32; 3 * stored * P2];
         let mut x = vec![0.0f32; 3 * stored * P2];
         let mut valid = vec![false; stored * P2];
@@ -51,7 +52,7 @@ impl IsoSamples {
                         log_x[to + j] = from_log[stride * j];
                     }
                     for (x, &l) in x[to..to + N2].iter_mut().zip(&log_x[to..to + N2]) {
-                        *x = exp_m1(l);
+                        *x = exp_m1(l) * eps;
                     }
                     // The sums of the exact x where the rows hold them.
                     match (stride, full.sum_coarse_x.is_empty()) {
@@ -80,6 +81,7 @@ impl IsoSamples {
         let data = IsoData {
             slot,
             log_x,
+            scale: full.scale,
             x,
             valid,
             sum_x,
@@ -208,7 +210,7 @@ mod tests {
     #[test]
     fn coarse_rows_are_every_fourth_bin_of_the_full_ones() {
         let src = parse_analytic("beckmann?alpha=0.15&f0=0.04&kd=0.3,0.1,0.05").unwrap();
-        let full = IsoSamples::new(&src).diagonal(4);
+        let full = IsoSamples::new(&src, 1.0).diagonal(4);
         let coarse = full.coarse();
         let d = &*full.data;
         // Full rows keep ln(1 + x) alone (x recovered from it, as the coarse rows' is).
@@ -235,6 +237,7 @@ mod tests {
             data: Arc::new(IsoData {
                 slot: Vec::new(),
                 log_x,
+                scale: d.scale,
                 x: Vec::new(),
                 valid,
                 sum_x,
@@ -304,7 +307,7 @@ mod tests {
     #[test]
     fn diagonal_subsample_keeps_every_bin() {
         let src = parse_analytic("ggx?alpha=0.2&f0=0.5").unwrap();
-        let all = IsoSamples::new(&src);
+        let all = IsoSamples::new(&src, 1.0);
         // Rows per θh bin (`by_h`) or per θd bin.
         let per_bin = |set: &IsoSamples, by_h: bool| {
             let mut n = [0usize; THETA_D_RES];

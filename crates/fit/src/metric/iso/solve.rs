@@ -166,9 +166,11 @@ impl<const N: usize, const M: usize, const P: usize> RowPass for WeightedRows<'_
         let (i, j) = (r / THETA_D_RES, r % THETA_D_RES);
         let d = t.d32[i];
         let d = if d > 0.0 { d } else { 0.0 };
+        // F D and ρd/π in the metric's space (x/ε)
+        let sc = self.set.data.scale;
         let l1 = self.l1.then(|| {
-            let fd = t.fresnel[j].map(|f| f as f32 * d);
-            (fd, t.diffuse.map(|k| k as f32))
+            let fd = t.fresnel[j].map(|f| f as f32 * d * sc);
+            (fd, t.diffuse.map(|k| k as f32 * sc))
         });
         let (sums, error) = weighted_row(&self.set.data, r, self.ideals.row(p), l1);
         acc.error += error;
@@ -221,7 +223,7 @@ fn weighted_row<const N: usize, const M: usize, const P: usize>(
             // The terms, cleared once for the three channels (each overwrites them all).
             let mut terms = [[0.0f32; P]; 5];
             for (c, out) in sums.iter_mut().enumerate() {
-                let s = plain_channel(&m, &mu_i, &data.x(r, c), &mut terms);
+                let s = plain_channel(&m, &mu_i, &data.x(r, c), data.scale, &mut terms);
                 // A loop, not `map`: an array's map is called out of line, outside the
                 // vector code.
                 for (o, s) in out.iter_mut().zip(&s) {
@@ -233,7 +235,12 @@ fn weighted_row<const N: usize, const M: usize, const P: usize>(
             let chunks = valid_chunks(valid);
             for (c, out) in sums.iter_mut().enumerate() {
                 let (x, log_x) = (data.x(r, c), data.log_x(r, c));
-                let (s, e) = l1_channel(&m, &mu_i, &x, log_x, fd[c], kd[c], &chunks);
+                let l1 = L1Model {
+                    fd: fd[c],
+                    kd: kd[c],
+                    scale: data.scale,
+                };
+                let (s, e) = l1_channel(&m, &mu_i, &x, log_x, l1, &chunks);
                 for (o, s) in out.iter_mut().zip(&s) {
                     *o = lanes_total(s);
                 }
@@ -253,12 +260,14 @@ fn plain_channel<const P: usize>(
     m: &[f32; P],
     mu_i: &[f32; P],
     x: &[f32; P],
+    scale: f32,
     t: &mut [[f32; P]; 5],
 ) -> [[f32; 8]; 5] {
     let mut s = [[0.0f32; 8]; 5];
     for k in 0..P {
-        // w = 1 / (1 + x)² (d ln(1 + x) = dx / (1 + x))
-        let w = 1.0 / ((1.0 + x[k]) * (1.0 + x[k]));
+        // w = 1 / (1 + x/ε)² (d ln(1 + x/ε) = (dx/ε) / (1 + x/ε); the constant 1/ε² dropped)
+        let y = scale.mul_add(x[k], 1.0);
+        let w = 1.0 / (y * y);
         let (wm, wu) = (w * m[k], w * mu_i[k]);
         t[0][k] = wm * m[k];
         t[1][k] = wm * mu_i[k];
@@ -276,6 +285,14 @@ fn plain_channel<const P: usize>(
     s
 }
 
+/// The model of one channel of an L1 step: F D / ε of the row, ρd/(π ε), and 1/ε itself.
+#[derive(Clone, Copy)]
+struct L1Model {
+    fd: f32,
+    kd: f32,
+    scale: f32,
+}
+
 /// One channel of [`weighted_row`] reweighted for the L1 norm (F D = `f`, ρd/π = `kd`): the
 /// five sums and the residuals in eight lanes, chunk by chunk (those of `chunks`), each
 /// chunk's lanes in registers. Stored per bin as [`plain_channel`] does, the pass took 1.7 times as long.
@@ -285,10 +302,10 @@ fn l1_channel<const P: usize>(
     mu_i: &[f32; P],
     x: &[f32; P],
     log_x: &[f32; P],
-    f: f32,
-    kd: f32,
+    model: L1Model,
     chunks: &std::ops::Range<usize>,
 ) -> ([[f32; 8]; 5], [f32; 8]) {
+    let L1Model { fd: f, kd, scale } = model;
     let (mut s, mut e) = ([[0.0f32; 8]; 5], [0.0f32; 8]);
     for n in 0..P / 8 {
         // (Chunks without a valid bin add 0: ι = μ = x = ln(1 + x) = 0 there.)
@@ -297,11 +314,12 @@ fn l1_channel<const P: usize>(
         }
         for l in 0..8 {
             let k = 8 * n + l;
-            // x_model = F D (G2 / (4 cos θo)) + ρd/π cos θi
+            // x_model/ε = F D/ε (G2 / (4 cos θo)) + ρd/(π ε) cos θi
             let res = (ln_1p_fused(f.mul_add(m[k], kd * mu_i[k])) - log_x[k]).abs();
             e[l] += res;
-            // w = 1 / (1 + x)² over the residual (at least the floor): one division
-            let w = 1.0 / (res.max(IRLS_FLOOR) * (1.0 + x[k]) * (1.0 + x[k]));
+            // w = 1 / (1 + x/ε)² over the residual (at least the floor): one division
+            let y = scale.mul_add(x[k], 1.0);
+            let w = 1.0 / (res.max(IRLS_FLOOR) * y * y);
             let (wm, wu) = (w * m[k], w * mu_i[k]);
             s[0][l] += wm * m[k];
             s[1][l] += wm * mu_i[k];
@@ -323,7 +341,7 @@ mod tests {
     #[test]
     fn cached_row_sums_give_the_pass_sums() {
         let src = parse_analytic("ggx?alpha=0.3&f0=0.04&kd=0.3,0.1,0.05").unwrap();
-        let set = IsoSamples::new(&src).diagonal(4);
+        let set = IsoSamples::new(&src, 1.0).diagonal(4);
         let model = crate::model::microfacet::MicrofacetBrdf::ideal(
             "m",
             crate::model::microfacet::Ndf::Analytic(

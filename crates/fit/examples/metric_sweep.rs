@@ -1,0 +1,145 @@
+//! Issue 60's objective chosen by measurement: every proxy of a library fitted with a metric,
+//! and the default model (the tabulated fit, coated where the fit kept a coat) compared with
+//! the measurement on a sphere under the report's point light, rendered here on the CPU, in
+//! CIEDE2000 — the figure `facet report` shows, without the GPU renders (one sample at each
+//! pixel's centre, 64² pixels).
+//!
+//! `cargo run --release -p facet-fit --example metric_sweep -- METRIC [NBRDF.json|-] [CACHE_DIR] [NAME_FILTER]`
+//!
+//! METRIC: `log` or `perceptual` (`FACET_METRIC_EPS` overrides its floor); `SWEEP_COAT=off`
+//! or `always` overrides the coat search. The proxies'
+//! MERL-grid tables are cached as `.binary` files in CACHE_DIR (default `target/merl-cache`).
+
+use facet_fit::fitting::{CoatSearch, FitConfig, fit_material};
+use facet_fit::metric::Metric;
+use facet_fit::metric::grid::{GridSamples, microfacet_error};
+use facet_fit::model::brdf::Brdf;
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::numerics::stats::quantile;
+use facet_fit::sources::merl::MerlBrdf;
+use glam::DVec3;
+use palette::color_difference::Ciede2000;
+use palette::{FromColor, Lab, LinSrgb};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+mod common;
+
+/// The report's scene (`src/report_cmd/scenes.rs`): camera on +z at 3, 45° vertical field of
+/// view, the point light at (−1.6, 1.8, 3) with I = 40.
+const CAMERA_Z: f64 = 3.0;
+const YFOV_DEG: f64 = 45.0;
+const LIGHT: DVec3 = DVec3::new(-1.6, 1.8, 3.0);
+const INTENSITY: f64 = 40.0;
+const SIDE: usize = 64;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let metric = match args.first().map(String::as_str) {
+        Some("log") => Metric::Log,
+        Some("perceptual") => Metric::Perceptual,
+        _ => panic!("METRIC: log or perceptual"),
+    };
+    let lib = common::library(args.get(1));
+    let cache = PathBuf::from(args.get(2).map_or("target/merl-cache", String::as_str));
+    std::fs::create_dir_all(&cache).unwrap();
+    let filter = args.get(3).cloned().unwrap_or_default();
+    // SWEEP_COAT=off: the single layer alone (the coat's search is most of a fit's time).
+    let coat = match std::env::var("SWEEP_COAT").as_deref() {
+        Ok("off") => CoatSearch::Off,
+        Ok("always") => CoatSearch::Always,
+        _ => FitConfig::isotropic().coat,
+    };
+    let cfg = FitConfig {
+        metric,
+        coat,
+        ..FitConfig::isotropic()
+    };
+    let mut rows = Vec::new();
+    for name in lib.names().filter(|n| n.contains(&filter)) {
+        let src = cached(&cache, name, || MerlTable::sample(&lib.get(name).unwrap()));
+        let t = Instant::now();
+        let m = fit_material(&src, name, &cfg).unwrap();
+        let secs = t.elapsed().as_secs_f64();
+        let log_err = microfacet_error(&m.tabulated, &GridSamples::new(&src));
+        let de = sphere_delta_e(&src, &m);
+        println!(
+            "{name:32} ΔE {de:6.2}  log {log_err:.4}  fit {secs:5.2} s  ρd {:.3} {:.3} {:.3}  coat {}",
+            m.record.tabulated.diffuse[0],
+            m.record.tabulated.diffuse[1],
+            m.record.tabulated.diffuse[2],
+            m.record.coat.is_some()
+        );
+        rows.push((de, log_err, secs));
+    }
+    let col = |f: fn(&(f64, f64, f64)) -> f64| rows.iter().map(f).collect::<Vec<_>>();
+    let (de, log, secs) = (col(|r| r.0), col(|r| r.1), col(|r| r.2));
+    let count = |f: &dyn Fn(f64) -> bool| de.iter().filter(|&&d| f(d)).count();
+    println!(
+        "{} materials, metric {} (ε {}): ΔE median {:.2}, mean {:.2}; below 1: {}; above 3: {}; above 4: {}; \
+         log median {:.4}; fit median {:.3} s, max {:.2} s, total {:.1} s",
+        rows.len(),
+        metric.name(),
+        metric.floor(),
+        quantile(&de, 0.5),
+        de.iter().sum::<f64>() / de.len().max(1) as f64,
+        count(&|d| d < 1.0),
+        count(&|d| d > 3.0),
+        count(&|d| d > 4.0),
+        quantile(&log, 0.5),
+        quantile(&secs, 0.5),
+        secs.iter().cloned().fold(0.0, f64::max),
+        secs.iter().sum::<f64>(),
+    );
+}
+
+/// The proxy's MERL-grid table, from the cache or tabulated and cached.
+fn cached(dir: &Path, name: &str, table: impl FnOnce() -> MerlTable) -> MerlBrdf {
+    let path = dir.join(format!("{name}.binary"));
+    if let Ok(src) = MerlBrdf::open(&path) {
+        return src;
+    }
+    let src = MerlBrdf::from_table(name, table()).unwrap();
+    src.table().write(&path).unwrap();
+    src
+}
+
+/// The mean CIEDE2000 over the sphere's pixels (centres within 0.98 of its radius) of `model`
+/// against `data`, as the report shows them: L = f cos θi I / r², displayed as 1 − e^−L,
+/// read as linear sRGB.
+fn sphere_delta_e(data: &dyn Brdf, model: &dyn Brdf) -> f64 {
+    let tan = (YFOV_DEG.to_radians() / 2.0).tan();
+    let camera = DVec3::new(0.0, 0.0, CAMERA_Z);
+    let (mut sum, mut n) = (0.0, 0usize);
+    for py in 0..SIDE {
+        for px in 0..SIDE {
+            let ndc = |p: usize| (2.0 * (p as f64 + 0.5) / SIDE as f64 - 1.0) * tan;
+            let dir = DVec3::new(ndc(px), -ndc(py), -1.0).normalize();
+            // The ray's closest approach to the centre: within 0.98 of the radius.
+            let t_mid = -camera.dot(dir);
+            let closest = (camera + t_mid * dir).length();
+            if closest > 0.98 {
+                continue;
+            }
+            let p = camera + (t_mid - (1.0 - closest * closest).sqrt()) * dir;
+            let nrm = p.normalize();
+            let tangent = DVec3::Y.cross(nrm).normalize();
+            let bitangent = nrm.cross(tangent);
+            let local = |w: DVec3| DVec3::new(w.dot(tangent), w.dot(bitangent), w.dot(nrm));
+            let to_light = LIGHT - p;
+            let (wi, wo) = (local(to_light.normalize()), local(-dir));
+            let irradiance = INTENSITY / to_light.length_squared();
+            let shown = |b: &dyn Brdf| -> Lab {
+                let f = match wi.z > 0.0 {
+                    true => b.eval(wi, wo).unwrap_or([0.0; 3]),
+                    false => [0.0; 3],
+                };
+                let d = f.map(|f| (1.0 - (-(f * wi.z.max(0.0) * irradiance).max(0.0)).exp()) as f32);
+                Lab::from_color(LinSrgb::new(d[0], d[1], d[2]))
+            };
+            sum += shown(data).difference(shown(model)) as f64;
+            n += 1;
+        }
+    }
+    sum / n.max(1) as f64
+}
