@@ -107,8 +107,13 @@ pub fn print_medians(rows: &[FitRow], seconds: f64) {
     let [tab, ggx, ggx_m, beck, coat] =
         error_medians(rows).map(|m| m.map_or("-".into(), |m| format!("{m:.4}")));
     let coated = rows.iter().filter(|r| r.record.coat.is_some()).count();
+    // The metric the fits minimised (their errors are in it), or "mixed".
+    let metric = match rows.first().map(|r| r.record.metric) {
+        Some(m) if rows.iter().all(|r| r.record.metric == m) => m.name(),
+        _ => "mixed",
+    };
     println!(
-        "median error over {} fits: tabulated {tab}, ggx {ggx} (moments {ggx_m}), beckmann {beck}; coat kept by {coated} (their coated error {coat}); {seconds:.2} s in all",
+        "median error over {} fits ({metric} metric): tabulated {tab}, ggx {ggx} (moments {ggx_m}), beckmann {beck}; coat kept by {coated} (their coated error {coat}); {seconds:.2} s in all",
         rows.len()
     );
 }

@@ -6,7 +6,8 @@
 //!
 //! `cargo run --release -p facet-fit --example metric_sweep -- METRIC [NBRDF.json|-] [CACHE_DIR] [NAME_FILTER]`
 //!
-//! METRIC: `log` or `perceptual` (`FACET_METRIC_EPS` overrides its floor); `SWEEP_COAT=off`
+//! METRIC: `log` or `perceptual` (`FACET_METRIC_KAPPA` and `FACET_METRIC_EPS`
+//! override its floor's fraction of the mean and its least value); `SWEEP_COAT=off`
 //! or `always` overrides the coat search. The proxies'
 //! MERL-grid tables are cached as `.binary` files in CACHE_DIR (default `target/merl-cache`).
 
@@ -55,7 +56,7 @@ fn main() {
         coat,
         ..FitConfig::isotropic()
     };
-    let mut rows = Vec::new();
+    let (mut rows, mut floor) = (Vec::new(), Vec::new());
     for name in lib.names().filter(|n| n.contains(&filter)) {
         let src = cached(&cache, name, || MerlTable::sample(&lib.get(name).unwrap()));
         let t = Instant::now();
@@ -64,23 +65,27 @@ fn main() {
         let log_err = microfacet_error(&m.tabulated, &GridSamples::new(&src));
         let de = sphere_delta_e(&src, &m);
         println!(
-            "{name:32} ΔE {de:6.2}  log {log_err:.4}  fit {secs:5.2} s  ρd {:.3} {:.3} {:.3}  coat {}",
+            "{name:32} ΔE {de:6.2}  log {log_err:.4}  fit {secs:5.2} s  ρd {:.3} {:.3} {:.3}  coat {}  \
+             error {:.4} coated {:.4}",
             m.record.tabulated.diffuse[0],
             m.record.tabulated.diffuse[1],
             m.record.tabulated.diffuse[2],
-            m.record.coat.is_some()
+            m.record.coat.is_some(),
+            m.record.tabulated.error.unwrap_or(f64::NAN),
+            m.record.coat.as_ref().map_or(f64::NAN, |c| c.error),
         );
+        floor.push(m.record.metric_floor);
         rows.push((de, log_err, secs));
     }
     let col = |f: fn(&(f64, f64, f64)) -> f64| rows.iter().map(f).collect::<Vec<_>>();
     let (de, log, secs) = (col(|r| r.0), col(|r| r.1), col(|r| r.2));
     let count = |f: &dyn Fn(f64) -> bool| de.iter().filter(|&&d| f(d)).count();
     println!(
-        "{} materials, metric {} (ε {}): ΔE median {:.2}, mean {:.2}; below 1: {}; above 3: {}; above 4: {}; \
+        "{} materials, metric {} (ε median {:.4}): ΔE median {:.2}, mean {:.2}; below 1: {}; above 3: {}; above 4: {}; \
          log median {:.4}; fit median {:.3} s, max {:.2} s, total {:.1} s",
         rows.len(),
         metric.name(),
-        metric.floor(),
+        quantile(&floor, 0.5),
         quantile(&de, 0.5),
         de.iter().sum::<f64>() / de.len().max(1) as f64,
         count(&|d| d < 1.0),
@@ -134,7 +139,8 @@ fn sphere_delta_e(data: &dyn Brdf, model: &dyn Brdf) -> f64 {
                     true => b.eval(wi, wo).unwrap_or([0.0; 3]),
                     false => [0.0; 3],
                 };
-                let d = f.map(|f| (1.0 - (-(f * wi.z.max(0.0) * irradiance).max(0.0)).exp()) as f32);
+                let d =
+                    f.map(|f| (1.0 - (-(f * wi.z.max(0.0) * irradiance).max(0.0)).exp()) as f32);
                 Lab::from_color(LinSrgb::new(d[0], d[1], d[2]))
             };
             sum += shown(data).difference(shown(model)) as f64;

@@ -822,6 +822,7 @@ mod tests {
             refine_rounds: 0,
             coat: None,
             metric: crate::metric::Metric::Log,
+            metric_floor: 1.0,
             other_metric: None,
             timings_ms: Default::default(),
         }

@@ -7,8 +7,8 @@
 //! bin and Λ only on cos θ, so each is a small table; `tests/grid.rs` checks it against the
 //! direct evaluation.
 
-use crate::metric::iso::{CoarseSamples, IsoSamples};
 use crate::metric::Metric;
+use crate::metric::iso::{CoarseSamples, IsoSamples, median_x};
 use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
@@ -62,15 +62,36 @@ impl GridSamples {
 
     /// [`Self::new`] in the space of `metric`: its errors are that metric's.
     pub fn for_metric(src: &dyn Brdf, metric: Metric) -> Self {
-        let scale = metric.scale();
         if src.is_isotropic() {
+            let table = src.merl_table();
+            let scale = 1.0 / metric.floor(|| median_x(&table));
             return GridSamples {
                 rotations: vec![0.0],
                 samples: OnceLock::new(),
-                iso: Some(IsoSamples::new(src, scale)),
+                iso: Some(IsoSamples::new(&table, scale)),
                 scale,
             };
         }
+        // An anisotropic source: the floor from its samples' median at the paper's scale.
+        let scale = match metric {
+            Metric::Log => 1.0,
+            _ => {
+                let plain = Self::anisotropic(src, 1.0);
+                let mut xs: Vec<f64> = (plain.samples().iter())
+                    .flat_map(|s| s.x.map(f64::from))
+                    .collect();
+                let mid = xs.len() / 2;
+                1.0 / metric.floor(|| match xs.is_empty() {
+                    true => 0.0,
+                    false => *xs.select_nth_unstable_by(mid, f64::total_cmp).1,
+                })
+            }
+        };
+        Self::anisotropic(src, scale)
+    }
+
+    /// The samples of an anisotropic source stored for the metric of scale `scale` (1/ε).
+    fn anisotropic(src: &dyn Brdf, scale: f32) -> Self {
         let rotations: Vec<f64> = (0..4).map(|r| r as f64 * PI / 4.0).collect();
         let samples: Vec<GridSample> = (0..SAMPLES * rotations.len())
             .into_par_iter()

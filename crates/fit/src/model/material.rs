@@ -159,6 +159,9 @@ pub struct FitRecord {
     /// written before it was recorded, the paper's metric).
     #[serde(default = "paper_metric")]
     pub metric: Metric,
+    /// The metric's ε: its errors are |ln(1 + x_model/ε) − ln(1 + x_data/ε)| (1 for `log`).
+    #[serde(default = "one")]
+    pub metric_floor: f64,
     /// The same models' errors in the other metric (absent in older records).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub other_metric: Option<MetricErrors>,
@@ -168,6 +171,10 @@ pub struct FitRecord {
 
 fn paper_metric() -> Metric {
     Metric::Log
+}
+
+fn one() -> f64 {
+    1.0
 }
 
 /// A fit's models' errors in one metric.

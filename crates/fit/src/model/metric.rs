@@ -12,31 +12,31 @@ pub enum Metric {
     /// ε = 1: the paper's (Dupuy et al. 2015). Where x ≪ 1, the dark half of most materials,
     /// it is an absolute error, blind to what the eye sees there.
     Log,
-    /// ε = [`Metric::PERCEPTUAL_FLOOR`]: relative down to the darkest values a display shows
-    /// apart, as lightness (L* ∝ Y^⅓) is, so that a dark metal's colour and a dark plastic's
-    /// diffuse count as much as a highlight does.
+    /// ε a tenth of the material's median x ([`Metric::RELATIVE_FLOOR`], at least
+    /// [`Metric::MIN_FLOOR`]): relative down to well below the material's typical brightness,
+    /// as lightness (L* ∝ Y^⅓) is, so that a dark metal's colour and a dark plastic's diffuse
+    /// count as a highlight does. Chosen by the sphere's ΔE2000 against the measurement on the
+    /// MERL-100 (`docs/log/fitting.md`, 2026-12-06).
     #[default]
     Perceptual,
 }
 
 impl Metric {
-    /// ε of [`Metric::Perceptual`].
-    pub const PERCEPTUAL_FLOOR: f32 = 0.01;
+    /// [`Metric::Perceptual`]'s ε: this fraction of the material's median x over the MERL
+    /// grid (its typical brightness away from the highlight), ...
+    pub const RELATIVE_FLOOR: f64 = 0.1;
+    /// ... and no less than this: under the reference light of `facet report` (a white
+    /// Lambertian shown at 0.78, Y ≈ 4.8 x), x = 0.002 is Y ≈ 0.0096, where lightness stops
+    /// being a cube root (L* is linear in Y below 0.008856).
+    pub const MIN_FLOOR: f64 = 0.002;
 
-    /// ε of the metric.
-    pub fn floor(self) -> f32 {
+    /// ε of the metric on a source whose median x over the grid `median_x` gives (asked only
+    /// where the metric needs it).
+    pub fn floor(self, median_x: impl FnOnce() -> f64) -> f32 {
         match self {
             Metric::Log => 1.0,
-            Metric::Perceptual => std::env::var("FACET_METRIC_EPS")
-                .ok()
-                .and_then(|v| v.parse().ok())
-                .unwrap_or(Self::PERCEPTUAL_FLOOR),
+            Metric::Perceptual => (Self::RELATIVE_FLOOR * median_x()).max(Self::MIN_FLOOR) as f32,
         }
-    }
-
-    /// 1/ε: the grids store ln(1 + x/ε) and the passes form ln(1 + x_model/ε).
-    pub fn scale(self) -> f32 {
-        1.0 / self.floor()
     }
 
     /// The other metric: the one a record's `other_metric` errors are in.

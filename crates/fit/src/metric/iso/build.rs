@@ -8,8 +8,7 @@ use crate::metric::iso_tables::MAX_X;
 use crate::metric::merl_geometry::{
     COARSE_ROW, COARSE_STRIDE, MU_ROW, MerlGeometry, ROW, ROWS, merl_geometry,
 };
-use crate::model::brdf::Brdf;
-use crate::model::merl_grid::THETA_D_RES;
+use crate::model::merl_grid::{MerlTable, SCALE, THETA_D_RES};
 use crate::numerics::fast_log::ln_1p;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -18,8 +17,7 @@ use std::sync::Arc;
 impl IsoSamples {
     /// The samples of an isotropic source from its MERL table, in the space of the metric
     /// whose scale is `scale` (1/ε: ln(1 + x/ε) is stored).
-    pub fn new(src: &dyn Brdf, scale: f32) -> Self {
-        let table = src.merl_table();
+    pub fn new(table: &MerlTable, scale: f32) -> Self {
         let geo = merl_geometry();
         let per_i = THETA_D_RES;
         // Allocated, not zeroed: the rows write every value, padding included (zeroing the
@@ -75,6 +73,34 @@ impl IsoSamples {
         Self::rows_of(Arc::new(data))
     }
 }
+
+/// The median of x = f_r cos θi over a MERL table's valid samples and its three channels,
+/// from every [`MEDIAN_STRIDE`]-th bin: the material's typical brightness, to which the
+/// metric's floor is tied ([`crate::metric::Metric::floor`]). (The mean is no such figure: the
+/// grid's θh bins crowd the specular peak, whose values dominate it.)
+pub(crate) fn median_x(table: &MerlTable) -> f64 {
+    let geo = merl_geometry();
+    let channels = [table.channel(0), table.channel(1), table.channel(2)];
+    let mut xs = Vec::with_capacity(3 * ROWS * ROW / MEDIAN_STRIDE + 3);
+    for s in (0..ROWS * ROW).step_by(MEDIAN_STRIDE) {
+        let (r, k) = (s / ROW, s % ROW);
+        let mu = geo.mu_row(r);
+        // cos θi of bin k: the row's cosine at 180 − k; cos θo at k.
+        let (mu_i, mu_o) = (mu[ROW - k] as f64, mu[k] as f64);
+        let v: [f64; 3] = std::array::from_fn(|c| f64::from_le_bytes(channels[c][s]));
+        if mu_i > 0.0 && mu_o > 0.0 && v.iter().all(|&v| v >= 0.0 && v.is_finite()) {
+            xs.extend((0..3).map(|c| v[c] * SCALE[c] * mu_i));
+        }
+    }
+    if xs.is_empty() {
+        return 0.0;
+    }
+    let mid = xs.len() / 2;
+    *xs.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// [`median_x`] reads every `MEDIAN_STRIDE`-th bin (a prime: no alias with the 180 φd bins).
+const MEDIAN_STRIDE: usize = 31;
 
 /// The outputs of consecutive rows of an [`IsoData`] being built.
 struct RowsOut<'a> {

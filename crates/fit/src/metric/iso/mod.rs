@@ -29,6 +29,7 @@ mod rows;
 mod samples;
 mod solve;
 
+pub(crate) use build::median_x;
 pub(crate) use medians::MEDIAN_BUCKETS;
 
 use crate::metric::merl_geometry::{COARSE_MU_ROW, COARSE_ROW, MU_ROW, ROW, row_geometry};

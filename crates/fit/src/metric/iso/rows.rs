@@ -145,7 +145,7 @@ mod tests {
     #[test]
     fn vector_and_baseline_paths_agree_bitwise() {
         let src = parse_analytic("ggx?alpha=0.25&f0=0.04&kd=0.3,0.1,0.05").unwrap();
-        let set = IsoSamples::new(&src, 1.0).diagonal(8);
+        let set = IsoSamples::new(&src.merl_table(), 1.0).diagonal(8);
         let model = crate::model::microfacet::MicrofacetBrdf::ideal(
             "m",
             crate::model::microfacet::Ndf::Analytic(

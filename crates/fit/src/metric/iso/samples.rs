@@ -210,7 +210,7 @@ mod tests {
     #[test]
     fn coarse_rows_are_every_fourth_bin_of_the_full_ones() {
         let src = parse_analytic("beckmann?alpha=0.15&f0=0.04&kd=0.3,0.1,0.05").unwrap();
-        let full = IsoSamples::new(&src, 1.0).diagonal(4);
+        let full = IsoSamples::new(&src.merl_table(), 1.0).diagonal(4);
         let coarse = full.coarse();
         let d = &*full.data;
         // Full rows keep ln(1 + x) alone (x recovered from it, as the coarse rows' is).
@@ -307,7 +307,7 @@ mod tests {
     #[test]
     fn diagonal_subsample_keeps_every_bin() {
         let src = parse_analytic("ggx?alpha=0.2&f0=0.5").unwrap();
-        let all = IsoSamples::new(&src, 1.0);
+        let all = IsoSamples::new(&src.merl_table(), 1.0);
         // Rows per θh bin (`by_h`) or per θd bin.
         let per_bin = |set: &IsoSamples, by_h: bool| {
             let mut n = [0usize; THETA_D_RES];

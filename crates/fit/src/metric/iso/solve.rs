@@ -341,7 +341,7 @@ mod tests {
     #[test]
     fn cached_row_sums_give_the_pass_sums() {
         let src = parse_analytic("ggx?alpha=0.3&f0=0.04&kd=0.3,0.1,0.05").unwrap();
-        let set = IsoSamples::new(&src, 1.0).diagonal(4);
+        let set = IsoSamples::new(&src.merl_table(), 1.0).diagonal(4);
         let model = crate::model::microfacet::MicrofacetBrdf::ideal(
             "m",
             crate::model::microfacet::Ndf::Analytic(
