@@ -7,10 +7,14 @@ use crate::error::FitError;
 use crate::metric::grid::{CoarseGrid, GridSamples};
 use crate::metric::iso_tables::MAX_X;
 use crate::model::brdf::Brdf;
-use crate::model::merl_grid::MIN_VALID_SAMPLES;
+use crate::model::merl_grid::{MIN_VALID_SAMPLES, MerlTable};
+use std::borrow::Cow;
 
 /// Every grid of one fit.
-pub(super) struct Grids {
+pub(super) struct Grids<'a> {
+    /// An isotropic source's MERL-grid table, sampled once (a neural proxy's costs about as
+    /// much as the fit): the grid in the other metric is built from it too.
+    pub table: Option<Cow<'a, MerlTable>>,
     /// Every valid sample: the reported errors and the Fresnel average.
     pub full: GridSamples,
     /// The final steps' rows: with a diffuse lobe about a quarter of the rows
@@ -28,11 +32,15 @@ pub(super) struct Grids {
     pub diffuse: bool,
 }
 
-impl Grids {
+impl<'a> Grids<'a> {
     /// The grids of `src`, or an error naming it when it has no valid sample or a value the
     /// passes cannot sum.
-    pub fn new(src: &dyn Brdf, cfg: &FitConfig) -> Result<Self, FitError> {
-        let full = GridSamples::for_metric(src, cfg.metric);
+    pub fn new(src: &'a dyn Brdf, cfg: &FitConfig) -> Result<Self, FitError> {
+        let table = src.is_isotropic().then(|| src.merl_table());
+        let full = match &table {
+            Some(t) => GridSamples::from_table(t, cfg.metric),
+            None => GridSamples::for_metric(src, cfg.metric),
+        };
         check(src, &full)?;
         // The diffuse lobe is solved on the isotropic grid, on the CPU.
         let diffuse = cfg.diffuse && !cfg.anisotropic && full.iso.is_some();
@@ -50,6 +58,7 @@ impl Grids {
             .then(|| search.coarse())
             .flatten();
         Ok(Grids {
+            table,
             full,
             final_steps,
             coarse,

@@ -235,7 +235,7 @@ struct Fit<'a> {
     src: &'a dyn Brdf,
     cfg: &'a FitConfig,
     eval: Evaluator<'a>,
-    grids: Grids,
+    grids: Grids<'a>,
     /// Every model carries a diffuse lobe (isotropic sources only, solved on the CPU).
     diffuse: bool,
 }
@@ -290,7 +290,10 @@ fn fit_with(
         total: 0.0,
     };
     let mut material = fit.material(source, tab, ggx, beckmann, timings, start)?;
-    let other = GridSamples::for_metric(src, cfg.metric.other());
+    let other = match &fit.grids.table {
+        Some(t) => GridSamples::from_table(t, cfg.metric.other()),
+        None => GridSamples::for_metric(src, cfg.metric.other()),
+    };
     material.record.other_metric = Some(errors_in(&material, &other, cfg.metric.other()));
     let mut material = fit.with_coat(material, start)?;
     if let (Some(c), Some(e)) = (&material.coated, &mut material.record.other_metric) {

@@ -13,7 +13,7 @@ use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::geometry::{HalfDiff, from_half_diff};
-use crate::model::merl_grid::{PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles, bin_of};
+use crate::model::merl_grid::{MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles, bin_of};
 use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::rgb::Rgb;
 use crate::numerics::fast_log::{ln_1p, ln_1p_abs};
@@ -63,14 +63,7 @@ impl GridSamples {
     /// [`Self::new`] in the space of `metric`: its errors are that metric's.
     pub fn for_metric(src: &dyn Brdf, metric: Metric) -> Self {
         if src.is_isotropic() {
-            let table = src.merl_table();
-            let scale = 1.0 / metric.floor(|| median_x(&table));
-            return GridSamples {
-                rotations: vec![0.0],
-                samples: OnceLock::new(),
-                iso: Some(IsoSamples::new(&table, scale)),
-                scale,
-            };
+            return Self::from_table(&src.merl_table(), metric);
         }
         // An anisotropic source: the floor from its samples' median at the paper's scale.
         let scale = match metric {
@@ -88,6 +81,17 @@ impl GridSamples {
             }
         };
         Self::anisotropic(src, scale)
+    }
+
+    /// The samples of an isotropic source's MERL table, in the space of `metric`.
+    pub fn from_table(table: &MerlTable, metric: Metric) -> Self {
+        let scale = 1.0 / metric.floor(|| median_x(table));
+        GridSamples {
+            rotations: vec![0.0],
+            samples: OnceLock::new(),
+            iso: Some(IsoSamples::new(table, scale)),
+            scale,
+        }
     }
 
     /// The samples of an anisotropic source stored for the metric of scale `scale` (1/ε).
