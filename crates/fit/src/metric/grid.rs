@@ -65,22 +65,26 @@ impl GridSamples {
         if src.is_isotropic() {
             return Self::from_table(&src.merl_table(), metric);
         }
-        // An anisotropic source: the floor from its samples' median at the paper's scale.
-        let scale = match metric {
-            Metric::Log => 1.0,
-            _ => {
-                let plain = Self::anisotropic(src, 1.0);
-                let mut xs: Vec<f64> = (plain.samples().iter())
-                    .flat_map(|s| s.x.map(f64::from))
-                    .collect();
-                let mid = xs.len() / 2;
-                1.0 / metric.floor(|| match xs.is_empty() {
+        // An anisotropic source: sampled once, the floor from its samples' median.
+        let mut set = Self::anisotropic(src);
+        if metric != Metric::Log {
+            let mut samples = set
+                .samples
+                .take()
+                .expect("an anisotropic set holds its list");
+            let mut xs: Vec<f64> = samples.iter().flat_map(|s| s.x.map(f64::from)).collect();
+            let mid = xs.len() / 2;
+            set.scale = 1.0
+                / metric.floor(|| match xs.is_empty() {
                     true => 0.0,
                     false => *xs.select_nth_unstable_by(mid, f64::total_cmp).1,
-                })
+                });
+            for s in &mut samples {
+                s.log_x = s.x.map(|x| ln_1p(x * set.scale));
             }
-        };
-        Self::anisotropic(src, scale)
+            set.samples = OnceLock::from(samples);
+        }
+        set
     }
 
     /// The samples of an isotropic source's MERL table, in the space of `metric`.
@@ -94,8 +98,8 @@ impl GridSamples {
         }
     }
 
-    /// The samples of an anisotropic source stored for the metric of scale `scale` (1/ε).
-    fn anisotropic(src: &dyn Brdf, scale: f32) -> Self {
+    /// The samples of an anisotropic source in the paper's metric (ε = 1).
+    fn anisotropic(src: &dyn Brdf) -> Self {
         let rotations: Vec<f64> = (0..4).map(|r| r as f64 * PI / 4.0).collect();
         let samples: Vec<GridSample> = (0..SAMPLES * rotations.len())
             .into_par_iter()
@@ -110,14 +114,14 @@ impl GridSamples {
                     return None;
                 }
                 let v = src.eval(wi, wo)?;
-                Some(make_sample(s, r as u8, v, wi.z, scale))
+                Some(make_sample(s, r as u8, v, wi.z, 1.0))
             })
             .collect();
         GridSamples {
             rotations,
             samples: OnceLock::from(samples),
             iso: None,
-            scale,
+            scale: 1.0,
         }
     }
 
