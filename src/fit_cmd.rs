@@ -258,11 +258,12 @@ pub struct FitArgs {
     #[arg(long, value_enum, default_value = "off")]
     coat: CoatArg,
     /// The objective every step of the fit minimises: `perceptual`, |ln(1 + x_model/ε) −
-    /// ln(1 + x_data/ε)| with ε a tenth of the material's median x (a relative error down to
-    /// well below its typical brightness, as the eye sees it), or `log`, the paper's (ε = 1).
-    /// The JSON names it and holds every model's error in both.
-    #[arg(long, value_enum, default_value = "perceptual")]
-    metric: MetricArg,
+    /// ln(1 + x_data/ε)| with ε 0.3 times the material's median x (a relative error down to
+    /// well below its typical brightness, as the eye sees it; the default), or `log`, the
+    /// paper's (ε = 1; the default of --no-diffuse and --aniso, the paper's pipelines). The JSON
+    /// names it and holds every model's error in both.
+    #[arg(long, value_enum)]
+    metric: Option<MetricArg>,
     /// The same as --coat off: the single layer alone.
     #[arg(long, conflicts_with = "coat")]
     no_coat: bool,
@@ -289,7 +290,11 @@ impl FitArgs {
         if let Some(n) = self.resolution {
             cfg.extract.resolution = n;
         }
-        cfg.metric = self.metric.metric();
+        cfg.metric = match self.metric {
+            Some(m) => m.metric(),
+            None if self.no_diffuse || self.aniso => Metric::Log,
+            None => Metric::Perceptual,
+        };
         cfg.diffuse &= !self.no_diffuse;
         cfg.refine &= !self.no_refine && cfg.diffuse;
         if cfg.diffuse && !self.aniso {

@@ -208,7 +208,7 @@ fn refined_tabulated_model_beats_the_analytic_fits_on_proxies() {
 /// metal without one are told apart under the default (perceptual) metric: the tabulated
 /// model's ρd within 0.005 of the truth in every channel, a quarter of the term's bluest
 /// channel. Where x = f cos θi is far below the floor ε the metric is absolute, so a term this
-/// small is seen only if ε is small enough for this material (0.009, a tenth of its median x).
+/// small is seen only if ε is small enough for this material (0.028, 0.3 times its median x).
 #[test]
 fn a_dark_metals_small_diffuse_term_is_told_apart() {
     for kd in [[0.0; 3], [0.02, 0.015, 0.01]] {

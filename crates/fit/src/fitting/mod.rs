@@ -152,7 +152,8 @@ impl FitConfig {
         }
     }
 
-    /// Anisotropic extraction ([`ExtractConfig::anisotropic`]), every model.
+    /// Anisotropic extraction ([`ExtractConfig::anisotropic`]), every model, the paper's single
+    /// lobe in the paper's metric (the perceptual one was measured on isotropic data only).
     pub const fn anisotropic() -> Self {
         FitConfig {
             extract: ExtractConfig::anisotropic(),
@@ -163,7 +164,7 @@ impl FitConfig {
             refine: false,
             fresnel: FresnelChoice::Table,
             coat: CoatSearch::Off,
-            metric: Metric::Perceptual,
+            metric: Metric::Log,
         }
     }
 }

@@ -12,11 +12,11 @@ pub enum Metric {
     /// ε = 1: the paper's (Dupuy et al. 2015). Where x ≪ 1, the dark half of most materials,
     /// it is an absolute error, blind to what the eye sees there.
     Log,
-    /// ε a tenth of the material's median x ([`Metric::RELATIVE_FLOOR`], at least
+    /// ε 0.3 times the material's median x ([`Metric::RELATIVE_FLOOR`], at least
     /// [`Metric::MIN_FLOOR`]): relative down to well below the material's typical brightness,
     /// as lightness (L* ∝ Y^⅓) is, so that a dark metal's colour and a dark plastic's diffuse
     /// count as a highlight does. Chosen by the sphere's ΔE2000 against the measurement on the
-    /// MERL-100 (`docs/log/fitting.md`, 2026-12-06).
+    /// MERL-100 and the RGL-51 (`docs/log/fitting.md`, 2026-12-06).
     #[default]
     Perceptual,
 }
@@ -24,7 +24,7 @@ pub enum Metric {
 impl Metric {
     /// [`Metric::Perceptual`]'s ε: this fraction of the material's median x over the MERL
     /// grid (its typical brightness away from the highlight), ...
-    pub const RELATIVE_FLOOR: f64 = 0.1;
+    pub const RELATIVE_FLOOR: f64 = 0.3;
     /// ... and no less than this: under the reference light of `facet report` (a white
     /// Lambertian shown at 0.78, Y ≈ 4.8 x), x = 0.002 is Y ≈ 0.0096, where lightness stops
     /// being a cube root (L* is linear in Y below 0.008856).

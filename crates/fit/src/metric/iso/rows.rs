@@ -137,6 +137,7 @@ mod tests {
     use crate::metric::iso_tables::IsoTables;
     use crate::metric::sums::LinearSums;
     use crate::model::analytic::parse_analytic;
+    use crate::model::brdf::Brdf;
 
     /// The passes give the same bits on the vector path the CPU takes (AVX2 + FMA here) and on
     /// the baseline x86-64 path: `run_rows`' claim. Row by row for the metric (cached and

@@ -202,6 +202,7 @@ mod tests {
     use crate::metric::iso_tables::IsoTables;
     use crate::metric::merl_geometry::COARSE_ROW;
     use crate::model::analytic::parse_analytic;
+    use crate::model::brdf::Brdf;
     use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 
     /// The coarse rows hold every fourth φd bin of the full ones with its cosines and λ(φ): a

@@ -335,6 +335,7 @@ fn l1_channel<const P: usize>(
 mod tests {
     use super::*;
     use crate::model::analytic::parse_analytic;
+    use crate::model::brdf::Brdf;
 
     /// The plain normal equations from the rows' cached sums are the pass's: the same per-row
     /// sums ([`weighted_row`]) added in another order, so equal to f64 rounding (1e-12).
