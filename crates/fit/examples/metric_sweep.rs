@@ -6,6 +6,7 @@
 //!
 //! `cargo run --release -p facet-fit --example metric_sweep -- METRIC [NBRDF.json|-] [CACHE_DIR] [NAME_FILTER]`
 //!
+//! `CHROMA=1` also prints the ΔE a colour table over (θh, θd) times the lobe could reach.
 //! METRIC: `log` or `perceptual` (`FACET_METRIC_KAPPA` and `FACET_METRIC_EPS`
 //! override its floor's fraction of the mean and its least value); `SWEEP_COAT=off`
 //! or `always` overrides the coat search. The proxies'
@@ -64,6 +65,11 @@ fn main() {
         let secs = t.elapsed().as_secs_f64();
         let log_err = microfacet_error(&m.tabulated, &GridSamples::new(&src));
         let de = sphere_delta_e(&src, &m);
+        // CHROMA=1: the bound a colour table over (θh, θd) times the lobe could reach.
+        if std::env::var("CHROMA").is_ok() {
+            let chroma = Chromatic::fit(&src, &m.tabulated);
+            println!("{name:32} with a chromatic table: ΔE {:.2}", sphere_delta_e(&src, &chroma));
+        }
         println!(
             "{name:32} ΔE {de:6.2}  log {log_err:.4}  fit {secs:5.2} s  ρd {:.3} {:.3} {:.3}  coat {}  \
              error {:.4} coated {:.4}",
@@ -148,4 +154,71 @@ fn sphere_delta_e(data: &dyn Brdf, model: &dyn Brdf) -> f64 {
         }
     }
     sum / n.max(1) as f64
+}
+
+/// The tabulated model with its lobe times a colour table over (θh, θd) bins, each bin's ratio
+/// Σ (data − diffuse) / Σ lobe over its φd bins per channel: the most a chromatic table of the
+/// AxF kind could give this single layer (issue 60's third question), before any smoothing.
+struct Chromatic {
+    lobe: facet_fit::model::microfacet::MicrofacetBrdf,
+    diffuse: [f64; 3],
+    table: Vec<[f64; 3]>,
+}
+
+impl Chromatic {
+    fn fit(data: &MerlBrdf, model: &facet_fit::model::microfacet::MicrofacetBrdf) -> Self {
+        use facet_fit::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES, bin_directions};
+        let lobe = facet_fit::model::microfacet::MicrofacetBrdf {
+            diffuse: [0.0; 3],
+            ..model.clone()
+        };
+        let kd = model.diffuse.map(|d| d / std::f64::consts::PI);
+        let mut table = vec![[1.0; 3]; THETA_H_RES * THETA_D_RES];
+        for i in 0..THETA_H_RES {
+            for j in 0..THETA_D_RES {
+                let (mut num, mut den) = ([0.0; 3], [0.0; 3]);
+                for k in 0..PHI_D_RES {
+                    let (wi, wo) = bin_directions(i, j, k);
+                    let (Some(d), Some(l)) = (data.table().value(i, j, k), lobe.eval(wi, wo))
+                    else {
+                        continue;
+                    };
+                    if wi.z <= 0.0 || wo.z <= 0.0 {
+                        continue;
+                    }
+                    for c in 0..3 {
+                        num[c] += (d[c] - kd[c]).max(0.0);
+                        den[c] += l[c];
+                    }
+                }
+                for c in 0..3 {
+                    if den[c] > 0.0 {
+                        table[i * THETA_D_RES + j][c] = (num[c] / den[c]).clamp(0.0, 10.0);
+                    }
+                }
+            }
+        }
+        Chromatic {
+            lobe,
+            diffuse: kd,
+            table,
+        }
+    }
+}
+
+impl Brdf for Chromatic {
+    fn name(&self) -> &str {
+        "chromatic"
+    }
+    fn eval(&self, wi: DVec3, wo: DVec3) -> Option<facet_fit::Rgb> {
+        use facet_fit::model::merl_grid::{THETA_D_RES, THETA_H_RES};
+        let hd = facet_fit::model::geometry::to_half_diff(wi, wo);
+        let half_pi = std::f64::consts::FRAC_PI_2;
+        let i = (((hd.theta_h.max(0.0) / half_pi).sqrt() * THETA_H_RES as f64) as usize)
+            .min(THETA_H_RES - 1);
+        let j = ((hd.theta_d.max(0.0) / half_pi * THETA_D_RES as f64) as usize).min(THETA_D_RES - 1);
+        let c = self.table[i * THETA_D_RES + j];
+        let l = self.lobe.eval(wi, wo)?;
+        Some(std::array::from_fn(|k| l[k] * c[k] + self.diffuse[k]))
+    }
 }
