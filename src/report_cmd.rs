@@ -1,8 +1,8 @@
 //! `facet report`: one HTML page, for a paper's supplement, comparing measured materials with
 //! their fits — per material, spheres of the measurement and of each model under a point light
-//! and an environment, ΔE2000 images, NDF and Fresnel plots, errors and times; a database
-//! summary (sortable table, mean ΔE per model, mean ΔE images over the set); run time against
-//! error over N = 32, 64, 90, 128 ([`sweep`]).
+//! and an environment, their ΔE2000 images and mean ΔE2000 and ΔE_ITP, NDF and Fresnel plots,
+//! errors and times; a database summary (sortable table, mean ΔE per model, mean ΔE images over
+//! the set); run time against error over N = 32, 64, 90, 128 ([`sweep`]).
 
 mod delta_e;
 mod false_colour;
@@ -243,22 +243,25 @@ fn write_page(
     Ok(())
 }
 
-/// The mean ΔE per model over the set, and the wall time.
+/// The mean ΔE2000 and ΔE_ITP per model over the set, and the wall time.
 fn print_means(reports: &[MaterialReport], started: Instant) {
     let means = html::set_means(reports);
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        let v: Vec<String> = scenes::Variant::MODELS
-            .iter()
-            .zip(means[l])
-            .map(|(m, v)| {
-                format!(
-                    "{} {}",
-                    m.key(),
-                    v.map_or("–".into(), |v| format!("{v:.3}"))
-                )
-            })
-            .collect();
-        println!("mean ΔE ({}): {}", lighting.key(), v.join(", "));
+        for (d, name) in ["ΔE", "ΔE_ITP"].iter().enumerate() {
+            let v: Vec<String> = scenes::Variant::MODELS
+                .iter()
+                .zip(means[l])
+                .map(|(m, v)| {
+                    let v = v.map(|v| v.both()[d]);
+                    format!(
+                        "{} {}",
+                        m.key(),
+                        v.map_or("–".into(), |v| format!("{v:.3}"))
+                    )
+                })
+                .collect();
+            println!("mean {name} ({}): {}", lighting.key(), v.join(", "));
+        }
     }
     println!(
         "{} material(s) in {:.1} s",

@@ -1,6 +1,7 @@
 //! The page: one self-contained `index.html` (inline CSS and a few lines of inline JS to sort
 //! the table), its images as PNG and SVG files in `img/` beside it.
 
+use super::delta_e::{DePair, NAMES, REFERENCE_WHITE};
 use super::false_colour::DE_MAX;
 use super::material::{MaterialReport, de_file, reference, render_file, variants};
 use super::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
@@ -43,14 +44,15 @@ fn label(model: Variant) -> &'static str {
 
 const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;max-width:1400px}\
 table{border-collapse:collapse;font-size:13px}td,th{border:1px solid #ccc;padding:2px 6px;\
-text-align:right}th{background:#eee;cursor:pointer}td:first-child{text-align:left}\
+text-align:right}th{background:#eee}thead tr:last-child th{cursor:pointer}\
+td:first-child{text-align:left}.scroll{overflow-x:auto}\
 figure{display:inline-block;margin:4px;text-align:center;font-size:12px}\
 figure img{display:block}section{border-top:1px solid #999;margin-top:1.5em}";
 
-/// Sorts the table by the clicked column: numbers as numbers, the rest as text; a second
-/// click reverses.
-const SORT_JS: &str = "document.querySelectorAll('table.sortable th').forEach((th,i)=>{\
-th.onclick=()=>{const b=th.closest('table').tBodies[0];const rows=[...b.rows];\
+/// Sorts the table by the clicked column (a cell of the last header row): numbers as numbers,
+/// the rest as text; a second click reverses.
+const SORT_JS: &str = "document.querySelectorAll('table.sortable thead tr:last-child th')\
+.forEach(th=>{th.onclick=()=>{const i=th.cellIndex;const b=th.closest('table').tBodies[0];const rows=[...b.rows];\
 const asc=th.dataset.asc!=='1';th.dataset.asc=asc?'1':'0';\
 const v=r=>{const t=r.cells[i].textContent;const n=parseFloat(t);return isNaN(n)?t:n};\
 rows.sort((x,y)=>{const a=v(x),c=v(y);return (a<c?-1:a>c?1:0)*(asc?1:-1)});\
@@ -68,13 +70,20 @@ fn fmt_opt(v: Option<f64>, digits: usize) -> String {
     v.map_or("–".into(), |v| format!("{v:.digits$}"))
 }
 
-/// The mean over the set of each lighting's and model's mean ΔE (`None` where no material has
-/// one).
-pub fn set_means(materials: &[MaterialReport]) -> [[Option<f64>; N_MODELS]; 2] {
+/// The mean of `values` (`None` when empty).
+fn mean(values: &[f64]) -> Option<f64> {
+    (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+}
+
+/// The mean over the set of each lighting's and model's mean ΔE2000 and ΔE_ITP (`None` where
+/// no material has one).
+pub fn set_means(materials: &[MaterialReport]) -> [[Option<DePair<f64>>; N_MODELS]; 2] {
     std::array::from_fn(|l| {
         std::array::from_fn(|m| {
-            let v: Vec<f64> = materials.iter().filter_map(|r| r.mean_de[l][m]).collect();
-            (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+            let v: Vec<DePair<f64>> = materials.iter().filter_map(|r| r.mean_de[l][m]).collect();
+            let de2000 = mean(&v.iter().map(|p| p.de2000).collect::<Vec<_>>())?;
+            let itp = mean(&v.iter().map(|p| p.itp).collect::<Vec<_>>())?;
+            Some(DePair { de2000, itp })
         })
     })
 }
@@ -105,11 +114,14 @@ fn header(info: &PageInfo, n: usize) -> String {
          Fits: isotropic, N = {} polar nodes, a diffuse lobe with every model; {}. Spheres {side}×{side} \
          pixels: (a) one point light, no environment, depth 1, {POINT_SPP} spp (only the pixel \
          positions vary: each pixel is f cos θ I / r²); (b) the environment {}, depth {ENV_DEPTH}, \
-         {} spp.</p>\n<p>ΔE: CIEDE2000 per pixel on the sphere (silhouette excluded) of each \
+         {} spp.</p>\n<p>ΔE per pixel on the sphere (silhouette excluded) of each \
          model against the measurement (or, for a fit JSON, against the model it stands for as \
          a source: its coated tabulated model when it kept a coat, else its tabulated model), on \
          the colours the PNGs show: the tone map 1 − exp(−L) at exposure 0 read as linear \
-         sRGB, to CIELAB (D65), by the <code>palette</code> crate. False colour: viridis from 0 \
+         sRGB. Two differences: <b>ΔE2000</b> (CIEDE2000, CIELAB D65, by the <code>palette</code> \
+         crate) and <b>ΔE_ITP</b> (ITU-R BT.2124: to BT.2020, display white at {REFERENCE_WHITE} \
+         cd/m² — BT.2408's HDR reference white —, ICtCp with PQ; one unit about one \
+         just-noticeable difference). The images show ΔE2000 in false colour: viridis from 0 \
          to {DE_MAX} (and above).</p>\n<img src=\"{SCALE_FILE}\" alt=\"ΔE colour scale\">\n",
         info.version,
         escape(&info.adapter),
@@ -124,51 +136,10 @@ fn header(info: &PageInfo, n: usize) -> String {
 
 fn summary(materials: &[MaterialReport]) -> String {
     let means = set_means(materials);
-    let with_coat = materials.iter().filter(|m| m.coated).count();
-    let mut s = String::from("<section><h2>Database summary</h2>\n<p>Mean ΔE over the set: ");
-    for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        let _ = write!(s, "<b>{}</b>: ", lighting_name(*lighting));
-        for (m, model) in Variant::MODELS.iter().enumerate() {
-            let _ = write!(s, "{} {}; ", model.key(), fmt_opt(means[l][m], 2));
-        }
-    }
-    let _ = write!(
-        s,
-        "the coated model's over the {with_coat} of {} material(s) whose fit kept a coat.</p>\n\
-         <table class=\"sortable\"><thead><tr><th>material</th>",
-        materials.len()
-    );
-    let lightings = Lighting::ALL.map(|l| format!(" ({})", l.key()));
-    for suffix in lightings.iter().map(String::as_str).chain([""]) {
-        let kind = if suffix.is_empty() { "error" } else { "ΔE" };
-        for model in Variant::MODELS {
-            let _ = write!(s, "<th>{kind} {}{suffix}</th>", label(model));
-        }
-    }
-    s += "<th>fit (s)</th><th>render (s)</th></tr></thead><tbody>\n";
-    for m in materials {
-        let _ = write!(
-            s,
-            "<tr><td><a href=\"#{}\">{}</a></td>",
-            escape(&m.stem),
-            escape(&m.name)
-        );
-        for l in 0..2 {
-            for v in m.mean_de[l] {
-                let _ = write!(s, "<td>{}</td>", fmt_opt(v, 2));
-            }
-        }
-        for e in errors(m) {
-            let _ = write!(s, "<td>{}</td>", fmt_opt(e, 4));
-        }
-        let _ = writeln!(
-            s,
-            "<td>{:.2}</td><td>{:.2}</td></tr>",
-            m.fit_ms / 1e3,
-            m.render_ms / 1e3
-        );
-    }
-    s += "</tbody></table>\n<h3>Mean ΔE image over the set</h3>\n";
+    let mut s = String::from("<section><h2>Database summary</h2>\n");
+    s += &means_table(materials, &means);
+    s += &sortable_table(materials);
+    s += "<h3>Mean ΔE2000 image over the set</h3>\n";
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
         for (k, model) in Variant::MODELS.iter().enumerate() {
             if means[l][k].is_some() {
@@ -181,6 +152,95 @@ fn summary(materials: &[MaterialReport]) -> String {
         s += "<br>\n";
     }
     s + "</section>\n"
+}
+
+/// The mean ΔE2000 and ΔE_ITP per model over the set, a row per lighting and difference.
+fn means_table(
+    materials: &[MaterialReport],
+    means: &[[Option<DePair<f64>>; N_MODELS]; 2],
+) -> String {
+    let with_coat = materials.iter().filter(|m| m.coated).count();
+    let mut s = format!(
+        "<p>Mean over the set ({} material(s); the coated model's over the {with_coat} whose \
+         fit kept a coat):</p>\n<table><tr><th>lighting</th><th>difference</th>",
+        materials.len()
+    );
+    for model in Variant::MODELS {
+        let _ = write!(s, "<th>{}</th>", label(model));
+    }
+    s += "</tr>\n";
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        for (d, name) in NAMES.iter().enumerate() {
+            let _ = write!(
+                s,
+                "<tr><td>{}</td><td>{name}</td>",
+                lighting_name(*lighting)
+            );
+            for v in means[l] {
+                let _ = write!(s, "<td>{}</td>", fmt_opt(v.map(|v| v.both()[d]), 2));
+            }
+            s += "</tr>\n";
+        }
+    }
+    s + "</table>\n"
+}
+
+/// The sortable table: a row per material; per lighting and difference, the mean over the
+/// sphere per model; the error metric per model; the times. Two header rows: the groups, then
+/// the columns (click one to sort).
+fn sortable_table(materials: &[MaterialReport]) -> String {
+    let mut s =
+        String::from("<div class=\"scroll\"><table class=\"sortable\"><thead><tr><th></th>");
+    for lighting in Lighting::ALL {
+        for name in NAMES {
+            let _ = write!(
+                s,
+                "<th colspan=\"{N_MODELS}\">{name}, {}</th>",
+                lighting_name(lighting)
+            );
+        }
+    }
+    let _ = write!(
+        s,
+        "<th colspan=\"{N_MODELS}\">error metric</th><th colspan=\"2\">time (s)</th></tr>\n\
+         <tr><th>material</th>"
+    );
+    for _ in 0..2 * NAMES.len() + 1 {
+        for model in Variant::MODELS {
+            let _ = write!(s, "<th>{}</th>", label(model));
+        }
+    }
+    s += "<th>fit</th><th>render</th></tr></thead><tbody>\n";
+    for m in materials {
+        s += &table_row(m);
+    }
+    s + "</tbody></table></div>\n"
+}
+
+/// One material's row of the sortable table.
+fn table_row(m: &MaterialReport) -> String {
+    let mut s = format!(
+        "<tr><td><a href=\"#{}\">{}</a></td>",
+        escape(&m.stem),
+        escape(&m.name)
+    );
+    for l in 0..2 {
+        for d in 0..NAMES.len() {
+            for v in m.mean_de[l] {
+                let _ = write!(s, "<td>{}</td>", fmt_opt(v.map(|v| v.both()[d]), 2));
+            }
+        }
+    }
+    for e in errors(m) {
+        let _ = write!(s, "<td>{}</td>", fmt_opt(e, 4));
+    }
+    let _ = writeln!(
+        s,
+        "<td>{:.2}</td><td>{:.2}</td></tr>",
+        m.fit_ms / 1e3,
+        m.render_ms / 1e3
+    );
+    s
 }
 
 fn lighting_name(l: Lighting) -> &'static str {
@@ -261,7 +321,12 @@ fn material_section(m: &MaterialReport) -> String {
             if let Some(mean) = m.mean_de[l][k] {
                 s += &figure(
                     &de_file(&m.stem, *lighting, *model),
-                    &format!("ΔE {} (mean {mean:.2})", model.key()),
+                    &format!(
+                        "{}: ΔE2000 {:.2}, ΔE_ITP {:.2}",
+                        model.key(),
+                        mean.de2000,
+                        mean.itp
+                    ),
                 );
             }
         }

@@ -2,7 +2,7 @@
 //! point light and the environment), the ΔE images of each model against the reference (the
 //! measurement, or the tabulated model when there is none), and the plots of its NDF and F.
 
-use super::delta_e::{DeltaE, delta_e_image};
+use super::delta_e::{DePair, DeltaE, delta_e_image};
 use super::scenes::{Lighting, N_MODELS, SphereRenderer, Variant, material, on_sphere};
 use super::subject::Subject;
 use super::{false_colour, plots};
@@ -32,9 +32,9 @@ pub struct MaterialReport {
     pub fit_ms: f64,
     /// The renders' wall time, ms.
     pub render_ms: f64,
-    /// Mean ΔE per lighting ([`Lighting::ALL`] order) and model ([`Variant::MODELS`] order);
-    /// `None` for the reference itself and for a model not shown.
-    pub mean_de: [[Option<f64>; N_MODELS]; 2],
+    /// Mean ΔE2000 and ΔE_ITP per lighting ([`Lighting::ALL`] order) and model
+    /// ([`Variant::MODELS`] order); `None` for the reference itself and for a model not shown.
+    pub mean_de: [[Option<DePair<f64>>; N_MODELS]; 2],
     /// The ΔE images in the same order (kept for the database means).
     pub de: [[Option<DeltaE>; N_MODELS]; 2],
 }
