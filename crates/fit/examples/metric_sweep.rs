@@ -134,7 +134,8 @@ fn sphere_delta_e(data: &dyn Brdf, model: &dyn Brdf) -> f64 {
                     true => b.eval(wi, wo).unwrap_or([0.0; 3]),
                     false => [0.0; 3],
                 };
-                let d = f.map(|f| (1.0 - (-(f * wi.z.max(0.0) * irradiance).max(0.0)).exp()) as f32);
+                let d =
+                    f.map(|f| (1.0 - (-(f * wi.z.max(0.0) * irradiance).max(0.0)).exp()) as f32);
                 Lab::from_color(LinSrgb::new(d[0], d[1], d[2]))
             };
             sum += shown(data).difference(shown(model)) as f64;

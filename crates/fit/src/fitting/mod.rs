@@ -28,10 +28,10 @@ use crate::fitting::grids::Grids;
 use crate::fitting::refine::model_of;
 use crate::fitting::tabulated::TabulatedFit;
 use crate::metric::Metric;
+use crate::metric::grid::{GridSamples, microfacet_error};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::FresnelTable;
 use crate::model::fresnel_curves::FresnelChoice;
-use crate::metric::grid::{GridSamples, microfacet_error};
 use crate::model::material::{
     FitRecord, FittedMaterial, MetricErrors, ParamRecord, TabulatedRecord, Timings,
 };

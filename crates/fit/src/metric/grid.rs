@@ -7,8 +7,8 @@
 //! bin and Λ only on cos θ, so each is a small table; `tests/grid.rs` checks it against the
 //! direct evaluation.
 
-use crate::metric::iso::{CoarseSamples, IsoSamples};
 use crate::metric::Metric;
+use crate::metric::iso::{CoarseSamples, IsoSamples};
 use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::{Fresnel, FresnelTable};
