@@ -243,7 +243,8 @@ fn write_page(
     Ok(())
 }
 
-/// The mean ΔE2000 and ΔE_ITP per model over the set, and the wall time.
+/// The mean ΔE2000 and ΔE_ITP per model over the set, the noise floor's mean and median, and
+/// the wall time.
 fn print_means(reports: &[MaterialReport], started: Instant) {
     let means = html::set_means(reports);
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
@@ -262,6 +263,17 @@ fn print_means(reports: &[MaterialReport], started: Instant) {
                 .collect();
             println!("mean {name} ({}): {}", lighting.key(), v.join(", "));
         }
+    }
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        let floors = html::floor_stats(reports)[l];
+        println!(
+            "noise floor ({}): ΔE mean {:.3} median {:.3}, ΔE_ITP mean {:.3} median {:.3}",
+            lighting.key(),
+            floors[0].0,
+            floors[0].1,
+            floors[1].0,
+            floors[1].1
+        );
     }
     println!(
         "{} material(s) in {:.1} s",

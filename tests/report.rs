@@ -62,8 +62,9 @@ fn report_on_three_proxies_writes_every_image() {
     assert!(stdout.contains("mean ΔE (point)"), "{stdout}");
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     let sources = image_sources(&html);
-    // Per material 8 renders, 6 ΔE images, 2 plots, and 2 renders and 2 ΔE images more where
-    // the fit kept a coat; the scale, the sweep, 6 mean images (8 when a fit kept a coat).
+    // Per material 8 renders, 6 ΔE images, 2 of the noise floor, 2 plots, and 2 renders and 2
+    // ΔE images more where the fit kept a coat; the scale, the sweep, 6 mean images (8 when a
+    // fit kept a coat).
     let coated = ["gold-metallic-paint", "blue-acrylic", "alum-bronze"]
         .iter()
         .filter(|name| html.contains(&format!("img/{name}-point-coated.png")))
@@ -71,7 +72,7 @@ fn report_on_three_proxies_writes_every_image() {
     let means = if coated > 0 { 8 } else { 6 };
     assert_eq!(
         sources.len(),
-        3 * 16 + 4 * coated + 1 + 1 + means,
+        3 * 18 + 4 * coated + 1 + 1 + means,
         "{sources:?}"
     );
     for src in &sources {
@@ -122,6 +123,78 @@ fn printed_mean(stdout: &str, lighting: &str, model: &str) -> f64 {
         .unwrap_or_else(|| panic!("no {model} mean in `{line}`"))
 }
 
+/// The noise floor of `lighting` (`point` or `env`) as the run prints it, ΔE2000 and ΔE_ITP
+/// means: `noise floor (env): ΔE mean 0.412 median 0.398, ΔE_ITP mean 1.730 median 1.702`.
+fn printed_floor(stdout: &str, lighting: &str) -> (f64, f64) {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with(&format!("noise floor ({lighting}):")))
+        .unwrap_or_else(|| panic!("no {lighting} noise floor in {stdout}"));
+    let after = |key: &str| -> f64 {
+        let rest = &line[line
+            .find(key)
+            .unwrap_or_else(|| panic!("{key} in `{line}`"))
+            + key.len()..];
+        rest.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    (after("ΔE mean "), after("ΔE_ITP mean "))
+}
+
+/// The noise floor (the measurement rendered again at another seed, against its first render)
+/// of one material at 8 and 32 spp: two independent estimates of a pixel differ by noise of
+/// σ √2 / √N, and for small noise ΔE is proportional to it, so quadrupling N halves the floor
+/// (ratio 0.5; ±0.12 for the ~700 pixels' own scatter and ΔE's curvature, as measured on the
+/// proxies: 0.50 from 16 to 64 spp). Under the point light only the pixel positions vary, so
+/// its floor is far below the environment's (below a quarter of it).
+#[test]
+fn noise_floor_halves_when_the_samples_quadruple() {
+    const TEST: &str = "noise_floor_halves_when_the_samples_quadruple";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_floor");
+    let floor_at = |spp: &str| {
+        let out = format!("page-{spp}");
+        let (ok, stdout, stderr) = facet_in(
+            &dir,
+            &[
+                "report",
+                "analytic:ggx?alpha=0.2&conductor=gold",
+                "--out",
+                &out,
+                "--resolution",
+                "32",
+                "--spp",
+                spp,
+                "--fit-resolution",
+                "32",
+                "--coat",
+                "off",
+                "--sweep",
+                "0",
+            ],
+        );
+        assert!(ok, "{stdout}\n{stderr}");
+        let html = std::fs::read_to_string(dir.join(&out).join("index.html")).unwrap();
+        assert!(html.contains("-env-de-noise.png"), "no noise floor image");
+        (
+            printed_floor(&stdout, "env"),
+            printed_floor(&stdout, "point"),
+        )
+    };
+    let ((env8, itp8), (point8, _)) = floor_at("8");
+    let ((env32, itp32), _) = floor_at("32");
+    eprintln!("noise floor (env): ΔE2000 {env8:.3} → {env32:.3}, ΔE_ITP {itp8:.3} → {itp32:.3}");
+    assert!(env8 > 0.0 && itp8 > 0.0, "{env8} {itp8}");
+    for (ratio, what) in [(env32 / env8, "ΔE2000"), (itp32 / itp8, "ΔE_ITP")] {
+        assert!(
+            (ratio - 0.5).abs() < 0.12,
+            "{what}: 8 → 32 spp ratio {ratio}"
+        );
+    }
+    assert!(point8 < 0.25 * env8, "point {point8}, env {env8}");
+}
+
 /// A measurement made from a known coat (η 1.5, α 0.05, weight 1) over GGX α 0.3 gold, reported
 /// with `--coat always`: the fit keeps the coat, and the page shows its coated model (one more
 /// sphere per lighting, its ΔE images and error). The coated model is the measurement's own
@@ -152,8 +225,9 @@ fn report_of_a_coated_measurement_shows_its_coated_model() {
         .unwrap();
     let (stdout, html) = small_report(&dir, &["coated-gold.binary", "--coat", "always"]);
     let sources = image_sources(&html);
-    // 5 renders and 4 ΔE images per lighting, 2 plots; the scale and 8 mean images.
-    assert_eq!(sources.len(), 2 * 9 + 2 + 1 + 8, "{sources:?}");
+    // 5 renders, 4 ΔE images and the noise floor's per lighting, 2 plots; the scale and 8 mean
+    // images.
+    assert_eq!(sources.len(), 2 * 10 + 2 + 1 + 8, "{sources:?}");
     for src in &sources {
         check_image(&dir.join("page").join(src));
     }

@@ -3,7 +3,7 @@
 
 use super::delta_e::{DePair, NAMES, REFERENCE_WHITE};
 use super::false_colour::DE_MAX;
-use super::material::{MaterialReport, de_file, reference, render_file, variants};
+use super::material::{MaterialReport, de_file, floor_file, reference, render_file, variants};
 use super::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
 use super::scenes::{ENV_DEPTH, Lighting, N_MODELS, POINT_SPP, Variant};
 use super::sweep::SweepPoint;
@@ -88,6 +88,23 @@ pub fn set_means(materials: &[MaterialReport]) -> [[Option<DePair<f64>>; N_MODEL
     })
 }
 
+/// The mean and the median over the set of the noise floor, per lighting and difference
+/// ([`DePair::both`] order).
+pub fn floor_stats(materials: &[MaterialReport]) -> [[(f64, f64); 2]; 2] {
+    std::array::from_fn(|l| {
+        std::array::from_fn(|d| {
+            let mut v: Vec<f64> = materials.iter().map(|m| m.floor[l].both()[d]).collect();
+            v.sort_by(f64::total_cmp);
+            let median = match v.len() {
+                0 => 0.0,
+                n if n % 2 == 1 => v[n / 2],
+                n => 0.5 * (v[n / 2 - 1] + v[n / 2]),
+            };
+            (mean(&v).unwrap_or(0.0), median)
+        })
+    })
+}
+
 /// The whole page.
 pub fn page(info: &PageInfo, materials: &[MaterialReport], sweep: &[SweepPoint]) -> String {
     let mut s = String::new();
@@ -160,15 +177,19 @@ fn means_table(
     means: &[[Option<DePair<f64>>; N_MODELS]; 2],
 ) -> String {
     let with_coat = materials.iter().filter(|m| m.coated).count();
+    let floors = floor_stats(materials);
     let mut s = format!(
         "<p>Mean over the set ({} material(s); the coated model's over the {with_coat} whose \
-         fit kept a coat):</p>\n<table><tr><th>lighting</th><th>difference</th>",
+         fit kept a coat), and the noise floor — the reference rendered again at another seed \
+         against itself: the ΔE of the renders' noise alone, mean and median over the set. A \
+         model's ΔE near the floor is within the noise.</p>\n<table><tr><th>lighting</th>\
+         <th>difference</th>",
         materials.len()
     );
     for model in Variant::MODELS {
         let _ = write!(s, "<th>{}</th>", label(model));
     }
-    s += "</tr>\n";
+    s += "<th>noise floor (mean)</th><th>noise floor (median)</th></tr>\n";
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
         for (d, name) in NAMES.iter().enumerate() {
             let _ = write!(
@@ -179,14 +200,15 @@ fn means_table(
             for v in means[l] {
                 let _ = write!(s, "<td>{}</td>", fmt_opt(v.map(|v| v.both()[d]), 2));
             }
-            s += "</tr>\n";
+            let (mean, median) = floors[l][d];
+            let _ = writeln!(s, "<td>{mean:.2}</td><td>{median:.2}</td></tr>");
         }
     }
     s + "</table>\n"
 }
 
 /// The sortable table: a row per material; per lighting and difference, the mean over the
-/// sphere per model; the error metric per model; the times. Two header rows: the groups, then
+/// sphere per model and the noise floor; the error metric per model; the times. Two header rows: the groups, then
 /// the columns (click one to sort).
 fn sortable_table(materials: &[MaterialReport]) -> String {
     let mut s =
@@ -195,7 +217,8 @@ fn sortable_table(materials: &[MaterialReport]) -> String {
         for name in NAMES {
             let _ = write!(
                 s,
-                "<th colspan=\"{N_MODELS}\">{name}, {}</th>",
+                "<th colspan=\"{}\">{name}, {}</th>",
+                N_MODELS + 1,
                 lighting_name(lighting)
             );
         }
@@ -205,9 +228,13 @@ fn sortable_table(materials: &[MaterialReport]) -> String {
         "<th colspan=\"{N_MODELS}\">error metric</th><th colspan=\"2\">time (s)</th></tr>\n\
          <tr><th>material</th>"
     );
-    for _ in 0..2 * NAMES.len() + 1 {
+    for group in 0..2 * NAMES.len() + 1 {
         for model in Variant::MODELS {
             let _ = write!(s, "<th>{}</th>", label(model));
+        }
+        // The ΔE groups end with the noise floor; the errors' group does not.
+        if group < 2 * NAMES.len() {
+            s += "<th>noise</th>";
         }
     }
     s += "<th>fit</th><th>render</th></tr></thead><tbody>\n";
@@ -229,6 +256,7 @@ fn table_row(m: &MaterialReport) -> String {
             for v in m.mean_de[l] {
                 let _ = write!(s, "<td>{}</td>", fmt_opt(v.map(|v| v.both()[d]), 2));
             }
+            let _ = write!(s, "<td>{:.2}</td>", m.floor[l].both()[d]);
         }
     }
     for e in errors(m) {
@@ -306,7 +334,8 @@ fn material_section(m: &MaterialReport) -> String {
         _ => "the tabulated model (a fit JSON: no measurement to render)",
     };
     let mut s = format!(
-        "<section id=\"{}\"><h2>{}</h2>\n<p>Input <code>{}</code>; ΔE against {reference}.</p>\n",
+        "<section id=\"{}\"><h2>{}</h2>\n<p>Input <code>{}</code>; ΔE against {reference}; the noise floor: \
+         {reference} rendered again at another seed, against its first render.</p>\n",
         escape(&m.stem),
         escape(&m.name),
         escape(&m.input)
@@ -330,6 +359,14 @@ fn material_section(m: &MaterialReport) -> String {
                 );
             }
         }
+        let floor = m.floor[l];
+        s += &figure(
+            &floor_file(&m.stem, *lighting),
+            &format!(
+                "noise floor: ΔE2000 {:.2}, ΔE_ITP {:.2}",
+                floor.de2000, floor.itp
+            ),
+        );
         s += "<br>\n";
     }
     s += &figure(&ndf_file(&m.stem), "NDF (log scale)");

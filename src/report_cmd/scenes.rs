@@ -40,6 +40,11 @@ const LIGHT_INTENSITY: f32 = 40.0;
 pub const ENV_DEPTH: u32 = 3;
 /// Samples per pixel of the point-light renders: only the pixel positions vary (anti-aliasing).
 pub const POINT_SPP: u32 = 4;
+/// The seed of every sphere's render: the measurement and the models take the same sample
+/// sequence.
+pub const SEED: u32 = 0;
+/// The seed of the reference's second render, whose ΔE against the first is the noise floor.
+pub const FLOOR_SEED: u32 = 1;
 
 /// The two lightings of every material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -234,8 +239,8 @@ impl<'g> SphereRenderer<'g> {
         self.side
     }
 
-    /// `material` on the sphere under `lighting`.
-    pub fn render(&mut self, material: Material, lighting: Lighting) -> Result<Image> {
+    /// `material` on the sphere under `lighting`, its samples drawn from `seed`'s sequence.
+    pub fn render(&mut self, material: Material, lighting: Lighting, seed: u32) -> Result<Image> {
         let scene = sphere_scene(material, lighting);
         let env = (lighting == Lighting::Environment).then_some(&self.environment);
         let res = SceneResources::new(self.gpu, &scene, env, ResourceConfig::standard())?;
@@ -268,7 +273,7 @@ impl<'g> SphereRenderer<'g> {
                 height: self.side,
                 wavefront: 1 << 18,
             },
-            sampling,
+            sampling: SampleConfig { seed, ..sampling },
         };
         let (image, _) = integrator.render(self.gpu, &res, &camera, &config, &mut |_| {})?;
         Ok(image)
