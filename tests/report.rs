@@ -290,6 +290,73 @@ fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
     );
 }
 
+/// A fit JSON's record names the metric its fit minimised and its models' errors in the other:
+/// the page says which was minimised and shows each error in its metric's column — as
+/// written, and again with the two metrics swapped in the JSON (the page must follow the
+/// record, not assume the default).
+#[test]
+fn report_shows_the_metric_minimised_and_the_errors_in_both() {
+    const TEST: &str = "report_shows_the_metric_minimised_and_the_errors_in_both";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_metric");
+    let (ok, _, stderr) = facet_in(
+        &dir,
+        &[
+            "fit",
+            "analytic:ggx?alpha=0.3&conductor=gold",
+            "--out",
+            "fits",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    let path = std::fs::read_dir(dir.join("fits"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .expect("a fit JSON");
+    let rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let minimised = rec["metric"].as_str().unwrap().to_owned();
+    let other = rec["other_metric"]["metric"].as_str().unwrap().to_owned();
+    assert_ne!(minimised, other);
+    let own = rec["tabulated"]["error"].as_f64().unwrap();
+    let theirs = rec["other_metric"]["tabulated"].as_f64().unwrap();
+    // The record table's tabulated row: the perceptual column first, then the log one.
+    let row = |perceptual: f64, log: f64| {
+        format!("<tr><td>tabulated</td><td>{perceptual:.4}</td><td>{log:.4}</td>")
+    };
+    let order = |metric: &str, value: f64, other_value: f64| match metric {
+        "perceptual" => (value, other_value),
+        "log" => (other_value, value),
+        m => panic!("unknown metric {m}"),
+    };
+    let (_, html) = small_report(&dir, &[path.to_str().unwrap()]);
+    let (p, l) = order(&minimised, own, theirs);
+    for want in [
+        format!("The fit minimised the {minimised} metric."),
+        format!("<th>error ({minimised}, minimised)</th>"),
+        format!("<th>error ({other})</th>"),
+        format!("<td>{minimised}</td>"),
+        row(p, l),
+    ] {
+        assert!(html.contains(&want), "no {want} on the page");
+    }
+    // The same record with the metrics swapped.
+    let mut swapped = rec.clone();
+    swapped["metric"] = other.clone().into();
+    swapped["other_metric"]["metric"] = minimised.clone().into();
+    swapped["tabulated"]["error"] = theirs.into();
+    swapped["other_metric"]["tabulated"] = own.into();
+    std::fs::write(dir.join("swapped.json"), swapped.to_string()).unwrap();
+    std::fs::remove_dir_all(dir.join("page")).unwrap();
+    let (_, html) = small_report(&dir, &["swapped.json"]);
+    let (p, l) = order(&other, theirs, own);
+    assert!(html.contains(&format!("The fit minimised the {other} metric.")));
+    assert!(html.contains(&row(p, l)), "no {} on the page", row(p, l));
+}
+
 /// A PNG decodes to a non-empty image; an SVG is an `<svg …>` document.
 fn check_image(path: &Path) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));

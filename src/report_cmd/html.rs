@@ -7,6 +7,7 @@ use super::material::{MaterialReport, de_file, floor_file, reference, render_fil
 use super::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
 use super::scenes::{ENV_DEPTH, Lighting, N_MODELS, POINT_SPP, Variant};
 use super::sweep::SweepPoint;
+use facet_fit::model::metric::Metric;
 use std::fmt::Write;
 
 /// What the page says about the run.
@@ -114,6 +115,13 @@ pub fn page(info: &PageInfo, materials: &[MaterialReport], sweep: &[SweepPoint])
          <title>Facet report</title><style>{STYLE}</style></head><body>\n"
     );
     s += &header(info, materials.len());
+    let _ = writeln!(
+        s,
+        "<p>The metric the fits minimised: {}. The errors are given in both metrics: {}; {}.</p>",
+        minimised(materials),
+        metric_words(METRICS[0]),
+        metric_words(METRICS[1])
+    );
     s += &summary(materials);
     if !sweep.is_empty() {
         s += &sweep_section(sweep);
@@ -131,7 +139,7 @@ fn header(info: &PageInfo, n: usize) -> String {
          Fits: isotropic, N = {} polar nodes, a diffuse lobe with every model; {}. Spheres {side}×{side} \
          pixels: (a) one point light, no environment, depth 1, {POINT_SPP} spp (only the pixel \
          positions vary: each pixel is f cos θ I / r²); (b) the environment {}, depth {ENV_DEPTH}, \
-         {} spp.</p>\n<p>ΔE per pixel on the sphere (silhouette excluded) of each \
+         {} spp; both with Owen-scrambled Sobol points, every sphere at the same seed.</p>\n<p>ΔE per pixel on the sphere (silhouette excluded) of each \
          model against the measurement (or, for a fit JSON, against the model it stands for as \
          a source: its coated tabulated model when it kept a coat, else its tabulated model), on \
          the colours the PNGs show: the tone map 1 − exp(−L) at exposure 0 read as linear \
@@ -208,7 +216,8 @@ fn means_table(
 }
 
 /// The sortable table: a row per material; per lighting and difference, the mean over the
-/// sphere per model and the noise floor; the error metric per model; the times. Two header rows: the groups, then
+/// sphere per model and the noise floor; the metric the fit minimised and each model's error
+/// in both metrics; the times. Two header rows: the groups, then
 /// the columns (click one to sort).
 fn sortable_table(materials: &[MaterialReport]) -> String {
     let mut s =
@@ -223,16 +232,24 @@ fn sortable_table(materials: &[MaterialReport]) -> String {
             );
         }
     }
-    let _ = write!(
-        s,
-        "<th colspan=\"{N_MODELS}\">error metric</th><th colspan=\"2\">time (s)</th></tr>\n\
-         <tr><th>material</th>"
-    );
-    for group in 0..2 * NAMES.len() + 1 {
+    s += "<th></th>";
+    for metric in METRICS {
+        let _ = write!(
+            s,
+            "<th colspan=\"{N_MODELS}\">error, {} metric</th>",
+            metric.name()
+        );
+    }
+    s += "<th colspan=\"2\">time (s)</th></tr>\n<tr><th>material</th>";
+    for group in 0..2 * NAMES.len() + METRICS.len() {
+        // The ΔE groups end with the noise floor; the errors' groups follow the metric
+        // minimised.
+        if group == 2 * NAMES.len() {
+            s += "<th>minimised</th>";
+        }
         for model in Variant::MODELS {
             let _ = write!(s, "<th>{}</th>", label(model));
         }
-        // The ΔE groups end with the noise floor; the errors' group does not.
         if group < 2 * NAMES.len() {
             s += "<th>noise</th>";
         }
@@ -259,8 +276,11 @@ fn table_row(m: &MaterialReport) -> String {
             let _ = write!(s, "<td>{:.2}</td>", m.floor[l].both()[d]);
         }
     }
-    for e in errors(m) {
-        let _ = write!(s, "<td>{}</td>", fmt_opt(e, 4));
+    let _ = write!(s, "<td>{}</td>", m.record.metric.name());
+    for metric in METRICS {
+        for e in errors(m, metric) {
+            let _ = write!(s, "<td>{}</td>", fmt_opt(e, 4));
+        }
     }
     let _ = writeln!(
         s,
@@ -278,16 +298,51 @@ fn lighting_name(l: Lighting) -> &'static str {
     }
 }
 
-/// The error metric of each model ([`Variant::MODELS`] order): the tabulated, GGX and
-/// Beckmann single layers and the coated tabulated model.
-fn errors(m: &MaterialReport) -> [Option<f64>; N_MODELS] {
+/// The metrics of the error columns, in the page's order.
+const METRICS: [Metric; 2] = [Metric::Perceptual, Metric::Log];
+
+/// Each model's error in `metric` ([`Variant::MODELS`] order: the tabulated, GGX and Beckmann
+/// single layers and the coated tabulated model): the record's own errors where the fit
+/// minimised `metric`, else its errors in the other metric (`None` where it has none).
+fn errors(m: &MaterialReport, metric: Metric) -> [Option<f64>; N_MODELS] {
     let r = &m.record;
-    [
-        r.tabulated.error,
-        r.ggx.as_ref().map(|p| p.error),
-        r.beckmann.as_ref().map(|p| p.error),
-        r.coat.as_ref().map(|c| c.error),
-    ]
+    if r.metric == metric {
+        return [
+            r.tabulated.error,
+            r.ggx.as_ref().map(|p| p.error),
+            r.beckmann.as_ref().map(|p| p.error),
+            r.coat.as_ref().map(|c| c.error),
+        ];
+    }
+    match &r.other_metric {
+        Some(o) if o.metric == metric => [o.tabulated, o.ggx, o.beckmann, o.coated],
+        _ => [None; N_MODELS],
+    }
+}
+
+/// What a metric measures, for the page.
+fn metric_words(metric: Metric) -> String {
+    format!(
+        "<b>{}</b>: the mean over the MERL grid of |ln(1 + x_model/ε) − ln(1 + x_data/ε)|, \
+         x = f cos θi, ε = {}",
+        metric.name(),
+        metric.floor()
+    )
+}
+
+/// Which metric the set's fits minimised: each metric with its count.
+fn minimised(materials: &[MaterialReport]) -> String {
+    let counts: Vec<String> = METRICS
+        .iter()
+        .filter_map(|&metric| {
+            let n = materials
+                .iter()
+                .filter(|m| m.record.metric == metric)
+                .count();
+            (n > 0).then(|| format!("{} ({n} of {})", metric.name(), materials.len()))
+        })
+        .collect();
+    counts.join(", ")
 }
 
 fn figure(src: &str, caption: &str) -> String {
@@ -300,10 +355,11 @@ fn figure(src: &str, caption: &str) -> String {
 }
 
 fn sweep_section(points: &[SweepPoint]) -> String {
+    let metric = points.first().map_or("", |p| p.metric.name());
     let mut s = format!(
         "<section><h2>Run time against error</h2>\n<img src=\"{SWEEP_FILE}\" alt=\"sweep\">\n\
-         <table><thead><tr><th>material</th><th>N</th><th>fit (s)</th><th>power iteration (ms)</th><th>error tab</th>\
-         <th>error GGX</th><th>error Beck</th></tr></thead><tbody>\n"
+         <table><thead><tr><th>material</th><th>N</th><th>fit (s)</th><th>power iteration (ms)</th><th>error tab ({metric})</th>\
+         <th>error GGX ({metric})</th><th>error Beck ({metric})</th></tr></thead><tbody>\n"
     );
     for p in points {
         let _ = write!(
@@ -375,20 +431,25 @@ fn material_section(m: &MaterialReport) -> String {
     s + "</section>\n"
 }
 
-/// The fit's errors, parameters and times.
+/// The fit's errors in both metrics, its parameters and times.
 fn record_table(m: &MaterialReport) -> String {
     let r = &m.record;
     let t = &r.timings_ms;
-    let e = errors(m);
+    let e = METRICS.map(|metric| errors(m, metric));
+    let cells = |k: usize| -> String {
+        e.iter()
+            .map(|e| format!("<td>{}</td>", fmt_opt(e[k], 4)))
+            .collect()
+    };
     let alpha = |p: &Option<facet_fit::model::material::ParamRecord>| {
         p.as_ref()
             .map_or("–".into(), |p| format!("α {:.4}", p.alpha_x))
     };
     let coated = r.coat.as_ref().map_or(String::new(), |c| {
         format!(
-            "<tr><td>coated</td><td>{}</td><td>coat η {}, α {:.4}, weight {:.3} over the base's \
+            "<tr><td>coated</td>{}<td>coat η {}, α {:.4}, weight {:.3} over the base's \
              tabulated model (its own fit under the coat: N = {}, {} iterations)</td></tr>",
-            fmt_opt(e[3], 4),
+            cells(3),
             c.coat.eta,
             c.coat.alpha,
             c.coat.weight,
@@ -396,19 +457,32 @@ fn record_table(m: &MaterialReport) -> String {
             c.base.iterations
         )
     });
+    let heads: String = METRICS
+        .iter()
+        .map(|&metric| {
+            let mark = if metric == r.metric {
+                ", minimised"
+            } else {
+                ""
+            };
+            format!("<th>error ({}{mark})</th>", metric.name())
+        })
+        .collect();
     format!(
-        "<table><tr><th>model</th><th>error metric</th><th>parameters</th></tr>\
-         <tr><td>tabulated</td><td>{}</td><td>N = {}, {} iterations</td></tr>\
-         <tr><td>GGX</td><td>{}</td><td>{}</td></tr>\
-         <tr><td>Beckmann</td><td>{}</td><td>{}</td></tr>{coated}</table>\n\
+        "<p>The fit minimised the {} metric.</p>\n<table><tr><th>model</th>{heads}\
+         <th>parameters</th></tr>\
+         <tr><td>tabulated</td>{}<td>N = {}, {} iterations</td></tr>\
+         <tr><td>GGX</td>{}<td>{}</td></tr>\
+         <tr><td>Beckmann</td>{}<td>{}</td></tr>{coated}</table>\n\
          <p>Fit times (ms): load {:.0}, extract {:.0}, Fresnel and diffuse {:.0}, fits {:.0}, \
          coat search {:.0}, total {:.0}; fit here {:.0} ms, renders {:.0} ms.</p>\n",
-        fmt_opt(e[0], 4),
+        r.metric.name(),
+        cells(0),
         r.resolution,
         r.iterations,
-        fmt_opt(e[1], 4),
+        cells(1),
         alpha(&r.ggx),
-        fmt_opt(e[2], 4),
+        cells(2),
         alpha(&r.beckmann),
         t.load,
         t.extract,
