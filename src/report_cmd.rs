@@ -1,8 +1,8 @@
 //! `facet report`: one HTML page, for a paper's supplement, comparing measured materials with
 //! their fits — per material, spheres of the measurement and of each model under a point light
-//! and an environment, ΔE2000 images, NDF and Fresnel plots, errors and times; a database
-//! summary (sortable table, mean ΔE per model, mean ΔE images over the set); run time against
-//! error over N = 32, 64, 90, 128 ([`sweep`]).
+//! and an environment, their ΔE2000 images and mean ΔE2000 and ΔE_ITP, NDF and Fresnel plots,
+//! errors and times; a database summary (sortable table, mean ΔE per model, mean ΔE images over
+//! the set); run time against error over N = 32, 64, 90, 128 ([`sweep`]).
 
 mod delta_e;
 mod false_colour;
@@ -47,8 +47,10 @@ pub struct ReportArgs {
     /// on two CPU cores with lavapipe).
     #[arg(long, default_value_t = 128, value_parser = crate::args::side)]
     resolution: u32,
-    /// Samples per pixel of the environment renders, 1 to 2^20 (the point-light renders take 4:
-    /// only their pixel positions vary).
+    /// Samples per pixel of the environment renders, 1 to 2^20, best a power of two (scrambled
+    /// Sobol points). 16: a noise floor of about 1.6 ΔE2000 and the 100 proxies within 10
+    /// minutes; it halves at 4 times the samples and the cost (docs/report.md). The point-light
+    /// renders take 4: only their pixel positions vary.
     #[arg(long, default_value_t = 16, value_parser = crate::args::spp)]
     spp: u32,
     /// Polar nodes N of the fits, 2 to 4096.
@@ -248,22 +250,37 @@ fn write_page(
     Ok(())
 }
 
-/// The mean ΔE per model over the set, and the wall time.
+/// The mean ΔE2000 and ΔE_ITP per model over the set, the noise floor's mean and median, and
+/// the wall time.
 fn print_means(reports: &[MaterialReport], started: Instant) {
     let means = html::set_means(reports);
     for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        let v: Vec<String> = scenes::Variant::MODELS
-            .iter()
-            .zip(means[l])
-            .map(|(m, v)| {
-                format!(
-                    "{} {}",
-                    m.key(),
-                    v.map_or("–".into(), |v| format!("{v:.3}"))
-                )
-            })
-            .collect();
-        println!("mean ΔE ({}): {}", lighting.key(), v.join(", "));
+        for (d, name) in ["ΔE", "ΔE_ITP"].iter().enumerate() {
+            let v: Vec<String> = scenes::Variant::MODELS
+                .iter()
+                .zip(means[l])
+                .map(|(m, v)| {
+                    let v = v.map(|v| v.both()[d]);
+                    format!(
+                        "{} {}",
+                        m.key(),
+                        v.map_or("–".into(), |v| format!("{v:.3}"))
+                    )
+                })
+                .collect();
+            println!("mean {name} ({}): {}", lighting.key(), v.join(", "));
+        }
+    }
+    for (l, lighting) in Lighting::ALL.iter().enumerate() {
+        let floors = html::floor_stats(reports)[l];
+        println!(
+            "noise floor ({}): ΔE mean {:.3} median {:.3}, ΔE_ITP mean {:.3} median {:.3}",
+            lighting.key(),
+            floors[0].0,
+            floors[0].1,
+            floors[1].0,
+            floors[1].1
+        );
     }
     println!(
         "{} material(s) in {:.1} s",

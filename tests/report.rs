@@ -1,6 +1,8 @@
 //! `facet report`: the page on three proxies, every image it names present and decodable, the
 //! page loaded in a real browser (headless Chromium) with every image loaded; the ΔE path
-//! (palette's CIEDE2000 on the displayed colours) against Sharma, Wu & Dalal's test data.
+//! (palette's CIEDE2000 on the displayed colours) against Sharma, Wu & Dalal's test data; ΔE_ITP
+//! (BT.2124) against published PQ levels and the BT.2087 matrix, and against values computed
+//! independently from the BT.2100 formulas.
 
 mod common;
 
@@ -10,9 +12,12 @@ mod common;
 mod delta_e;
 
 use common::{facet_in, scratch};
-use delta_e::{ciede2000, delta_e_image, displayed, lab};
+use delta_e::{
+    REC709_TO_REC2020, REFERENCE_WHITE, ciede2000, delta_e_image, delta_e_itp, displayed, ictcp,
+    lab, pq,
+};
 use facet_render::Image;
-use palette::Lab;
+use palette::{Lab, LinSrgb};
 use std::path::Path;
 use std::process::Command;
 
@@ -57,8 +62,19 @@ fn report_on_three_proxies_writes_every_image() {
     assert!(stdout.contains("mean ΔE (point)"), "{stdout}");
     let html = std::fs::read_to_string(out.join("index.html")).unwrap();
     let sources = image_sources(&html);
-    // Per material 8 renders, 6 ΔE images, 2 plots; the scale, the sweep, 6 mean images.
-    assert_eq!(sources.len(), 3 * 16 + 1 + 1 + 6, "{sources:?}");
+    // Per material 8 renders, 6 ΔE images, 2 of the noise floor, 2 plots, and 2 renders and 2
+    // ΔE images more where the fit kept a coat; the scale, the sweep, 6 mean images (8 when a
+    // fit kept a coat).
+    let coated = ["gold-metallic-paint", "blue-acrylic", "alum-bronze"]
+        .iter()
+        .filter(|name| html.contains(&format!("img/{name}-point-coated.png")))
+        .count();
+    let means = if coated > 0 { 8 } else { 6 };
+    assert_eq!(
+        sources.len(),
+        3 * 18 + 4 * coated + 1 + 1 + means,
+        "{sources:?}"
+    );
     for src in &sources {
         check_image(&out.join(src));
     }
@@ -107,6 +123,81 @@ fn printed_mean(stdout: &str, lighting: &str, model: &str) -> f64 {
         .unwrap_or_else(|| panic!("no {model} mean in `{line}`"))
 }
 
+/// The noise floor of `lighting` (`point` or `env`) as the run prints it, ΔE2000 and ΔE_ITP
+/// means: `noise floor (env): ΔE mean 0.412 median 0.398, ΔE_ITP mean 1.730 median 1.702`.
+fn printed_floor(stdout: &str, lighting: &str) -> (f64, f64) {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with(&format!("noise floor ({lighting}):")))
+        .unwrap_or_else(|| panic!("no {lighting} noise floor in {stdout}"));
+    let after = |key: &str| -> f64 {
+        let rest = &line[line
+            .find(key)
+            .unwrap_or_else(|| panic!("{key} in `{line}`"))
+            + key.len()..];
+        rest.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    (after("ΔE mean "), after("ΔE_ITP mean "))
+}
+
+/// The noise floor (the measurement rendered again at another seed, against its first render)
+/// of one material at 8 and 32 spp: two independent estimates of a pixel (two randomisations of
+/// its scrambled Sobol points) differ by noise of σ √2 / √N, and for small noise ΔE is
+/// proportional to it, so quadrupling N halves the floor (ratio 0.5; the Sobol points'
+/// stratification can only make it smaller, little on these integrands with the sun's and the
+/// lobe choice's discontinuities: 0.47 and 0.45 measured on the proxies from 16 to 64 and from
+/// 64 to 256 spp; ±0.12 for that, the ~700 pixels' own scatter and ΔE's curvature). Under the
+/// point light only the pixel positions vary, so its floor is far below the environment's
+/// (below a quarter of it).
+#[test]
+fn noise_floor_halves_when_the_samples_quadruple() {
+    const TEST: &str = "noise_floor_halves_when_the_samples_quadruple";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_floor");
+    let floor_at = |spp: &str| {
+        let out = format!("page-{spp}");
+        let (ok, stdout, stderr) = facet_in(
+            &dir,
+            &[
+                "report",
+                "analytic:ggx?alpha=0.2&conductor=gold",
+                "--out",
+                &out,
+                "--resolution",
+                "32",
+                "--spp",
+                spp,
+                "--fit-resolution",
+                "32",
+                "--coat",
+                "off",
+                "--sweep",
+                "0",
+            ],
+        );
+        assert!(ok, "{stdout}\n{stderr}");
+        let html = std::fs::read_to_string(dir.join(&out).join("index.html")).unwrap();
+        assert!(html.contains("-env-de-noise.png"), "no noise floor image");
+        (
+            printed_floor(&stdout, "env"),
+            printed_floor(&stdout, "point"),
+        )
+    };
+    let ((env8, itp8), (point8, _)) = floor_at("8");
+    let ((env32, itp32), _) = floor_at("32");
+    eprintln!("noise floor (env): ΔE2000 {env8:.3} → {env32:.3}, ΔE_ITP {itp8:.3} → {itp32:.3}");
+    assert!(env8 > 0.0 && itp8 > 0.0, "{env8} {itp8}");
+    for (ratio, what) in [(env32 / env8, "ΔE2000"), (itp32 / itp8, "ΔE_ITP")] {
+        assert!(
+            (ratio - 0.5).abs() < 0.12,
+            "{what}: 8 → 32 spp ratio {ratio}"
+        );
+    }
+    assert!(point8 < 0.25 * env8, "point {point8}, env {env8}");
+}
+
 /// A measurement made from a known coat (η 1.5, α 0.05, weight 1) over GGX α 0.3 gold, reported
 /// with `--coat always`: the fit keeps the coat, and the page shows its coated model (one more
 /// sphere per lighting, its ΔE images and error). The coated model is the measurement's own
@@ -137,16 +228,13 @@ fn report_of_a_coated_measurement_shows_its_coated_model() {
         .unwrap();
     let (stdout, html) = small_report(&dir, &["coated-gold.binary", "--coat", "always"]);
     let sources = image_sources(&html);
-    // 5 renders and 4 ΔE images per lighting, 2 plots; the scale and 8 mean images.
-    assert_eq!(sources.len(), 2 * 9 + 2 + 1 + 8, "{sources:?}");
+    // 5 renders, 4 ΔE images and the noise floor's per lighting, 2 plots; the scale and 8 mean
+    // images.
+    assert_eq!(sources.len(), 2 * 10 + 2 + 1 + 8, "{sources:?}");
     for src in &sources {
         check_image(&dir.join("page").join(src));
     }
-    for want in [
-        "point-coated.png",
-        "env-de-coated.png",
-        "<th>error coated</th>",
-    ] {
+    for want in ["point-coated.png", "env-de-coated.png", "<th>coated</th>"] {
         assert!(html.contains(want), "no {want} on the page");
     }
     let (coated, single) = (
@@ -203,6 +291,73 @@ fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
         single > 1.0,
         "ΔE of the single layer against the coated model: {single}"
     );
+}
+
+/// A fit JSON's record names the metric its fit minimised and its models' errors in the other:
+/// the page says which was minimised and shows each error in its metric's column — as
+/// written, and again with the two metrics swapped in the JSON (the page must follow the
+/// record, not assume the default).
+#[test]
+fn report_shows_the_metric_minimised_and_the_errors_in_both() {
+    const TEST: &str = "report_shows_the_metric_minimised_and_the_errors_in_both";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_metric");
+    let (ok, _, stderr) = facet_in(
+        &dir,
+        &[
+            "fit",
+            "analytic:ggx?alpha=0.3&conductor=gold",
+            "--out",
+            "fits",
+        ],
+    );
+    assert!(ok, "{stderr}");
+    let path = std::fs::read_dir(dir.join("fits"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .expect("a fit JSON");
+    let rec: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let minimised = rec["metric"].as_str().unwrap().to_owned();
+    let other = rec["other_metric"]["metric"].as_str().unwrap().to_owned();
+    assert_ne!(minimised, other);
+    let own = rec["tabulated"]["error"].as_f64().unwrap();
+    let theirs = rec["other_metric"]["tabulated"].as_f64().unwrap();
+    // The record table's tabulated row: the perceptual column first, then the log one.
+    let row = |perceptual: f64, log: f64| {
+        format!("<tr><td>tabulated</td><td>{perceptual:.4}</td><td>{log:.4}</td>")
+    };
+    let order = |metric: &str, value: f64, other_value: f64| match metric {
+        "perceptual" => (value, other_value),
+        "log" => (other_value, value),
+        m => panic!("unknown metric {m}"),
+    };
+    let (_, html) = small_report(&dir, &[path.to_str().unwrap()]);
+    let (p, l) = order(&minimised, own, theirs);
+    for want in [
+        format!("The fit minimised the {minimised} metric."),
+        format!("<th>error ({minimised}, minimised)</th>"),
+        format!("<th>error ({other})</th>"),
+        format!("<td>{minimised}</td>"),
+        row(p, l),
+    ] {
+        assert!(html.contains(&want), "no {want} on the page");
+    }
+    // The same record with the metrics swapped.
+    let mut swapped = rec.clone();
+    swapped["metric"] = other.clone().into();
+    swapped["other_metric"]["metric"] = minimised.clone().into();
+    swapped["tabulated"]["error"] = theirs.into();
+    swapped["other_metric"]["tabulated"] = own.into();
+    std::fs::write(dir.join("swapped.json"), swapped.to_string()).unwrap();
+    std::fs::remove_dir_all(dir.join("page")).unwrap();
+    let (_, html) = small_report(&dir, &["swapped.json"]);
+    let (p, l) = order(&other, theirs, own);
+    assert!(html.contains(&format!("The fit minimised the {other} metric.")));
+    assert!(html.contains(&row(p, l)), "no {} on the page", row(p, l));
 }
 
 /// A PNG decodes to a non-empty image; an SVG is an `<svg …>` document.
@@ -374,8 +529,9 @@ fn displayed_colours_have_the_expected_lab() {
     }
 }
 
-/// An image against itself: ΔE 0 at every masked pixel, none elsewhere; against a copy with
-/// one pixel changed, ΔE > 0 there alone (a ΔE that is always 0 would fail here).
+/// An image against itself: ΔE 0 (both differences) at every masked pixel, none elsewhere;
+/// against a copy with one pixel changed, both above 1 there alone (a ΔE that is always 0 would
+/// fail here).
 #[test]
 fn delta_e_of_an_image_against_itself_is_zero() {
     let pixels: Vec<[f32; 3]> = (0..64)
@@ -390,14 +546,150 @@ fn delta_e_of_an_image_against_itself_is_zero() {
     let mask = |x: u32, _y: u32| x < 6;
     let same = delta_e_image(&image, &image, &mask);
     assert_eq!(same.values.iter().flatten().count(), 48);
-    assert!(same.values.iter().flatten().all(|&v| v == 0.0));
-    assert_eq!(same.mean(), 0.0);
+    assert!(
+        same.values
+            .iter()
+            .flatten()
+            .all(|v| v.de2000 == 0.0 && v.itp == 0.0)
+    );
+    let mean = same.mean();
+    assert_eq!((mean.de2000, mean.itp), (0.0, 0.0));
     let mut other = image.clone();
     other.pixels[9] = [0.5, 0.1, 0.1];
     let diff = delta_e_image(&image, &other, &mask);
-    assert!(diff.values[9].unwrap() > 1.0);
+    let changed = diff.values[9].unwrap();
+    assert!(changed.de2000 > 1.0 && changed.itp > 1.0, "{changed:?}");
     assert_eq!(
-        diff.values.iter().flatten().filter(|&&v| v > 0.0).count(),
+        diff.values
+            .iter()
+            .flatten()
+            .filter(|v| v.de2000 > 0.0 || v.itp > 0.0)
+            .count(),
         1
     );
+}
+
+/// The PQ inverse EOTF (SMPTE ST 2084) at the signal levels ITU-R BT.2408 publishes: 100 cd/m²
+/// → 0.508 (50.8 %), 203 cd/m² → 0.58 (58 %, its HDR reference white), 1000 cd/m² → 0.752
+/// (75.2 %), within half their last digit; 10 000 cd/m² → 1 and 0 → c1^m2 = 0.8359375^78.84375
+/// = 7.3096·10⁻⁷ by the formula's own constants (to 10⁻¹⁰).
+#[test]
+fn pq_matches_published_signal_levels() {
+    for (cd, want, within) in [
+        (100.0, 0.508, 5e-4),
+        (203.0, 0.58, 5e-3),
+        (1000.0, 0.752, 5e-4),
+        (10_000.0, 1.0, 1e-12),
+        (0.0, 7.309_56e-7, 1e-10),
+    ] {
+        let got = pq(cd);
+        assert!((got - want).abs() < within, "PQ({cd}) = {got}, want {want}");
+    }
+}
+
+/// The Rec. 709 → BT.2020 matrix: each row sums to 1 (D65 white to D65 white, to 10⁻¹²), and
+/// it is ITU-R BT.2087's printed matrix within its 4 decimals' rounding (5·10⁻⁵).
+#[test]
+fn rec709_to_rec2020_is_bt2087s_matrix() {
+    let printed = [
+        [0.6274, 0.3293, 0.0433],
+        [0.0691, 0.9195, 0.0114],
+        [0.0164, 0.0880, 0.8956],
+    ];
+    for (row, want) in REC709_TO_REC2020.iter().zip(printed) {
+        assert!((row.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{row:?}");
+        for (got, want) in row.iter().zip(want) {
+            assert!((got - want).abs() <= 5e-5, "{row:?} against {want}");
+        }
+    }
+}
+
+/// ICtCp and ΔE_ITP against values computed independently, in Python (double precision), from
+/// the BT.2100 and BT.2124 formulas as published: the 709 → 2020 matrix derived in exact
+/// fractions from the two sets of primaries and D65 (0.3127, 0.3290); LMS = [1688 2146 262;
+/// 683 2951 462; 99 309 3688]/4096 · RGB₂₀₂₀ · 203 cd/m²; PQ with m1 = 2610/16384,
+/// m2 = 2523/4096·128, c1 = 3424/4096, c2 = 2413/4096·32, c3 = 2392/4096·32 on Y = Fd/10000;
+/// I = ½L′ + ½M′, Ct = (6610 L′ − 13613 M′ + 7003 S′)/4096, Cp = (17933 L′ − 17390 M′ −
+/// 543 S′)/4096; ΔE_ITP = 720 √(ΔI² + (½ΔCt)² + ΔCp²). The inputs are exact in f32 (dyadic),
+/// so the only differences are double rounding (about 10⁻¹⁵ relative): 10⁻⁹ covers them with
+/// room. White shows I = PQ(203) and Ct = Cp = 0 by theory (the LMS rows sum to 4096 and the
+/// Ct and Cp rows to 0).
+#[test]
+fn ictcp_and_delta_e_itp_match_independent_values() {
+    assert_eq!(REFERENCE_WHITE, 203.0);
+    let rgb = |c: [f32; 3]| LinSrgb::new(c[0], c[1], c[2]);
+    let white = ictcp(rgb([1.0; 3]));
+    assert!((white[0] - pq(203.0)).abs() < 1e-12, "{white:?}");
+    assert!(
+        white[1].abs() < 1e-12 && white[2].abs() < 1e-12,
+        "{white:?}"
+    );
+    let colours: [([f32; 3], [f64; 3]); 4] = [
+        (
+            [1.0, 0.0, 0.0],
+            [
+                0.42788028436228087,
+                -0.11570435976966692,
+                0.2787289473753569,
+            ],
+        ),
+        (
+            [0.0, 1.0, 0.0],
+            [
+                0.5397602802111274,
+                -0.28124791880456723,
+                -0.04948450651597002,
+            ],
+        ),
+        (
+            [0.0, 0.0, 1.0],
+            [
+                0.35598362802705463,
+                0.2693341555682033,
+                -0.16137109768327434,
+            ],
+        ),
+        (
+            [0.5, 0.25, 0.125],
+            [
+                0.45709449739191776,
+                -0.06778701164057643,
+                0.06341792416056771,
+            ],
+        ),
+    ];
+    for (c, want) in colours {
+        let got = ictcp(rgb(c));
+        for k in 0..3 {
+            assert!(
+                (got[k] - want[k]).abs() < 1e-9,
+                "{c:?}: {got:?} against {want:?}"
+            );
+        }
+    }
+    let pairs: [([f32; 3], [f32; 3], f64); 5] = [
+        ([0.5, 0.5, 0.5], [0.5078125, 0.5, 0.5], 0.751123846162787),
+        (
+            [0.5, 0.25, 0.125],
+            [0.4375, 0.28125, 0.125],
+            13.528704623814072,
+        ),
+        ([1.0, 1.0, 1.0], [0.875, 0.875, 0.875], 10.016530201019798),
+        (
+            [0.015625, 0.03125, 0.0078125],
+            [0.0234375, 0.03125, 0.01171875],
+            12.312849615665444,
+        ),
+        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 256.68012347128337),
+    ];
+    for (a, b, want) in pairs {
+        let got = delta_e_itp(ictcp(rgb(a)), ictcp(rgb(b)));
+        assert!(
+            (got - want).abs() < 1e-9 * want,
+            "{a:?} {b:?}: {got} against {want}"
+        );
+        // Symmetric, and 0 against itself.
+        assert_eq!(got, delta_e_itp(ictcp(rgb(b)), ictcp(rgb(a))));
+        assert_eq!(delta_e_itp(ictcp(rgb(a)), ictcp(rgb(a))), 0.0);
+    }
 }

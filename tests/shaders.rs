@@ -217,7 +217,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         }),
         layout_check!(GpuFrame, "render/extend.wgsl", "Frame", {
             width, height, tile_base, tile_pixels, wavefront, sample_end, max_depth, seed,
-            rr_depth, ray_epsilon, strategy, ndf_sampling, moments, pad0, pad1, pad2, scene,
+            rr_depth, ray_epsilon, strategy, ndf_sampling, moments, sequence, pad1, pad2, scene,
             cam_pos, cam_forward, cam_up, cam_right,
         }),
         layout_check!(GpuSceneInfo, "render/extend.wgsl", "SceneInfo", {

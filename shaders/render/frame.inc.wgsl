@@ -57,7 +57,8 @@ struct Frame {
     ndf_sampling: u32,
     // 1: also accumulate squared radiance into film_sq (per-pixel variance)
     moments: u32,
-    pad0: u32,
+    // SEQUENCE_*
+    sequence: u32,
     pad1: u32,
     pad2: u32,
     scene: SceneInfo,
@@ -117,8 +118,80 @@ fn pcg(v: u32) -> u32 {
 
 // Dimension d of sample s of pixel p: a uniform number in [0, 1).
 fn rand(p: u32, s: u32, d: u32) -> f32 {
+    if (frame.sequence == SEQUENCE_SOBOL) {
+        return sobol_rand(p, s, d);
+    }
     let h = pcg(pcg(pcg(p ^ pcg(frame.seed)) + s) + d);
     return f32(h >> 8u) * (1.0 / 16777216.0);
+}
+
+// Owen-scrambled Sobol points (Burley 2020, "Practical hash-based Owen scrambling"). The
+// dimensions a bounce uses together are paired — the pixel position (0, 1), the light sample's
+// point (k = 1, 2 of a bounce) and the BSDF sample's direction (k = 3, 4) — and each pair takes
+// the first two dimensions of the Sobol sequence, a (0, 2)-sequence: the first 2^m samples of a
+// pixel are then stratified in every elementary interval of area 2^-m of that pair. The other
+// dimensions take the first (van der Corput). Each pair's sample index is shuffled and its
+// values scrambled by hashes keyed by (pixel, seed, pair), so pairs are independent of one
+// another (padding) and every pixel and seed is an independent randomisation: unbiased, as
+// the PCG numbers are.
+
+// The Laine-Karras permutation, Burley's constants: bit i of the result depends on bits ≤ i.
+fn lk_permutation(x_in: u32, seed: u32) -> u32 {
+    var x = x_in + seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return x;
+}
+
+// Nested uniform (Owen) scrambling in base 2: each bit flipped by a hash of the bits above it.
+fn owen_scramble(x: u32, seed: u32) -> u32 {
+    return reverseBits(lk_permutation(reverseBits(x), seed));
+}
+
+// The second Sobol dimension of index i, its generator matrix (the Pascal matrix mod 2) a
+// column at a time: v_k+1 = v_k ^ (v_k >> 1) from v_1 = 2^31.
+fn sobol_second(i: u32) -> u32 {
+    var v = 0x80000000u;
+    var r = 0u;
+    var n = i;
+    loop {
+        if (n == 0u) {
+            break;
+        }
+        if ((n & 1u) != 0u) {
+            r ^= v;
+        }
+        n = n >> 1u;
+        v ^= v >> 1u;
+    }
+    return r;
+}
+
+// Dimension d of sample s of pixel p from the scrambled Sobol points: (the first dimension of
+// its pair, which of the pair's two it is).
+fn sobol_pair(d: u32) -> vec2<u32> {
+    if (d < 2u) {
+        return vec2<u32>(0u, d);
+    }
+    let k = (d - 2u) % DIMS_PER_BOUNCE;
+    if (k == 2u || k == 4u) {
+        return vec2<u32>(d - 1u, 1u);
+    }
+    return vec2<u32>(d, 0u);
+}
+
+fn sobol_rand(p: u32, s: u32, d: u32) -> f32 {
+    let pair = sobol_pair(d);
+    let key = pcg(pcg(p ^ pcg(frame.seed)) ^ pcg(pair.x + 0x2545f491u));
+    let index = owen_scramble(s, key);
+    var x = reverseBits(index);
+    if (pair.y == 1u) {
+        x = sobol_second(index);
+    }
+    x = owen_scramble(x, pcg(key ^ (0x68bc21ebu * (pair.y + 1u))));
+    return f32(x >> 8u) * (1.0 / 16777216.0);
 }
 
 // Random dimensions used per bounce.

@@ -30,6 +30,10 @@ const NDF_SAMPLING_VISIBLE: u32 = 0u; // the normals visible from ωo (Heitz 201
 const NDF_SAMPLING_D_COS: u32 = 1u; // D(h) cos θh, the older choice, kept to measure against
 const NDF_SAMPLING_COSINE: u32 = 2u; // the cosine lobe alone, in the microfacet and measured MERL stages: the reference
 
+// facet_render::tags::Sequence
+const SEQUENCE_RANDOM: u32 = 0u; // independent numbers: a PCG hash of (pixel, sample, dimension, seed)
+const SEQUENCE_SOBOL: u32 = 1u; // Owen-scrambled Sobol points, the dimensions a bounce uses together stratified
+
 // facet_render::tags::Region
 const R_ORIGIN: u32 = 0u; // xyz origin, w cone width at the origin
 const R_DIR: u32 = 1u; // xyz direction, w cone spread angle

@@ -1,5 +1,6 @@
-//! ΔE images in false colour: viridis (plotters' colour map) from 0 to [`DE_MAX`], pixels off
-//! the sphere dark grey. One fixed scale for every image of a report, so that images compare.
+//! ΔE images in false colour: their ΔE2000, viridis (plotters' colour map) from 0 to
+//! [`DE_MAX`], pixels off the sphere dark grey. One fixed scale for every image of a report, so
+//! that images compare.
 
 use super::delta_e::DeltaE;
 use anyhow::{Context, Result};
@@ -18,12 +19,12 @@ pub fn colour(de: f32) -> [u8; 3] {
     [c.0, c.1, c.2]
 }
 
-/// Writes `de` as an 8-bit PNG in false colour.
+/// Writes the ΔE2000 of `de` as an 8-bit PNG in false colour.
 pub fn write_png(de: &DeltaE, path: &Path) -> Result<()> {
     let bytes: Vec<u8> = de
         .values
         .iter()
-        .flat_map(|v| v.map_or(OFF, colour))
+        .flat_map(|v| v.map_or(OFF, |v| colour(v.de2000)))
         .collect();
     image::save_buffer_with_format(
         path,

@@ -1,14 +1,18 @@
 //! One material's part of the report: its spheres (the measurement and each model, under the
 //! point light and the environment), the ΔE images of each model against the reference (the
-//! measurement, or the tabulated model when there is none), and the plots of its NDF and F.
+//! measurement, or the tabulated model when there is none), the noise floor (the reference
+//! rendered again at another seed, against itself), and the plots of its NDF and F.
 
-use super::delta_e::{DeltaE, delta_e_image};
-use super::scenes::{Lighting, N_MODELS, SphereRenderer, Variant, material, on_sphere};
+use super::delta_e::{DePair, DeltaE, delta_e_image};
+use super::scenes::{
+    FLOOR_SEED, Lighting, N_MODELS, SEED, SphereRenderer, Variant, material, on_sphere,
+};
 use super::subject::Subject;
 use super::{false_colour, plots};
 use anyhow::{Context, Result};
 use facet_fit::model::material::ModelChoice;
 use facet_render::Image;
+use facet_render::scene::Material;
 use std::path::Path;
 
 /// Subfolder of the report's images.
@@ -32,9 +36,13 @@ pub struct MaterialReport {
     pub fit_ms: f64,
     /// The renders' wall time, ms.
     pub render_ms: f64,
-    /// Mean ΔE per lighting ([`Lighting::ALL`] order) and model ([`Variant::MODELS`] order);
-    /// `None` for the reference itself and for a model not shown.
-    pub mean_de: [[Option<f64>; N_MODELS]; 2],
+    /// Mean ΔE2000 and ΔE_ITP per lighting ([`Lighting::ALL`] order) and model
+    /// ([`Variant::MODELS`] order); `None` for the reference itself and for a model not shown.
+    pub mean_de: [[Option<DePair<f64>>; N_MODELS]; 2],
+    /// The noise floor per lighting: the mean ΔE2000 and ΔE_ITP of the reference rendered at
+    /// [`FLOOR_SEED`] against its render at [`SEED`], the difference the renders' noise alone
+    /// gives.
+    pub floor: [DePair<f64>; 2],
     /// The ΔE images in the same order (kept for the database means).
     pub de: [[Option<DeltaE>; N_MODELS]; 2],
 }
@@ -42,6 +50,11 @@ pub struct MaterialReport {
 /// The page-relative path of one render.
 pub fn render_file(stem: &str, lighting: Lighting, variant: Variant) -> String {
     format!("{IMG}/{stem}-{}-{}.png", lighting.key(), variant.key())
+}
+
+/// The page-relative path of the image of the noise floor under one lighting.
+pub fn floor_file(stem: &str, lighting: Lighting) -> String {
+    format!("{IMG}/{stem}-{}-de-noise.png", lighting.key())
 }
 
 /// The page-relative path of one ΔE image.
@@ -80,10 +93,6 @@ pub fn report_material(
     out: &Path,
 ) -> Result<MaterialReport> {
     let t = std::time::Instant::now();
-    let side = renderer.side();
-    let mask = |x, y| on_sphere(side, x, y);
-    let mut mean_de = [[None; N_MODELS]; 2];
-    let mut de: [[Option<DeltaE>; N_MODELS]; 2] = Default::default();
     let source = &subject.fit.record.source;
     let measured = subject.measurement.is_some();
     let coated = subject.fit.coated.is_some();
@@ -97,25 +106,22 @@ pub fn report_material(
             ))
         })
         .collect::<Result<Vec<_>>>()?;
+    let reference_variant = reference(measured, coated);
+    let mut mean_de = [[None; N_MODELS]; 2];
+    let mut de: [[Option<DeltaE>; N_MODELS]; 2] = Default::default();
+    let mut floor = [DePair::default(); 2];
     for (li, &lighting) in Lighting::ALL.iter().enumerate() {
-        let mut images: Vec<(Variant, Image)> = Vec::new();
-        for (variant, m) in &materials {
-            let variant = *variant;
-            let image = renderer
-                .render(m.clone(), lighting)
-                .with_context(|| format!("{}: rendering {}", subject.input, variant.key()))?;
-            let path = out.join(render_file(stem, lighting, variant));
-            image
-                .write_png(&path, 0.0)
-                .with_context(|| format!("writing {}", path.display()))?;
-            images.push((variant, image));
-        }
-        let reference_variant = reference(measured, coated);
+        let images = render_variants(renderer, subject, &materials, lighting, stem, out)?;
         let reference = &images
             .iter()
             .find(|(v, _)| *v == reference_variant)
             .expect("the reference is rendered")
             .1;
+        let again = materials
+            .iter()
+            .find(|(v, _)| *v == reference_variant)
+            .expect("the reference has a material");
+        floor[li] = noise_floor(renderer, subject, again, reference, lighting, stem, out)?;
         for (mi, &model) in Variant::MODELS.iter().enumerate() {
             if model == reference_variant {
                 continue;
@@ -124,7 +130,7 @@ pub fn report_material(
             let Some((_, image)) = images.iter().find(|(v, _)| *v == model) else {
                 continue;
             };
-            let d = delta_e_image(reference, image, &mask);
+            let d = delta_e_image(reference, image, &mask(renderer.side()));
             false_colour::write_png(&d, &out.join(de_file(stem, lighting, model)))?;
             mean_de[li][mi] = Some(d.mean());
             de[li][mi] = Some(d);
@@ -143,6 +149,55 @@ pub fn report_material(
         fit_ms: subject.fit_ms,
         render_ms,
         mean_de,
+        floor,
         de,
     })
+}
+
+/// The pixels compared in a `side`² image: those that see the sphere.
+fn mask(side: u32) -> impl Fn(u32, u32) -> bool {
+    move |x, y| on_sphere(side, x, y)
+}
+
+/// Every variant of `materials` rendered under `lighting` at [`SEED`], each written as a PNG.
+fn render_variants(
+    renderer: &mut SphereRenderer,
+    subject: &Subject,
+    materials: &[(Variant, Material)],
+    lighting: Lighting,
+    stem: &str,
+    out: &Path,
+) -> Result<Vec<(Variant, Image)>> {
+    let mut images = Vec::new();
+    for (variant, m) in materials {
+        let image = renderer
+            .render(m.clone(), lighting, SEED)
+            .with_context(|| format!("{}: rendering {}", subject.input, variant.key()))?;
+        let path = out.join(render_file(stem, lighting, *variant));
+        image
+            .write_png(&path, 0.0)
+            .with_context(|| format!("writing {}", path.display()))?;
+        images.push((*variant, image));
+    }
+    Ok(images)
+}
+
+/// The noise floor under `lighting`: the reference (`again`, whose render at [`SEED`] is
+/// `reference`) rendered once more at [`FLOOR_SEED`] and compared with that render — the ΔE of
+/// the renders' noise alone; its image written beside the models' ΔE images.
+fn noise_floor(
+    renderer: &mut SphereRenderer,
+    subject: &Subject,
+    again: &(Variant, Material),
+    reference: &Image,
+    lighting: Lighting,
+    stem: &str,
+    out: &Path,
+) -> Result<DePair<f64>> {
+    let image = renderer
+        .render(again.1.clone(), lighting, FLOOR_SEED)
+        .with_context(|| format!("{}: rendering {} again", subject.input, again.0.key()))?;
+    let d = delta_e_image(reference, &image, &mask(renderer.side()));
+    false_colour::write_png(&d, &out.join(floor_file(stem, lighting)))?;
+    Ok(d.mean())
 }

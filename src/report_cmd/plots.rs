@@ -185,7 +185,10 @@ pub fn write_sweep_plot(points: &[SweepPoint], path: &Path) -> Result<()> {
     chart
         .configure_mesh()
         .x_desc("fit time (s)")
-        .y_desc("error metric")
+        .y_desc(format!(
+            "error ({} metric)",
+            points.first().map_or("", |p| p.metric.name())
+        ))
         .draw()
         .map_err(plot_error)?;
     let mut materials: Vec<&str> = points.iter().map(|p| p.material.as_str()).collect();

@@ -5,6 +5,7 @@
 
 use anyhow::{Context, Result, anyhow};
 use facet_fit::FitConfig;
+use facet_fit::model::metric::Metric;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::{InputSpec, Residence};
@@ -24,7 +25,9 @@ pub struct SweepPoint {
     pub seconds: f64,
     /// The power iteration's share of it (the extraction and its tables), seconds.
     pub extract_seconds: f64,
-    /// The error metric of the tabulated, GGX and Beckmann models.
+    /// The metric the fit minimised, the errors' metric.
+    pub metric: Metric,
+    /// The error of the tabulated, GGX and Beckmann models.
     pub errors: [Option<f64>; 3],
 }
 
@@ -58,6 +61,7 @@ pub fn sweep_input(
             resolution: n,
             seconds: t.elapsed().as_secs_f64(),
             extract_seconds: r.timings_ms.extract / 1e3,
+            metric: r.metric,
             errors: [
                 r.tabulated.error,
                 r.ggx.as_ref().map(|p| p.error),

@@ -68,7 +68,10 @@ fn main() {
         // CHROMA=1: the bound a colour table over (θh, θd) times the lobe could reach.
         if std::env::var("CHROMA").is_ok() {
             let chroma = Chromatic::fit(&src, &m.tabulated);
-            println!("{name:32} with a chromatic table: ΔE {:.2}", sphere_delta_e(&src, &chroma));
+            println!(
+                "{name:32} with a chromatic table: ΔE {:.2}",
+                sphere_delta_e(&src, &chroma)
+            );
         }
         println!(
             "{name:32} ΔE {de:6.2}  log {log_err:.4}  fit {secs:5.2} s  ρd {:.3} {:.3} {:.3}  coat {}  \
@@ -216,7 +219,8 @@ impl Brdf for Chromatic {
         let half_pi = std::f64::consts::FRAC_PI_2;
         let i = (((hd.theta_h.max(0.0) / half_pi).sqrt() * THETA_H_RES as f64) as usize)
             .min(THETA_H_RES - 1);
-        let j = ((hd.theta_d.max(0.0) / half_pi * THETA_D_RES as f64) as usize).min(THETA_D_RES - 1);
+        let j =
+            ((hd.theta_d.max(0.0) / half_pi * THETA_D_RES as f64) as usize).min(THETA_D_RES - 1);
         let c = self.table[i * THETA_D_RES + j];
         let l = self.lobe.eval(wi, wo)?;
         Some(std::array::from_fn(|k| l[k] * c[k] + self.diffuse[k]))

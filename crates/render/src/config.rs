@@ -4,7 +4,7 @@
 //! [`Integrator::render_more`](crate::Integrator::render_more) does). A wavefront cannot be
 //! asked to render another size than its own: the size is never passed again.
 
-pub use crate::tags::{NdfSampling, Strategy};
+pub use crate::tags::{NdfSampling, Sequence, Strategy};
 
 /// The image of a [`Wavefront`](crate::Wavefront): fixed when it is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -60,6 +60,8 @@ pub struct SampleConfig {
     pub strategy: Strategy,
     /// How the normals of microfacet lobes are sampled.
     pub ndf_sampling: NdfSampling,
+    /// Where the random numbers come from (independent, or stratified Sobol points).
+    pub sequence: Sequence,
 }
 
 impl SampleConfig {
@@ -83,6 +85,7 @@ impl SampleConfig {
             iterations_per_check: 8,
             strategy: Strategy::Mis,
             ndf_sampling: NdfSampling::Visible,
+            sequence: Sequence::Random,
         }
     }
 }

@@ -64,7 +64,8 @@ pub struct GpuFrame {
     pub ndf_sampling: u32,
     /// 1: the film's squares are accumulated too (`Integrator::wavefront_with_variance`).
     pub moments: u32,
-    pub pad0: u32,
+    /// [`Sequence`](crate::tags::Sequence) as `u32`.
+    pub sequence: u32,
     pub pad1: u32,
     pub pad2: u32,
     /// The scene's part, the same in every frame.

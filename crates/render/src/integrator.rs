@@ -620,6 +620,7 @@ fn frame_uniform(wf: &Wavefront, camera: &CameraFrame, sampling: &SampleConfig) 
         strategy: sampling.strategy as u32,
         ndf_sampling: sampling.ndf_sampling as u32,
         moments: wf.has_variance() as u32,
+        sequence: sampling.sequence as u32,
         scene: *wf.scene_info(),
         cam_pos: camera.position.extend(tan_half).to_array(),
         cam_forward: camera.forward.extend(aspect).to_array(),

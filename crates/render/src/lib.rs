@@ -51,7 +51,7 @@ pub mod trace;
 pub mod wavefront;
 
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
-pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Strategy};
+pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Sequence, Strategy};
 pub use error::RenderError;
 pub use facet_gpu::{Gpu, GpuError};
 pub use film::Image;

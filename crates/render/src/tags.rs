@@ -1,6 +1,6 @@
 //! The closed sets the Rust side and the WGSL stages share — material and light kinds, the
-//! environment's kind, the sampling strategy, the path-state regions and the slot states —
-//! written once, here. [`wgsl`] renders them as WGSL constants; the committed
+//! environment's kind, the sampling strategy and sequence, the path-state regions and the slot
+//! states — written once, here. [`wgsl`] renders them as WGSL constants; the committed
 //! `shaders/render/tags.inc.wgsl` is its output (`cargo test -p facet-render --test tags`
 //! fails when the two differ; `FACET_REGENERATE=1` rewrites the file) and no other WGSL file
 //! may define a constant with one of the prefixes. The `tags!` macro is facet-gpu's
@@ -96,6 +96,29 @@ impl Default for NdfSampling {
 }
 
 tags!(
+    /// Where a path's random numbers come from (`Frame.sequence`). Both are unbiased; the
+    /// Sobol points stratify each pair of dimensions a bounce uses together, so an image at a
+    /// power-of-two spp has less noise.
+    Sequence, "SEQUENCE_" {
+        /// independent numbers: a PCG hash of (pixel, sample, dimension, seed)
+        Random = 0 => "RANDOM",
+        /// Owen-scrambled Sobol points, the dimensions a bounce uses together stratified
+        /// (Burley 2020): per pixel, the pixel position, the light sample's point and the BSDF
+        /// sample's direction each a (0, 2)-sequence, shuffled and scrambled per pixel, seed
+        /// and dimension pair; the single dimensions scrambled van der Corput
+        Sobol = 1 => "SOBOL",
+    }
+);
+
+// By hand: `tags!` takes doc attributes only on variants.
+#[allow(clippy::derivable_impls)]
+impl Default for Sequence {
+    fn default() -> Self {
+        Sequence::Random
+    }
+}
+
+tags!(
     /// Regions of the path state: one vec4 per slot each, region r of slot s at
     /// `paths[r · wavefront + s]`.
     Region, "R_" {
@@ -142,6 +165,7 @@ pub fn all() -> Vec<TagSet> {
         EnvKind::tag_set(),
         Strategy::tag_set(),
         NdfSampling::tag_set(),
+        Sequence::tag_set(),
         Region::tag_set(),
         SlotState::tag_set(),
     ]
