@@ -322,11 +322,18 @@ fn errors(m: &MaterialReport, metric: Metric) -> [Option<f64>; N_MODELS] {
 
 /// What a metric measures, for the page.
 fn metric_words(metric: Metric) -> String {
+    let floor = match metric {
+        Metric::Log => "1".to_owned(),
+        Metric::Perceptual => format!(
+            "{} × the material's median x, at least {}",
+            Metric::RELATIVE_FLOOR,
+            Metric::MIN_FLOOR
+        ),
+    };
     format!(
         "<b>{}</b>: the mean over the MERL grid of |ln(1 + x_model/ε) − ln(1 + x_data/ε)|, \
-         x = f cos θi, ε = {}",
+         x = f cos θi, ε = {floor}",
         metric.name(),
-        metric.floor()
     )
 }
 
