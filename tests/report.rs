@@ -245,20 +245,10 @@ fn report_of_a_coated_measurement_shows_its_coated_model() {
     assert!(coated < 0.5 * single, "ΔE coated {coated}, single {single}");
 }
 
-/// A fit JSON that kept a coat (attached here by hand: the fit's own record as the base under a
-/// coat of α 0.05, weight 1) stands for its coated model: that is the reference, and the single
-/// layer's tabulated model, rendered without the coat, differs from it visibly (a mean ΔE above
-/// 1 under the point light, where the coat adds a highlight 6 times narrower than the base's
-/// lobe and about as bright as its peak; rendered coated by mistake it would be 0).
-#[test]
-fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
-    const TEST: &str = "report_of_a_coated_fit_json_compares_with_its_coated_model";
-    if facet_gpu::gpu_for_tests(TEST).is_none() {
-        return;
-    }
-    let dir = scratch("report_coated_json");
+/// `facet fit` of a GGX α 0.3 gold into `dir/fits`: its JSON file and record.
+fn gold_fit_record(dir: &Path) -> (std::path::PathBuf, serde_json::Value) {
     let (ok, _, stderr) = facet_in(
-        &dir,
+        dir,
         &[
             "fit",
             "analytic:ggx?alpha=0.3&conductor=gold",
@@ -272,8 +262,23 @@ fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
         .map(|e| e.unwrap().path())
         .find(|p| p.extension().is_some_and(|e| e == "json"))
         .expect("a fit JSON");
-    let mut rec: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let record = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    (path, record)
+}
+
+/// A fit JSON that kept a coat (attached here by hand: the fit's own record as the base under a
+/// coat of α 0.05, weight 1) stands for its coated model: that is the reference, and the single
+/// layer's tabulated model, rendered without the coat, differs from it visibly (a mean ΔE above
+/// 1 under the point light, where the coat adds a highlight 6 times narrower than the base's
+/// lobe and about as bright as its peak; rendered coated by mistake it would be 0).
+#[test]
+fn report_of_a_coated_fit_json_compares_with_its_coated_model() {
+    const TEST: &str = "report_of_a_coated_fit_json_compares_with_its_coated_model";
+    if facet_gpu::gpu_for_tests(TEST).is_none() {
+        return;
+    }
+    let dir = scratch("report_coated_json");
+    let (_, mut rec) = gold_fit_record(&dir);
     let base = rec.clone();
     rec["coat"] = serde_json::json!({
         "eta": 1.5, "alpha": 0.05, "weight": 1.0,
@@ -304,23 +309,7 @@ fn report_shows_the_metric_minimised_and_the_errors_in_both() {
         return;
     }
     let dir = scratch("report_metric");
-    let (ok, _, stderr) = facet_in(
-        &dir,
-        &[
-            "fit",
-            "analytic:ggx?alpha=0.3&conductor=gold",
-            "--out",
-            "fits",
-        ],
-    );
-    assert!(ok, "{stderr}");
-    let path = std::fs::read_dir(dir.join("fits"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.extension().is_some_and(|e| e == "json"))
-        .expect("a fit JSON");
-    let rec: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let (path, rec) = gold_fit_record(&dir);
     let minimised = rec["metric"].as_str().unwrap().to_owned();
     let other = rec["other_metric"]["metric"].as_str().unwrap().to_owned();
     assert_ne!(minimised, other);

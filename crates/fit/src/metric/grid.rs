@@ -17,6 +17,7 @@ use crate::model::merl_grid::{MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_an
 use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::rgb::Rgb;
 use crate::numerics::fast_log::{ln_1p, ln_1p_abs};
+use crate::numerics::stats::median_in_place;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -73,12 +74,7 @@ impl GridSamples {
                 .take()
                 .expect("an anisotropic set holds its list");
             let mut xs: Vec<f64> = samples.iter().flat_map(|s| s.x.map(f64::from)).collect();
-            let mid = xs.len() / 2;
-            set.scale = 1.0
-                / metric.floor(|| match xs.is_empty() {
-                    true => 0.0,
-                    false => *xs.select_nth_unstable_by(mid, f64::total_cmp).1,
-                });
+            set.scale = 1.0 / metric.floor(|| median_in_place(&mut xs));
             for s in &mut samples {
                 s.log_x = s.x.map(|x| ln_1p(x * set.scale));
             }

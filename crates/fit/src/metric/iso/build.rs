@@ -10,6 +10,7 @@ use crate::metric::merl_geometry::{
 };
 use crate::model::merl_grid::{MerlTable, SCALE, THETA_D_RES};
 use crate::numerics::fast_log::ln_1p;
+use crate::numerics::stats::median_in_place;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
 use std::sync::Arc;
@@ -92,11 +93,7 @@ pub(crate) fn median_x(table: &MerlTable) -> f64 {
             xs.extend((0..3).map(|c| v[c] * SCALE[c] * mu_i));
         }
     }
-    if xs.is_empty() {
-        return 0.0;
-    }
-    let mid = xs.len() / 2;
-    *xs.select_nth_unstable_by(mid, f64::total_cmp).1
+    median_in_place(&mut xs)
 }
 
 /// [`median_x`] reads every `MEDIAN_STRIDE`-th bin (a prime: no alias with the 180 φd bins).
