@@ -252,10 +252,12 @@ pub struct FitArgs {
     #[arg(long, value_enum, default_value = "table")]
     fresnel: FresnelArg,
     /// When to search a clear coat over a base (η 1.5; its α, its weight and the base under it
-    /// fitted; 2–5 s), kept where the coated model fits better: `off`, `auto` where the single
-    /// layer's tabulated error in the paper's log metric is above 0.03, or `always`. The single
-    /// layer's models are written either way; a coat kept is the fit JSON's `coat`.
-    #[arg(long, value_enum, default_value = "off")]
+    /// fitted; 0.5–1.5 s), kept where the coated sphere looks closer to the data (ΔE2000 under
+    /// the report's point light, at least 0.1 lower): `auto` (the default) where the single
+    /// layer's sphere differs from the data by more than ΔE 0.9, `always`, or `off`. The
+    /// single layer's models are written either way; a coat kept is the fit JSON's `coat`,
+    /// both looks its `look`.
+    #[arg(long, value_enum, default_value = "auto")]
     coat: CoatArg,
     /// The objective every step of the fit minimises: `perceptual`, |ln(1 + x_model/ε) −
     /// ln(1 + x_data/ε)| with ε 0.3 times the material's median x (a relative error down to

@@ -56,12 +56,12 @@ pub struct ReportArgs {
     /// Polar nodes N of the fits, 2 to 4096.
     #[arg(long, default_value_t = 90, value_parser = crate::args::resolution)]
     fit_resolution: usize,
-    /// When the fits search a clear coat, as `facet fit --coat`: `off`, `auto` where the
-    /// single layer's tabulated error in the paper's log metric is above 0.03 (3–8 s more for
-    /// such a material on two cores), or `always`. A fit that keeps a coat gets one more
-    /// sphere, its coated model, beside the single layer's three; a fit JSON that kept one
-    /// shows it whatever this says.
-    #[arg(long, value_enum, default_value = "off")]
+    /// When the fits search a clear coat, as `facet fit --coat`: `auto` (the default) where
+    /// the single layer's sphere differs from the data by more than ΔE2000 0.9 (0.5–1.5 s more
+    /// for such a material on two cores), `always`, or `off`; kept where it looks better. A
+    /// fit that keeps a coat gets one more sphere, its coated model, beside the single layer's
+    /// three; a fit JSON that kept one shows it whatever this says.
+    #[arg(long, value_enum, default_value = "auto")]
     coat: CoatArg,
     /// The objective the fits minimise, as `facet fit --metric`: `perceptual` or `log`.
     #[arg(long, value_enum, default_value = "perceptual")]
@@ -231,9 +231,12 @@ fn write_page(
         resolution: args.fit_resolution,
         coat: match args.coat.search(args.no_coat) {
             CoatSearch::Auto => {
-                "a clear coat searched where the single layer's log error is above 0.03"
+                "a clear coat searched where the single layer's point-light sphere is above \
+                 ΔE2000 0.9, kept where it looks better"
             }
-            CoatSearch::Always => "a clear coat searched for every material",
+            CoatSearch::Always => {
+                "a clear coat searched for every material, kept where it looks better"
+            }
             CoatSearch::Off => "no coat searched",
         },
         env: args

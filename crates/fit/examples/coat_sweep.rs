@@ -1,7 +1,7 @@
 //! Issue 48's coat measured on a library of neural proxies: each fitted with and without the
 //! coat step ([`facet_fit::fitting::coat`]) searched on every material (`CoatSearch::Always`;
-//! the default searches only above `coat::TRY_ABOVE`), the errors side by side, the coat kept
-//! and its time.
+//! the default searches only where the single layer's look is above `coat::TRY_ABOVE`), the
+//! errors side by side, the coat kept (by the look) and its time.
 //!
 //! `cargo run --release -p facet-fit --example coat_sweep -- [NBRDF.json] [NAME_FILTER]`
 
@@ -16,7 +16,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let lib = common::library(args.first());
     let filter = args.get(1).cloned().unwrap_or_default();
-    let mut rows = Vec::new();
+    let (mut rows, mut looks_off) = (Vec::new(), Vec::new());
     for name in lib.names().filter(|n| n.contains(&filter)) {
         let src = MerlBrdf::from_table(name, MerlTable::sample(&lib.get(name).unwrap())).unwrap();
         let cfg = FitConfig {
@@ -45,6 +45,11 @@ fn main() {
             t.total - t.coat,
             t.coat
         );
+        looks_off.push(
+            m.record
+                .look
+                .is_some_and(|l| l.tabulated > facet_fit::fitting::coat::TRY_ABOVE),
+        );
         rows.push((
             name.to_owned(),
             single,
@@ -67,22 +72,22 @@ fn main() {
         rows.len(),
         quantile(&ms, 0.5),
     );
-    // The default (`CoatSearch::Auto`) searches only above TRY_ABOVE: its errors and times.
-    let auto = |r: &(String, f64, f64, bool, f64, f64)| r.1 > facet_fit::fitting::coat::TRY_ABOVE;
-    let auto_err: Vec<f64> = rows
-        .iter()
-        .map(|r| if auto(r) { r.2 } else { r.1 })
+    // The default (`CoatSearch::Auto`) searches only where the look is above TRY_ABOVE.
+    let searched = |i: usize| looks_off[i];
+    let auto_err: Vec<f64> = (0..rows.len())
+        .map(|i| if searched(i) { rows[i].2 } else { rows[i].1 })
         .collect();
-    let auto_ms: Vec<f64> = rows
-        .iter()
-        .map(|r| r.4 + if auto(r) { r.5 } else { 0.0 })
+    let auto_ms: Vec<f64> = (0..rows.len())
+        .map(|i| rows[i].4 + if searched(i) { rows[i].5 } else { 0.0 })
         .collect();
     let single_ms: Vec<f64> = rows.iter().map(|r| r.4).collect();
     println!(
-        "the default (--coat auto, searched where the single layer's error is above {}): searched {}, kept {}; median {:.4} p90 {:.4}; fit time median {:.0} ms, p90 {:.0} ms (the single layer alone: median {:.0} ms)",
+        "the default (--coat auto, searched where the single layer's look is above ΔE {}): searched {}, kept {}; median {:.4} p90 {:.4}; fit time median {:.0} ms, p90 {:.0} ms (the single layer alone: median {:.0} ms)",
         facet_fit::fitting::coat::TRY_ABOVE,
-        rows.iter().filter(|r| auto(r)).count(),
-        rows.iter().filter(|r| auto(r) && r.3).count(),
+        (0..rows.len()).filter(|&i| searched(i)).count(),
+        (0..rows.len())
+            .filter(|&i| searched(i) && rows[i].3)
+            .count(),
         quantile(&auto_err, 0.5),
         quantile(&auto_err, 0.9),
         quantile(&auto_ms, 0.5),

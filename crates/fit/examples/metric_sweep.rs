@@ -15,25 +15,16 @@
 use facet_fit::fitting::{CoatSearch, FitConfig, fit_material};
 use facet_fit::metric::Metric;
 use facet_fit::metric::grid::{GridSamples, microfacet_error};
+use facet_fit::metric::look::SphereScene;
 use facet_fit::model::brdf::Brdf;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::numerics::stats::quantile;
 use facet_fit::sources::merl::MerlBrdf;
 use glam::DVec3;
-use palette::color_difference::Ciede2000;
-use palette::{FromColor, Lab, LinSrgb};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 mod common;
-
-/// The report's scene (`src/report_cmd/scenes.rs`): camera on +z at 3, 45° vertical field of
-/// view, the point light at (−1.6, 1.8, 3) with I = 40.
-const CAMERA_Z: f64 = 3.0;
-const YFOV_DEG: f64 = 45.0;
-const LIGHT: DVec3 = DVec3::new(-1.6, 1.8, 3.0);
-const INTENSITY: f64 = 40.0;
-const SIDE: usize = 64;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -75,13 +66,16 @@ fn main() {
         }
         println!(
             "{name:32} ΔE {de:6.2}  log {log_err:.4}  fit {secs:5.2} s  ρd {:.3} {:.3} {:.3}  coat {}  \
-             error {:.4} coated {:.4}",
+             error {:.4} coated {:.4}  look {:.3} coated {:.3}  coat step {:.2} s",
             m.record.tabulated.diffuse[0],
             m.record.tabulated.diffuse[1],
             m.record.tabulated.diffuse[2],
             m.record.coat.is_some(),
             m.record.tabulated.error.unwrap_or(f64::NAN),
             m.record.coat.as_ref().map_or(f64::NAN, |c| c.error),
+            m.record.look.map_or(f64::NAN, |l| l.tabulated),
+            m.record.look.and_then(|l| l.coated).unwrap_or(f64::NAN),
+            m.record.timings_ms.coat / 1e3,
         );
         floor.push(m.record.metric_floor);
         rows.push((de, log_err, secs));
@@ -118,45 +112,9 @@ fn cached(dir: &Path, name: &str, table: impl FnOnce() -> MerlTable) -> MerlBrdf
     src
 }
 
-/// The mean CIEDE2000 over the sphere's pixels (centres within 0.98 of its radius) of `model`
-/// against `data`, as the report shows them: L = f cos θi I / r², displayed as 1 − e^−L,
-/// read as linear sRGB.
+/// The look of `model` against `data`: the report's point-light sphere, mean CIEDE2000.
 fn sphere_delta_e(data: &dyn Brdf, model: &dyn Brdf) -> f64 {
-    let tan = (YFOV_DEG.to_radians() / 2.0).tan();
-    let camera = DVec3::new(0.0, 0.0, CAMERA_Z);
-    let (mut sum, mut n) = (0.0, 0usize);
-    for py in 0..SIDE {
-        for px in 0..SIDE {
-            let ndc = |p: usize| (2.0 * (p as f64 + 0.5) / SIDE as f64 - 1.0) * tan;
-            let dir = DVec3::new(ndc(px), -ndc(py), -1.0).normalize();
-            // The ray's closest approach to the centre: within 0.98 of the radius.
-            let t_mid = -camera.dot(dir);
-            let closest = (camera + t_mid * dir).length();
-            if closest > 0.98 {
-                continue;
-            }
-            let p = camera + (t_mid - (1.0 - closest * closest).sqrt()) * dir;
-            let nrm = p.normalize();
-            let tangent = DVec3::Y.cross(nrm).normalize();
-            let bitangent = nrm.cross(tangent);
-            let local = |w: DVec3| DVec3::new(w.dot(tangent), w.dot(bitangent), w.dot(nrm));
-            let to_light = LIGHT - p;
-            let (wi, wo) = (local(to_light.normalize()), local(-dir));
-            let irradiance = INTENSITY / to_light.length_squared();
-            let shown = |b: &dyn Brdf| -> Lab {
-                let f = match wi.z > 0.0 {
-                    true => b.eval(wi, wo).unwrap_or([0.0; 3]),
-                    false => [0.0; 3],
-                };
-                let d =
-                    f.map(|f| (1.0 - (-(f * wi.z.max(0.0) * irradiance).max(0.0)).exp()) as f32);
-                Lab::from_color(LinSrgb::new(d[0], d[1], d[2]))
-            };
-            sum += shown(data).difference(shown(model)) as f64;
-            n += 1;
-        }
-    }
-    sum / n.max(1) as f64
+    SphereScene::REPORT.delta_e(data, model)
 }
 
 /// The tabulated model with its lobe times a colour table over (θh, θd) bins, each bin's ratio

@@ -3,7 +3,7 @@
 
 mod common;
 use common::scratch;
-use facet_fit::fitting::{CoatSearch, FitConfig, fit_material};
+use facet_fit::fitting::{CoatSearch, FitConfig, coat, fit_material};
 use facet_fit::model::coat::{Coat, CoatLayer, Coated};
 use facet_fit::model::fresnel::Fresnel;
 use facet_fit::model::merl_grid::MerlTable;
@@ -130,4 +130,39 @@ fn the_coat_is_recorded() {
         err.contains("coated.json") && err.contains("coat.eta"),
         "{err}"
     );
+}
+
+/// The default (`auto`) searches a coat only where the single layer looks off: a coated gold's
+/// single layer differs from its data on the report's sphere by more than
+/// [`coat::TRY_ABOVE`], and the default keeps the coat `always` finds there, looking closer by
+/// at least [`coat::LOOK_MARGIN`]; an uncoated GGX, which the single layer represents exactly,
+/// looks right (below ΔE2000 0.1, a tenth of a just-noticeable difference: the tabulated model
+/// against the grid's interpolation of its own samples) and is not searched.
+#[test]
+fn the_default_searches_where_the_single_layer_looks_off() {
+    let fit = |truth: &dyn Brdf| {
+        let src = MerlBrdf::from_table("truth", MerlTable::sample(truth)).unwrap();
+        fit_material(&src, "synthetic", &FitConfig::isotropic()).unwrap()
+    };
+    let m = fit(&coated(ggx(0.3, Fresnel::GOLD, [0.0; 3])));
+    let look = m.record.look.unwrap();
+    let kept = m.record.coat.as_ref().expect("a coat");
+    assert!(look.tabulated > coat::TRY_ABOVE, "{look:?}");
+    assert!(
+        look.coated.unwrap() < look.tabulated - coat::LOOK_MARGIN,
+        "{look:?}"
+    );
+    assert_eq!(
+        kept.coat,
+        fit_of(&coated(ggx(0.3, Fresnel::GOLD, [0.0; 3])))
+            .record
+            .coat
+            .unwrap()
+            .coat
+    );
+
+    let plain = fit(&ggx(0.3, Fresnel::GOLD, [0.1, 0.05, 0.02]));
+    let look = plain.record.look.unwrap();
+    assert!(look.tabulated < 0.1 && look.coated.is_none(), "{look:?}");
+    assert!(plain.record.coat.is_none());
 }

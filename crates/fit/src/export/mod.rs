@@ -824,6 +824,7 @@ mod tests {
             metric: crate::metric::Metric::Log,
             metric_floor: 1.0,
             other_metric: None,
+            look: None,
             timings_ms: Default::default(),
         }
     }

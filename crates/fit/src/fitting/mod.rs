@@ -29,11 +29,12 @@ use crate::fitting::refine::model_of;
 use crate::fitting::tabulated::TabulatedFit;
 use crate::metric::Metric;
 use crate::metric::grid::{GridSamples, microfacet_error};
+use crate::metric::look::SphereScene;
 use crate::model::brdf::Brdf;
 use crate::model::fresnel::FresnelTable;
 use crate::model::fresnel_curves::FresnelChoice;
 use crate::model::material::{
-    FitRecord, FittedMaterial, MetricErrors, ParamRecord, TabulatedRecord, Timings,
+    FitRecord, FittedMaterial, LookRecord, MetricErrors, ParamRecord, TabulatedRecord, Timings,
 };
 use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::microfacet::NdfKind;
@@ -102,16 +103,16 @@ pub struct FitConfig {
     pub metric: Metric,
 }
 
-/// When a fit searches a clear coat over a base ([`coat`]). The search costs about 50 cheap
-/// fits of the base (2–5 s on 2 cores, 40–100 times the single layer's fit), and under the
-/// perceptual metric it changed the look little (on the MERL-100 searched everywhere: the
-/// sphere's ΔE2000 median 0.80 → 0.78, three materials worse), so by default it does not run.
+/// When a fit searches a clear coat over a base ([`coat`]); wherever it is searched, it is
+/// kept where it makes the look better ([`coat::CoatCandidate::keeps`]). A search costs about
+/// 40 cheap fits of the base (0.5–1.5 s on 2 cores), so by default it runs only where the
+/// single layer looks off.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CoatSearch {
-    /// Never: the single layer alone (`--no-coat`, the default).
+    /// Never: the single layer alone (`--coat off`).
     Off,
-    /// Where the single layer's tabulated error in the paper's metric ([`Metric::Log`],
-    /// whichever the fit minimises) is above [`coat::TRY_ABOVE`].
+    /// Where the single layer's look ([`LookRecord`]) is above [`coat::TRY_ABOVE`] ΔE2000
+    /// (`--coat auto`, the default).
     Auto,
     /// On every fit with a diffuse lobe (`--coat always`).
     Always,
@@ -128,7 +129,7 @@ impl FitConfig {
             diffuse: true,
             refine: true,
             fresnel: FresnelChoice::Table,
-            coat: CoatSearch::Off,
+            coat: CoatSearch::Auto,
             metric: Metric::Perceptual,
         }
     }
@@ -245,63 +246,41 @@ struct Fit<'a> {
 /// error when it came with the average.
 type SingleLobe = (Vec<Rgb>, Option<f64>);
 
-/// The pipeline: each step a named function, in the order they run.
+/// The pipeline: the single layer, its errors in the other metric and its look, then the
+/// coat where the settings ask for one.
 fn fit_with(
     src: &dyn Brdf,
     source: &str,
     cfg: &FitConfig,
-    mut eval: Evaluator,
+    eval: Evaluator,
 ) -> Result<FittedMaterial, FitError> {
     let start = Instant::now();
-    let ex = eval.extract(src, &cfg.extract, cfg.anisotropic)?;
-    let extract_ms = ms(start);
-
-    let t = Instant::now();
-    let grids = Grids::new(src, cfg)?;
-    eval.upload(&grids.full, src.name())?;
-    let diffuse = grids.diffuse;
-    let fit = Fit {
-        src,
-        cfg,
-        eval,
-        grids,
-        diffuse,
-    };
-    let single = (!diffuse)
-        .then(|| fit.single_lobe_fresnel(&ex))
-        .transpose()?;
-    let mut fresnel_ms = ms(t);
-
-    let t = Instant::now();
-    let (ggx, beckmann) = fit.analytic_fits(&ex, single.as_ref())?;
-    let fit_ms = ms(t);
-
-    let t = Instant::now();
-    let tab = match single {
-        Some(single) => fit.single_lobe_tabulated(ex, single)?,
-        None => fit.diffuse_tabulated(ex, best_analytic(&ggx, &beckmann))?,
-    };
-    fresnel_ms += ms(t);
-    let timings = Timings {
-        load: 0.0,
-        extract: extract_ms,
-        fresnel: fresnel_ms,
-        fit: fit_ms,
-        coat: 0.0,
-        total: 0.0,
-    };
-    let mut material = fit.material(source, tab, ggx, beckmann, timings, start)?;
+    let (fit, mut material) = Fit::single_layer(src, source, cfg, eval, start)?;
     let other = match &fit.grids.table {
         Some(t) => GridSamples::from_table(t, cfg.metric.other()),
         None => GridSamples::for_metric(src, cfg.metric.other()),
     };
     material.record.other_metric = Some(errors_in(&material, &other, cfg.metric.other()));
+    material.record.look = fit.grids.table.as_deref().map(|t| LookRecord {
+        tabulated: SphereScene::REPORT.delta_e_to_table(t, &material.tabulated),
+        coated: None,
+    });
     let mut material = fit.with_coat(material, start)?;
     if let (Some(c), Some(e)) = (&material.coated, &mut material.record.other_metric) {
         e.coated = Some(coat::coated_error(&c.layer, &c.base.tabulated, &other));
     }
     material.record.timings_ms.total = ms(start);
     Ok(material)
+}
+
+/// The single layer alone, on the CPU, without its errors in the other metric or its look:
+/// the coat step's fits of the base.
+pub(crate) fn fit_layer(
+    src: &dyn Brdf,
+    source: &str,
+    cfg: &FitConfig,
+) -> Result<FittedMaterial, FitError> {
+    Fit::single_layer(src, source, cfg, Evaluator::Cpu, Instant::now()).map(|(_, m)| m)
 }
 
 /// The single layer's models' errors on `set` (in its metric): recorded beside the errors in
@@ -328,28 +307,87 @@ fn best_analytic<'p>(
         .min_by(|a, b| a.1.error.total_cmp(&b.1.error))
 }
 
+impl<'a> Fit<'a> {
+    /// The steps of the single layer, in the order they run: the power iteration, the grids,
+    /// the single lobe's Fresnel average, the analytic fits, the tabulated model and the
+    /// record; the fit (its grids) returned beside it for the steps after.
+    fn single_layer(
+        src: &'a dyn Brdf,
+        source: &str,
+        cfg: &'a FitConfig,
+        mut eval: Evaluator<'a>,
+        start: Instant,
+    ) -> Result<(Self, FittedMaterial), FitError> {
+        let ex = eval.extract(src, &cfg.extract, cfg.anisotropic)?;
+        let extract_ms = ms(start);
+
+        let t = Instant::now();
+        let grids = Grids::new(src, cfg)?;
+        eval.upload(&grids.full, src.name())?;
+        let diffuse = grids.diffuse;
+        let fit = Fit {
+            src,
+            cfg,
+            eval,
+            grids,
+            diffuse,
+        };
+        let single = (!diffuse)
+            .then(|| fit.single_lobe_fresnel(&ex))
+            .transpose()?;
+        let mut fresnel_ms = ms(t);
+
+        let t = Instant::now();
+        let (ggx, beckmann) = fit.analytic_fits(&ex, single.as_ref())?;
+        let fit_ms = ms(t);
+
+        let t = Instant::now();
+        let tab = match single {
+            Some(single) => fit.single_lobe_tabulated(ex, single)?,
+            None => fit.diffuse_tabulated(ex, best_analytic(&ggx, &beckmann))?,
+        };
+        fresnel_ms += ms(t);
+        let timings = Timings {
+            load: 0.0,
+            extract: extract_ms,
+            fresnel: fresnel_ms,
+            fit: fit_ms,
+            coat: 0.0,
+            total: 0.0,
+        };
+        let material = fit.material(source, tab, ggx, beckmann, timings, start)?;
+        Ok((fit, material))
+    }
+}
+
 impl Fit<'_> {
-    /// The coat step ([`coat`]) where the settings ask for it and the single layer's tabulated
-    /// error is known: the material with the coat attached when one fits better.
+    /// The coat step ([`coat`]) where the settings ask for it (`auto`: where the single
+    /// layer's look is above [`coat::TRY_ABOVE`]): the material with the coat attached when it
+    /// looks better ([`coat::CoatCandidate::keeps`]); the coated look recorded either way.
     fn with_coat(&self, mut m: FittedMaterial, start: Instant) -> Result<FittedMaterial, FitError> {
-        // `auto` asks of the single layer's error in the paper's metric, whichever it minimised.
-        let log_error = match m.record.metric {
-            Metric::Log => m.record.tabulated.error,
-            _ => m.record.other_metric.and_then(|e| e.tabulated),
+        let data = self.grids.table.as_deref().filter(|_| self.diffuse);
+        let (Some(data), Some(look)) = (data, m.record.look) else {
+            return Ok(m);
         };
         let wanted = match self.cfg.coat {
             CoatSearch::Off => false,
-            CoatSearch::Auto => log_error.is_some_and(|e| e > coat::TRY_ABOVE),
+            CoatSearch::Auto => look.tabulated > coat::TRY_ABOVE,
             CoatSearch::Always => true,
         };
-        let single = m.record.tabulated.error.filter(|_| wanted);
-        let Some(single) = single.filter(|_| self.diffuse) else {
+        if !wanted {
             return Ok(m);
-        };
+        }
         let t = Instant::now();
-        if let Some(coated) = coat::fit_coat(self.src, self.cfg, &self.grids.full, single)? {
-            m.record.coat = Some(coated.record());
-            m.coated = Some(Box::new(coated.models));
+        if let Some(found) = coat::fit_coat(self.src, data, self.cfg, &self.grids.full)? {
+            m.record.look = Some(LookRecord {
+                coated: Some(found.look),
+                ..look
+            });
+            if found.keeps(look.tabulated) {
+                let coated = found.kept(&self.grids.full);
+                m.record.coat = Some(coated.record());
+                m.coated = Some(Box::new(coated.models));
+            }
         }
         m.record.timings_ms.coat = ms(t);
         m.record.timings_ms.total = ms(start);
@@ -406,6 +444,7 @@ impl Fit<'_> {
             metric: cfg.metric,
             metric_floor: 1.0 / self.grids.full.scale() as f64,
             other_metric: None,
+            look: None,
             timings_ms: timings,
         };
         FittedMaterial::from_parts(record, Arc::new(tab.ndf)).map_err(|problem| {

@@ -7,6 +7,7 @@ pub mod grid;
 pub(crate) mod iso;
 pub mod iso_tables;
 pub(crate) mod lambda_table;
+pub mod look;
 pub(crate) mod merl_geometry;
 pub(crate) mod sums;
 

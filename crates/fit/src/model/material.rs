@@ -165,6 +165,10 @@ pub struct FitRecord {
     /// The same models' errors in the other metric (absent in older records).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub other_metric: Option<MetricErrors>,
+    /// How the tabulated model looks beside the source: the sphere under the report's point
+    /// light (absent for anisotropic sources and in older records).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub look: Option<LookRecord>,
     /// How long each phase took.
     pub timings_ms: Timings,
 }
@@ -189,6 +193,18 @@ pub struct MetricErrors {
     /// The Beckmann model's, where fitted.
     pub beckmann: Option<f64>,
     /// The coated tabulated model's, where the fit kept a coat.
+    pub coated: Option<f64>,
+}
+
+/// The mean CIEDE2000 between a model and its source on a sphere under the report's point
+/// light ([`crate::metric::look::SphereScene::REPORT`], the source read from its MERL-grid
+/// table): below 1 the eye sees no difference.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LookRecord {
+    /// The single layer's tabulated model's ΔE2000.
+    pub tabulated: f64,
+    /// The coated tabulated model's, where a coat was searched (kept or not).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub coated: Option<f64>,
 }
 
