@@ -22,6 +22,7 @@ use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
     Sequence, Strategy,
 };
+use facet_fit::metric::look::SphereScene;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::Path;
@@ -29,15 +30,20 @@ use std::sync::Arc;
 
 /// The demo's sky, embedded so that the report needs no file beside the binary.
 const SKY_EXR: &[u8] = include_bytes!("../../assets/demo/sky.exr");
-/// The camera's distance from the sphere's centre.
-const CAMERA_Z: f32 = 3.0;
-/// The camera's vertical field of view, degrees: the unit sphere fills most of the frame.
-const YFOV_DEG: f32 = 45.0;
-/// The point light: upper left, in front of the sphere, at distance ≈ 3.9 from its centre.
-const LIGHT_POSITION: Vec3 = Vec3::new(-1.6, 1.8, 3.0);
-/// Its radiant intensity: a white Lambertian facing it gives L = I/(π r²) ≈ 1.5 (r ≈ 2.9 at
-/// the nearest point), shown as 1 − e^−1.5 = 0.78 — most MERL materials are darker.
-const LIGHT_INTENSITY: f32 = 40.0;
+/// The scene every sphere is rendered in, as the fit judges its look
+/// ([`SphereScene::REPORT`]): the camera on +z at 3 with a 45° vertical field of view, the
+/// point light upper left in front at distance ≈ 3.9, of intensity 40 (a white Lambertian
+/// facing it gives L = I/(π r²) ≈ 1.5, shown as 1 − e^−1.5 = 0.78 — most MERL materials are
+/// darker).
+const SCENE: SphereScene = SphereScene::REPORT;
+const CAMERA_Z: f32 = SCENE.camera_z as f32;
+const YFOV_DEG: f32 = SCENE.yfov_deg as f32;
+const LIGHT_POSITION: Vec3 = Vec3::new(
+    SCENE.light.x as f32,
+    SCENE.light.y as f32,
+    SCENE.light.z as f32,
+);
+const LIGHT_INTENSITY: f32 = SCENE.intensity as f32;
 /// Bounces of the environment renders (the sphere sees only the sky: 3 is plenty).
 pub const ENV_DEPTH: u32 = 3;
 /// Samples per pixel of the point-light renders: only the pixel positions vary (anti-aliasing).
