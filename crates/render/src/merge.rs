@@ -3,7 +3,7 @@
 //! variance by the exact pairwise formula (Chan, Golub & LeVeque 1979) — after checking that
 //! the parts belong together. Parts come in any order; the result is a part too, so merges nest.
 
-use crate::film::Image;
+use crate::film::{Image, to_f32_saturated};
 use crate::shard::{PixelKind, ShardRecord};
 use std::path::PathBuf;
 
@@ -85,6 +85,7 @@ fn check_part(part: &Part, first: &Part) -> Result<(), MergeError> {
     };
     let (image, record) = &part.image;
     let (first_image, first_record) = &first.image;
+    record.validate().map_err(err)?;
     if record.pixels != PixelKind::Mean {
         return Err(err("a variance image, not a render's mean image".into()));
     }
@@ -131,6 +132,14 @@ fn check_part(part: &Part, first: &Part) -> Result<(), MergeError> {
                 return Err(err(
                     "its variance image is of other samples or another size than its image".into(),
                 ));
+            }
+            if let Some(k) = var.pixels.iter().position(|p| p.iter().any(|v| *v < 0.0)) {
+                let w = var.width as usize;
+                return Err(err(format!(
+                    "its variance image is negative at pixel ({}, {}): not a variance",
+                    k % w,
+                    k / w
+                )));
             }
         }
         (None, Some(_)) => return Err(err("no variance image beside it".into())),
@@ -206,7 +215,8 @@ fn mean(parts: &[Part]) -> Image {
 
 /// Per pixel, the variance of the merged mean (the pixels of `merged`) from the parts' variances of their means
 /// vᵢ: each part's sum of squared deviations Mᵢ = vᵢ nᵢ (nᵢ − 1), then the pairwise formula
-/// M = Σ Mᵢ + Σ nᵢ (mᵢ − m)², and M / (N (N − 1)) (0 with fewer than two samples).
+/// M = Σ Mᵢ + Σ nᵢ (mᵢ − m)², and M / (N (N − 1)) (0 with fewer than two samples), in f64,
+/// saturated to `f32::MAX` as the film's variance is ([`to_f32_saturated`]).
 fn variance_of_mean(parts: &[Part], merged: &Image) -> Image {
     let n_total = total_count(parts);
     let pixels = (0..merged.pixels.len())
@@ -225,7 +235,7 @@ fn variance_of_mean(parts: &[Part], merged: &Image) -> Image {
                         vi * n * (n - 1.0) + n * (mi - m) * (mi - m)
                     })
                     .sum();
-                (m2 / (n_total * (n_total - 1.0))) as f32
+                to_f32_saturated(m2 / (n_total * (n_total - 1.0)))
             })
         })
         .collect();

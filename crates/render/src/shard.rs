@@ -9,15 +9,25 @@
 
 use crate::error::RenderError;
 use crate::film::Image;
+use facet_fit::io::input::{self, Cap};
 use serde::{Deserialize, Serialize};
+use std::fs::File;
+use std::io::BufReader;
 use std::ops::Range;
 use std::path::Path;
 
 /// The name of the EXR header attribute (image level, text) that holds a [`ShardRecord`].
 pub const EXR_ATTRIBUTE: &str = "facet";
 
+/// Largest sample index a render may reach (a shard's `--samples A..B` has B at most this; a
+/// part's record holds no range past it).
+pub const MAX_SAMPLE_INDEX: u32 = 1 << 30;
+
 /// Largest image side a part may declare (as `facet render` allows).
 const MAX_SIDE: usize = 16384;
+
+/// The largest part read: MAX_SIDE² RGB f32 pixels uncompressed (3 GiB) and its headers.
+const PART_CAP: Cap = Cap::new("render part (OpenEXR)", 3 * 1024 * 1024 * 1024 + (64 << 20));
 
 /// What the pixels of a part are.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -96,6 +106,20 @@ impl ShardRecord {
         if let Some([a, b]) = self.samples.iter().find(|[a, b]| a >= b) {
             return Err(format!("its sample range {a}..{b} is empty"));
         }
+        if let Some([a, b]) = self.samples.iter().find(|[_, b]| *b > MAX_SAMPLE_INDEX) {
+            return Err(format!(
+                "its sample range {a}..{b} reaches past {MAX_SAMPLE_INDEX}, the last sample \
+                 index a render takes"
+            ));
+        }
+        for (field, text) in [("digest", &self.digest), ("version", &self.version)] {
+            if text.chars().any(char::is_control) {
+                return Err(format!(
+                    "its {field} \"{}\" holds control characters",
+                    text.escape_debug()
+                ));
+            }
+        }
         Ok(())
     }
 }
@@ -109,7 +133,7 @@ impl Image {
             "every pixel holds the record's samples"
         );
         let json = serde_json::to_string(record).expect("a record serialises");
-        self.write_exr_with(path, Some(json))
+        self.write_exr_with(path, Some((EXR_ATTRIBUTE, json)))
     }
 
     /// A part written by [`Image::write_shard_exr`]: its pixels and its record. A file that is
@@ -118,8 +142,12 @@ impl Image {
     pub fn read_shard_exr(path: &Path) -> Result<(Image, ShardRecord), RenderError> {
         let bad = |m: String| RenderError::input(path, m);
         let not_exr = |e: exr::error::Error| bad(format!("not a readable OpenEXR image: {e}"));
+        // Through the input door: a regular file under its cap (a FIFO, a device or a
+        // directory is refused before it is opened), opened without blocking.
+        let open = || input::open(path, PART_CAP).map(|(f, len)| (BufReader::new(f), len));
+        let (file, bytes) = open()?;
         let meta = crate::scene::gltf_file::guard(path, "the OpenEXR image", || {
-            exr::meta::MetaData::read_from_file(path, false).map_err(not_exr)
+            exr::meta::MetaData::read_from_buffered(file, false).map_err(not_exr)
         })?;
         let record = record_of(&meta).map_err(bad)?;
         let header = &meta.headers[0];
@@ -131,15 +159,15 @@ impl Image {
         }
         // Each chunk has an 8-byte entry in the offset table, which the decoder allocates from
         // the header: more than the file can hold is a damaged (or hostile) header.
-        let bytes = std::fs::metadata(path).map_or(0, |m| m.len());
         if (header.chunk_count as u64).saturating_mul(8) > bytes {
             return Err(bad(format!(
                 "the header declares {} chunks, more than the file's {bytes} bytes can hold",
                 header.chunk_count
             )));
         }
+        let (file, _) = open()?;
         let pixels = crate::scene::gltf_file::guard(path, "the OpenEXR image", || {
-            read_rgb(path, w).map_err(not_exr)
+            read_rgb(file, w).map_err(not_exr)
         })?;
         if pixels.len() != w * h {
             return Err(bad(format!("{} pixels for {w} × {h}", pixels.len())));
@@ -193,7 +221,7 @@ fn record_of(meta: &exr::meta::MetaData) -> Result<ShardRecord, String> {
 }
 
 /// The RGB pixels of the first layer, row-major.
-fn read_rgb(path: &Path, width: usize) -> exr::error::Result<Vec<[f32; 3]>> {
+fn read_rgb(file: BufReader<File>, width: usize) -> exr::error::Result<Vec<[f32; 3]>> {
     use exr::prelude::{ReadChannels as _, ReadLayers as _};
     let image = exr::prelude::read()
         .no_deep_data()
@@ -206,6 +234,6 @@ fn read_rgb(path: &Path, width: usize) -> exr::error::Result<Vec<[f32; 3]>> {
         )
         .first_valid_layer()
         .all_attributes()
-        .from_file(path)?;
+        .from_buffered(file)?;
     Ok(image.layer_data.channel_data.pixels)
 }

@@ -234,3 +234,73 @@ fn write_with_attribute(path: &std::path::Path, image: &Image, text: &str) {
         .insert(Text::from("facet"), AttributeValue::Text(Text::from(text)));
     e.write().to_file(path).unwrap();
 }
+
+/// What a part's record or variance cannot be is refused where it enters, naming the part: a
+/// sample range past the last index a render takes (2³⁰), control characters in its digest or
+/// version (printed escaped, never raw to a terminal), a negative variance.
+#[test]
+fn impossible_records_and_variances_are_refused() {
+    let mut far = part(4, 6);
+    far.image.1.samples = vec![[4, (1 << 30) + 2]];
+    let e = refused(&[part(0, 4), far]);
+    assert!(e.message.contains("reaches past 1073741824"), "{e}");
+    let mut escape = part(4, 6);
+    escape.image.1.version = "0.1.0\u{1b}[31m".into();
+    let e = refused(&[part(0, 4), escape]);
+    assert!(
+        e.message.contains("version") && e.message.contains("\\u{1b}[31m"),
+        "{e}"
+    );
+    assert!(!e.to_string().contains('\u{1b}'), "{e}");
+    let mut negative = part(4, 6);
+    negative.variance.as_mut().unwrap().0.pixels[5][1] = -1e-3;
+    let e = refused(&[part(0, 4), negative]);
+    assert!(e.message.contains("negative at pixel (5, 0)"), "{e}");
+}
+
+/// Two finite parts whose means differ by ±3e38 merge to a finite variance: the between-part
+/// term (n (mᵢ − m)², past 1e77) is summed in f64 and saturated to `f32::MAX`, not cast to
+/// infinity.
+#[test]
+fn far_apart_parts_merge_to_a_finite_variance() {
+    let mut a = part(0, 4);
+    let mut b = part(4, 8);
+    for (p, v) in [(&mut a, 3e38f32), (&mut b, -3e38)] {
+        p.image.0.pixels.iter_mut().for_each(|px| *px = [v; 3]);
+    }
+    let merged = merge(&[a, b]).unwrap();
+    assert!(merged.image.pixels.iter().flatten().all(|v| *v == 0.0));
+    let var = merged.variance.unwrap();
+    assert!(
+        var.pixels.iter().flatten().all(|v| *v == f32::MAX),
+        "{:?}",
+        var.pixels[0]
+    );
+}
+
+/// A part, or its variance, that is a FIFO, a directory or a device is refused by name before
+/// it is opened: reading one blocked `facet merge` forever (a FIFO with no writer).
+#[cfg(unix)]
+#[test]
+fn a_part_that_is_not_a_regular_file_is_refused_without_blocking() {
+    let dir = std::env::temp_dir().join(format!("facet-shard-fifo-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("part.exr");
+    std::fs::remove_file(&fifo).ok();
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo {}", fifo.display());
+    for path in [fifo.clone(), dir.clone(), PathBuf::from("/dev/zero")] {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let p = path.clone();
+        std::thread::spawn(move || tx.send(Image::read_shard_exr(&p).map(|_| ())).ok());
+        let got = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("{} blocked the reader", path.display()));
+        let e = got.unwrap_err().to_string();
+        assert!(
+            e.contains(&path.display().to_string()) && e.contains("not a regular file"),
+            "{e}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
