@@ -1,5 +1,5 @@
 // Tone map of the film (facet_render::film's, written once there): per pixel the mean
-// L = film.rgb / max(film.w, 1), v = 1 − exp(−2^exposure · max(L, 0)), the sRGB transfer
+// L = film.rgb (the film holds running means), v = 1 − exp(−2^exposure · max(L, 0)), the sRGB transfer
 // function, 8 bits, packed RGBA with alpha 255. Rust: facet_render::tonemap::ToneMap.
 
 const WG: u32 = 64u;
@@ -36,7 +36,7 @@ fn tonemap(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroup
         return;
     }
     let f = film[i];
-    let l = f.xyz / max(f.w, 1.0);
+    let l = f.xyz;
     let v = vec3<f32>(1.0) - exp(-params.scale * max(l, vec3<f32>(0.0)));
     let s = vec3<f32>(encode_srgb(v.x), encode_srgb(v.y), encode_srgb(v.z));
     // Round half up, as the CPU's (s · 255 + 0.5) as u8.

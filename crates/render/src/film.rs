@@ -7,6 +7,22 @@
 use crate::error::RenderError;
 use std::path::Path;
 
+/// `v` as f32, `f32::MAX` where it is larger (a variance of radiance past 1.8e19 is): an image
+/// holds no infinity.
+pub fn to_f32_saturated(v: f64) -> f32 {
+    v.min(f32::MAX as f64) as f32
+}
+
+/// The values of `image` an image could not hold and were saturated to `f32::MAX`.
+pub fn saturated_count(image: &Image) -> usize {
+    image
+        .pixels
+        .iter()
+        .flatten()
+        .filter(|v| **v == f32::MAX)
+        .count()
+}
+
 /// A linear RGB image, row-major, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
@@ -21,18 +37,12 @@ pub struct Image {
 }
 
 impl Image {
-    /// Divides the film's sums by its counts (a pixel with no sample is black).
+    /// The film's running means and counts (a pixel with no sample is black).
     pub fn from_film(width: u32, height: u32, film: &[[f32; 4]]) -> Self {
         Image {
             width,
             height,
-            pixels: film
-                .iter()
-                .map(|v| {
-                    let n = v[3].max(1.0);
-                    [v[0] / n, v[1] / n, v[2] / n]
-                })
-                .collect(),
+            pixels: film.iter().map(|v| [v[0], v[1], v[2]]).collect(),
             samples: film.iter().map(|v| v[3] as u32).collect(),
         }
     }
@@ -77,12 +87,12 @@ impl Image {
         self.write_exr_with(path, None)
     }
 
-    /// Linear f32 RGB EXR with the text `facet` (a [`ShardRecord`](crate::shard::ShardRecord)'s
-    /// JSON) in its header when given.
+    /// Linear f32 RGB EXR with a text attribute `(name, text)` in its header when given (a
+    /// shard's record, [`crate::shard`]).
     pub(crate) fn write_exr_with(
         &self,
         path: &Path,
-        facet: Option<String>,
+        attribute: Option<(&str, String)>,
     ) -> Result<(), RenderError> {
         use exr::meta::attribute::{AttributeValue, Text};
         use exr::prelude::{SpecificChannels, Vec2, WritableImage as _};
@@ -93,11 +103,11 @@ impl Image {
             (p[0], p[1], p[2])
         });
         let mut image = exr::prelude::Image::from_channels((w, self.height as usize), channels);
-        if let Some(text) = facet {
-            let key = Text::from(crate::shard::EXR_ATTRIBUTE);
+        if let Some((name, text)) = attribute {
+            let key = Text::from(name);
             let value = Text::new_or_none(text.as_str()).ok_or_else(|| RenderError::Output {
                 path: path.to_owned(),
-                message: "the shard record is not EXR text".into(),
+                message: format!("the \"{name}\" attribute is not EXR text"),
             })?;
             image
                 .attributes

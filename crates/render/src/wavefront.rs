@@ -8,7 +8,7 @@
 use crate::bindings::{Group, bind_group};
 use crate::config::ImageConfig;
 use crate::error::RenderError;
-use crate::film::Image;
+use crate::film::{Image, to_f32_saturated};
 use crate::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::{COUNTERS, FETCH_COUNTER};
@@ -200,25 +200,28 @@ impl Wavefront {
     }
 
     /// Per pixel, the variance of its mean (the estimate the image shows): the samples' unbiased
-    /// variance over n, (Σ L² − n m²) / (n (n − 1)), 0 with fewer than two samples. `None`
-    /// unless made by [`Integrator::wavefront_with_variance`](crate::Integrator::wavefront_with_variance).
+    /// variance over n, (r² − m²) / (n − 1) from their mean m and root mean square r (in f64),
+    /// 0 with fewer than two samples, at most `f32::MAX` (an image holds no more: a variance
+    /// past it, from radiance past 1.8e19, is saturated, [`crate::film::saturated_count`] counts them).
+    /// `None` unless made by
+    /// [`Integrator::wavefront_with_variance`](crate::Integrator::wavefront_with_variance).
     pub fn variance(&self, gpu: &Gpu) -> Result<Option<Image>, RenderError> {
         if !self.moments {
             return Ok(None);
         }
         let film = self.read_film(gpu, &self.buffers.film)?;
-        let sq = self.read_film(gpu, &self.buffers.film_sq)?;
+        let rms = self.read_film(gpu, &self.buffers.film_sq)?;
         let var = film
             .iter()
-            .zip(&sq)
-            .map(|(s, q)| {
-                let n = s[3] as f64;
+            .zip(&rms)
+            .map(|(f, r)| {
+                let n = f[3] as f64;
                 std::array::from_fn(|c| {
                     if n < 2.0 {
                         return 0.0;
                     }
-                    let m = s[c] as f64 / n;
-                    (((q[c] as f64 - n * m * m) / (n * (n - 1.0))).max(0.0)) as f32
+                    let (m, r) = (f[c] as f64, r[c] as f64);
+                    to_f32_saturated(((r * r - m * m) / (n - 1.0)).max(0.0))
                 })
             })
             .collect();

@@ -770,3 +770,86 @@ fn reported_variance_matches_the_seed_to_seed_spread() {
     let plain = integrator.wavefront(&gpu, &res, image).unwrap();
     assert!(plain.variance(&gpu).unwrap().is_none());
 }
+
+/// Radiance a scene can hold in f32 does not overflow the film: a Lambertian sphere under a
+/// constant sky of 0.8 · s, at 16 spp, s = 1e25 and 1e37, gives the image and variance of the
+/// same scene at s = 1 scaled back: the mean times s within 1e-5 (each sample scaled by s rounds once, the running
+/// means round alike), the variance times s² within 1e-4 plus 1e-6 of the squared mean (r² − m²
+/// of f32 r and m cancels to about 2⁻²³ m²), or `f32::MAX` where that is past what an image
+/// holds (saturated, never infinite). At s = 1e38 every pixel is finite, and every pixel that
+/// sees only the sky is 0.8e38 (a sum of its 16 samples overflowed f32 before, as did their
+/// squares at 1e25); the sphere's pixels there lose samples whose path overflowed inside the
+/// integrator (the sky's radiance over a direction's density, past 3.4e38), which it drops.
+#[test]
+fn bright_skies_scale_the_image_without_overflow() {
+    let Some(gpu) = gpu_for_tests("bright_skies_scale_the_image_without_overflow") else {
+        return;
+    };
+    let scene = sphere_scene(lambert([0.5, 0.4, 0.3]));
+    let camera = CameraFrame::new(&scene.camera).unwrap();
+    let render = |s: f32| {
+        let env = Environment::Constant(Vec3::splat(0.8 * s));
+        let res =
+            SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
+        let integrator = Integrator::new(&gpu.device, &res).unwrap();
+        let mut wf = integrator
+            .wavefront_with_variance(&gpu, &res, config(16).image)
+            .unwrap();
+        integrator
+            .render_more(&gpu, &mut wf, &camera, &config(16).sampling, &mut |_| {})
+            .unwrap();
+        (wf.image(&gpu).unwrap(), wf.variance(&gpu).unwrap().unwrap())
+    };
+    let (image, variance) = render(1.0);
+    assert!(variance.pixels.iter().flatten().any(|&v| v > 0.0));
+    let (sky, _) = render(1e38);
+    for (got, want) in sky.pixels.iter().zip(&image.pixels) {
+        assert!(got.iter().all(|v| v.is_finite()), "{got:?}");
+        if *want == [0.8; 3] {
+            assert!(
+                got.iter().all(|&v| (v as f64 / 0.8e38 - 1.0).abs() < 1e-6),
+                "{got:?}"
+            );
+        }
+    }
+    assert!(
+        image.pixels.contains(&[0.8; 3]),
+        "no pixel sees the sky alone"
+    );
+    for s in [1e25f32, 1e37] {
+        let (bright, bright_var) = render(s);
+        let s = s as f64;
+        let close = |got: f32, want: f64, tol: f64| {
+            (got as f64 - want).abs() <= tol * want.abs() + f64::from(f32::MIN_POSITIVE)
+        };
+        for (k, (got, want)) in bright.pixels.iter().zip(&image.pixels).enumerate() {
+            for c in 0..3 {
+                assert!(
+                    got[c].is_finite() && close(got[c], s * want[c] as f64, 1e-5),
+                    "s = {s:e}, pixel {k}: {} against {}",
+                    got[c],
+                    s * want[c] as f64
+                );
+            }
+        }
+        let mut saturated = 0;
+        let pixels = bright_var.pixels.iter().zip(&variance.pixels);
+        for ((got, want), m) in pixels.zip(&bright.pixels) {
+            for c in 0..3 {
+                let want = s * s * want[c] as f64;
+                if want > f32::MAX as f64 {
+                    assert_eq!(got[c], f32::MAX);
+                    saturated += 1;
+                } else {
+                    let slack = 1e-4 * want + 1e-6 * (m[c] as f64).powi(2);
+                    assert!(
+                        (got[c] as f64 - want).abs() <= slack,
+                        "{} against {want}",
+                        got[c]
+                    );
+                }
+            }
+        }
+        println!("s = {s:e}: {saturated} variances past f32::MAX, saturated");
+    }
+}
