@@ -176,7 +176,12 @@ impl Manifest {
                 let outcome = match (e["json"].as_str(), e["error"].as_str()) {
                     (Some(json), None) => Ok(json.to_owned()),
                     (None, Some(error)) => Err(error.to_owned()),
-                    _ => return Err("an input has neither `json` nor `error`".to_owned()),
+                    (Some(_), Some(_)) => {
+                        return Err("an input has both `json` and `error` (one of them)".to_owned());
+                    }
+                    (None, None) => {
+                        return Err("an input has neither `json` nor `error` (text)".to_owned());
+                    }
                 };
                 Ok(Entry {
                     index: number(e, "index")?,
@@ -264,6 +269,17 @@ mod tests {
         };
         let v: Value = serde_json::from_str(&m.to_json()).unwrap();
         assert_eq!(Manifest::parse(&v), Ok(m.clone()));
+        // An entry with both outcomes, or neither, is named for what it is.
+        let mut both = v.clone();
+        both["inputs"][0]["error"] = "x".into();
+        assert!(
+            Manifest::parse(&both)
+                .unwrap_err()
+                .contains("both `json` and `error`")
+        );
+        let mut neither = v.clone();
+        neither["inputs"][0].as_object_mut().unwrap().remove("json");
+        assert!(Manifest::parse(&neither).unwrap_err().contains("neither"));
         let mut short = m;
         short.entries.pop();
         let v: Value = serde_json::from_str(&short.to_json()).unwrap();

@@ -37,3 +37,44 @@ fn fit_json_round_trip_and_fit_as_source() {
     let err = FittedMaterial::load(&path).err().unwrap().to_string();
     assert!(err.contains("gold.json"), "{err}");
 }
+
+/// The figures a record reports are checked as it is read, the field named: a phase's time past
+/// a week (1.7e308 ms summed to "inf s in all" in `facet fit --summary`), a negative or
+/// non-finite look, a zero metric floor.
+#[test]
+fn a_records_times_and_looks_are_checked() {
+    let src = merl_from_spec("ggx?alpha=0.15&conductor=gold");
+    let fit = fit_material(&src, "test", &FitConfig::isotropic()).unwrap();
+    let path = scratch("fit_json_figures").join("gold.json");
+    fit.save(&path).unwrap();
+    let good: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    assert!(
+        good["look"]["tabulated"].as_f64().unwrap() < 0.1,
+        "{}",
+        good["look"]
+    );
+    for (pointer, value, field) in [
+        (
+            "/timings_ms/total",
+            serde_json::json!(1.7e308),
+            "timings_ms.total",
+        ),
+        ("/timings_ms/fit", serde_json::json!(-3.0), "timings_ms.fit"),
+        ("/look/tabulated", serde_json::json!(-1.0), "look.tabulated"),
+        (
+            "/look/tabulated",
+            serde_json::json!(1e300),
+            "look.tabulated",
+        ),
+        ("/metric_floor", serde_json::json!(0.0), "metric_floor"),
+    ] {
+        let mut bad = good.clone();
+        *bad.pointer_mut(pointer).unwrap() = value;
+        let err = FittedMaterial::parse(&path, &bad.to_string())
+            .err()
+            .unwrap_or_else(|| panic!("{pointer} accepted"))
+            .to_string();
+        assert!(err.contains("gold.json") && err.contains(field), "{err}");
+    }
+}

@@ -315,6 +315,7 @@ impl FittedMaterial {
     /// The models of a record whose Fresnel table and stretch are checked, with its NDF.
     fn with_ndf(record: FitRecord, ndf: Arc<TabulatedNdf>) -> Result<Self, String> {
         check_normalised(&ndf)?;
+        check_figures(&record)?;
         check_albedo("tabulated.diffuse", record.tabulated.diffuse)?;
         let tabulated = MicrofacetBrdf {
             name: format!("{}-tabulated", record.name),
@@ -419,6 +420,46 @@ fn check_alpha(field: &str, alpha_x: f64, alpha_y: f64, rotation: f64) -> Result
         range.start(),
         range.end()
     ))
+}
+
+/// The longest a recorded phase of a fit may have taken, ms: a week (a fit takes seconds).
+const MAX_PHASE_MS: f64 = 7.0 * 24.0 * 3600e3;
+/// The largest ΔE2000 a look may record (two colours of CIELAB differ by at most about 200).
+const MAX_DELTA_E: f64 = 1000.0;
+
+/// The figures a record reports rather than renders with: each phase's time in
+/// [0, [`MAX_PHASE_MS`]], each look in [0, [`MAX_DELTA_E`]], the metric's ε positive and
+/// finite; an error naming the field and its value (a summary of fits sums the times: 1.7e308
+/// of them made "inf s in all").
+fn check_figures(r: &FitRecord) -> Result<(), String> {
+    let in_range = |field: &str, v: f64, max: f64, unit: &str| match (0.0..=max).contains(&v) {
+        true => Ok(()),
+        false => Err(format!("{field}: {v}{unit} (between 0 and {max}{unit})")),
+    };
+    let t = &r.timings_ms;
+    for (field, v) in [
+        ("load", t.load),
+        ("extract", t.extract),
+        ("fresnel", t.fresnel),
+        ("fit", t.fit),
+        ("coat", t.coat),
+        ("total", t.total),
+    ] {
+        in_range(&format!("timings_ms.{field}"), v, MAX_PHASE_MS, " ms")?;
+    }
+    if let Some(look) = r.look {
+        in_range("look.tabulated", look.tabulated, MAX_DELTA_E, "")?;
+        if let Some(c) = look.coated {
+            in_range("look.coated", c, MAX_DELTA_E, "")?;
+        }
+    }
+    if !(r.metric_floor > 0.0 && r.metric_floor.is_finite()) {
+        return Err(format!(
+            "metric_floor: {} (the metric's ε is positive and finite)",
+            r.metric_floor
+        ));
+    }
+    Ok(())
 }
 
 /// The widest factor by which a read NDF table's ∫ D cos θ dω may miss 1: 45 % is the table
