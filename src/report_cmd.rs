@@ -13,13 +13,14 @@ mod scenes;
 mod subject;
 mod sweep;
 
-use self::material::{IMG, MaterialReport, report_material};
+use self::material::{MaterialReport, report_material};
 use self::scenes::{Lighting, SphereRenderer};
 use crate::fit_cmd::{CoatArg, MetricArg};
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use facet_fit::FitConfig;
 use facet_fit::fitting::CoatSearch;
+use facet_fit::io::input::same_file;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::collections::HashSet;
@@ -106,6 +107,34 @@ fn inputs(args: &ReportArgs) -> Vec<String> {
     v
 }
 
+/// Subfolder of the report's images.
+pub const IMG: &str = "img";
+
+/// Refuses, before anything is written, an input file the page would replace: `index.html` of
+/// `--out`, or a file in its `img/` (whose names come from the materials'), named as an input
+/// or as `--env`.
+fn refuse_replacing_inputs(args: &ReportArgs, inputs: &[String]) -> Result<()> {
+    let files = inputs
+        .iter()
+        .map(PathBuf::from)
+        .filter(|p| p.exists())
+        .chain(args.env.clone());
+    let (index, img) = (args.out.join("index.html"), args.out.join(IMG));
+    for file in files {
+        let in_img = file.parent().is_some_and(|p| same_file(p, &img));
+        if same_file(&file, &index) || in_img {
+            bail!(
+                "{}: the report would replace this input (it writes {} and {}/); choose another \
+                 --out",
+                file.display(),
+                index.display(),
+                img.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// A file stem for `name`, unique among `taken` (-2, -3, ... on a repeat).
 fn unique_stem(name: &str, taken: &mut HashSet<String>) -> String {
     let base = facet_fit::io::input::safe_file_stem(name);
@@ -131,6 +160,7 @@ fn progress_bar(n: usize) -> ProgressBar {
 pub fn run(args: &ReportArgs) -> Result<ExitCode> {
     let started = Instant::now();
     let inputs = inputs(args);
+    refuse_replacing_inputs(args, &inputs)?;
     prepare_out(&args.out, args.force)?;
     let gpu = crate::render_cmd::open_gpu()?;
     let mut renderer = SphereRenderer::new(&gpu, args.resolution, args.spp, args.env.as_deref())?;

@@ -682,3 +682,44 @@ fn ictcp_and_delta_e_itp_match_independent_values() {
         assert_eq!(delta_e_itp(ictcp(rgb(a)), ictcp(rgb(a))), 0.0);
     }
 }
+
+/// `--force` writes into a folder that holds files, but never over an input: a fit JSON named
+/// `index.html` in `--out`, or an input (or the `--env` map) in `--out/img/`, is refused before
+/// anything is written, naming it, and is left as it was. (Refused before the GPU is asked for,
+/// so it runs without an adapter.)
+#[test]
+fn the_report_never_replaces_its_inputs() {
+    let dir = scratch("report_inputs_kept");
+    let (fit, _) = gold_fit_record(&dir);
+    std::fs::create_dir_all(dir.join("page/img")).unwrap();
+    let index = dir.join("page/index.html");
+    std::fs::copy(&fit, &index).unwrap();
+    let in_img = dir.join("page/img/gold.json");
+    std::fs::copy(&fit, &in_img).unwrap();
+    let before = std::fs::read(&fit).unwrap();
+    for args in [
+        vec!["report", "page/index.html"],
+        vec!["report", "page/img/gold.json"],
+        vec!["report", "fits/../page/img/gold.json"],
+        vec![
+            "report",
+            "analytic:ggx?alpha=0.2",
+            "--env",
+            "page/img/gold.json",
+        ],
+    ] {
+        let mut all = args.clone();
+        all.extend(["--out", "page", "--force"]);
+        let (ok, _, stderr) = facet_in(&dir, &all);
+        assert!(
+            !ok && stderr.contains("would replace this input"),
+            "{args:?}: {stderr}"
+        );
+        assert!(
+            stderr.contains("page/index.html") || stderr.contains("gold.json"),
+            "{stderr}"
+        );
+    }
+    assert_eq!(std::fs::read(&index).unwrap(), before);
+    assert_eq!(std::fs::read(&in_img).unwrap(), before);
+}

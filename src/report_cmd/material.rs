@@ -8,15 +8,12 @@ use super::scenes::{
     FLOOR_SEED, Lighting, N_MODELS, SEED, SphereRenderer, Variant, material, on_sphere,
 };
 use super::subject::Subject;
-use super::{false_colour, plots};
+use super::{IMG, false_colour, plots};
 use anyhow::{Context, Result};
 use facet_fit::model::material::ModelChoice;
 use facet_render::Image;
 use facet_render::scene::Material;
 use std::path::Path;
-
-/// Subfolder of the report's images.
-pub const IMG: &str = "img";
 
 /// What the page says of one material.
 pub struct MaterialReport {

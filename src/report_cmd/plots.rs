@@ -2,8 +2,8 @@
 //! a material's NDFs (log scale) and Fresnel curves, the N sweep's time against error, and the
 //! ΔE colour scale.
 
+use super::IMG;
 use super::false_colour::{DE_MAX, colour};
-use super::material::IMG;
 use super::sweep::SweepPoint;
 use anyhow::{Result, anyhow};
 use facet_fit::model::material::FittedMaterial;
