@@ -10,7 +10,6 @@ mod fit_cmd;
 mod merge_cmd;
 mod output;
 mod render_cmd;
-mod render_digest;
 mod report_cmd;
 
 use clap::{Parser, Subcommand};

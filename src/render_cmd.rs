@@ -1,5 +1,7 @@
 //! `facet render`: a glTF scene through the wavefront path tracer to PNG + EXR.
 
+mod digest;
+
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::io::input::same_file;
@@ -254,7 +256,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         light_selection: args.light_selection.selection(),
         ..ResourceConfig::standard()
     };
-    let digest = crate::render_digest::digest(args, &inputs)?;
+    let digest = digest::digest(args, &inputs)?;
     Ok(Job {
         scene,
         environment,
@@ -319,7 +321,7 @@ pub fn render_job(gpu: &facet_gpu::Gpu, job: &Job, out: &Path, exposure: f32) ->
             wf.sample_range(),
             c.sampling.seed,
             job.digest.clone(),
-            crate::render_digest::VERSION.into(),
+            digest::VERSION.into(),
         )
     };
     let (png, exr) = outputs(out);

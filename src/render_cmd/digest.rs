@@ -4,7 +4,7 @@
 //! (what a part holds), and what changes speed but not pixels (--wavefront, --bvh, --time-limit,
 //! --exposure, which only the PNG sees).
 
-use crate::render_cmd::RenderArgs;
+use super::RenderArgs;
 use anyhow::{Context, Result};
 use sha2::{Digest, Sha256};
 use std::path::Path;

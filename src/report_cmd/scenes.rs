@@ -11,6 +11,7 @@
 //! scene's resources).
 
 use anyhow::Result;
+use facet_fit::metric::look::SphereScene;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_gpu::Gpu;
 use facet_render::camera::CameraFrame;
@@ -22,7 +23,6 @@ use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
     Sequence, Strategy,
 };
-use facet_fit::metric::look::SphereScene;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::path::Path;
