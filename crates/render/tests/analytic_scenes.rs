@@ -1110,6 +1110,35 @@ fn measured_proxy(name: &str) -> (Material, MerlTable) {
     (material, table)
 }
 
+/// 200 materials naming one measurement hold its table and its sampling fit's tabulated NDF
+/// once: the scene's tables grow by each material's own Fresnel table (3 × FRESNEL_NODES f32)
+/// and nothing else, where each used to add the NDF's block again (about 1 MB: 110 of them
+/// passed the 128 MiB binding).
+#[test]
+fn materials_sharing_a_measurement_upload_it_once() {
+    let Some(gpu) = gpu_for_tests("materials_sharing_a_measurement_upload_it_once") else {
+        return;
+    };
+    let (material, _) = measured_proxy("gold-metallic-paint");
+    let upload = |n: usize| {
+        let mut scene = sphere_scene(material.clone());
+        scene.materials = vec![material.clone(); n];
+        let res = SceneResources::new(&gpu, &scene, None, ResourceConfig::standard()).unwrap();
+        let b = &res.built;
+        (res.tables.size(), b.measured_tables, b.tabulated_tables)
+    };
+    let (one, many) = (upload(1), upload(200));
+    assert_eq!((one.1, one.2, many.1, many.2), (1, 1, 1, 1));
+    let fresnel = 4 * 3 * facet_render::resources::materials::FRESNEL_NODES as u64;
+    println!(
+        "tables: {} bytes for 1 material, {} for 200 ({} a material more)",
+        one.0,
+        many.0,
+        (many.0 - one.0) / 199
+    );
+    assert_eq!(many.0 - one.0, 199 * fresnel);
+}
+
 /// f of the table at (wi, wo), channels reversed when `broken`.
 fn lookup(table: &MerlTable, wi: DVec3, wo: DVec3, broken: bool) -> DVec3 {
     let v = table.lookup_interpolated(wi, wo).unwrap_or([0.0; 3]);

@@ -132,14 +132,32 @@ impl MaterialPlan<'_> {
         Ok(())
     }
 
-    /// Appends the plan's tables (Fresnel, tabulated NDF) to `tables` and sets their offsets.
-    pub fn place_tables(&mut self, tables: &mut Tables, source: &str) {
+    /// Appends the plan's tables (Fresnel, tabulated NDF) to `tables` and sets their offsets;
+    /// a tabulated NDF already in `placed` (one fit named by many materials) is not appended
+    /// again. Whether a tabulated NDF was appended.
+    pub fn place_tables(
+        &mut self,
+        tables: &mut Tables,
+        source: &str,
+        placed: &mut PlacedNdfs,
+    ) -> bool {
         if let Some(f) = &self.fresnel {
+            // Per material: an update in place rewrites it.
             self.slot.gpu.fresnel_offset = tables.push(source, f.iter().copied());
             self.slot.gpu.fresnel_count = FRESNEL_NODES as u32;
         }
+        let mut appended = false;
         if let Some(tab) = self.tabulated {
-            self.slot.gpu.tab_offset = tables.push(source, tabulated_block(tab));
+            let key = std::ptr::from_ref(tab);
+            self.slot.gpu.tab_offset = match placed.iter().find(|(k, _)| *k == key) {
+                Some(&(_, at)) => at,
+                None => {
+                    let at = tables.push(source, tabulated_block(tab));
+                    placed.push((key, at));
+                    appended = true;
+                    at
+                }
+            };
         }
         if let Some(layer) = self.coat {
             let gpu = &mut self.slot.gpu;
@@ -148,8 +166,13 @@ impl MaterialPlan<'_> {
             gpu.coat_alpha = layer.coat.alpha as f32;
             gpu.coat_eta = layer.coat.eta as f32;
         }
+        appended
     }
 }
+
+/// The tabulated NDFs a scene's tables hold, by address, with their offsets: an NDF shared by
+/// many materials (the fit they all name) is placed once (about 1 MB each).
+pub type PlacedNdfs = Vec<(*const TabulatedNdf, u32)>;
 
 /// A tabulated NDF's block in the `tables` buffer, as shaders/render/tabulated.inc.wgsl reads
 /// it: [nu, nphi, ng, n_theta_v, n_phi_v, rows, columns, 0], then D₀, G1₀, the D cos θ cells'

@@ -44,7 +44,7 @@ pub struct Built {
     pub textures: usize,
     /// Whether the environment is a map (not a constant).
     pub environment_map: bool,
-    /// Tabulated NDFs uploaded.
+    /// Tabulated NDFs uploaded (one per fit, however many materials name it).
     pub tabulated_tables: usize,
     /// Measured tables uploaded (one per measurement, however many materials share it).
     pub measured_tables: usize,
@@ -384,8 +384,10 @@ fn plan_materials(
 ) -> Result<(Vec<MaterialSlot>, Vec<GlintSpec>), RenderError> {
     let mut slots = Vec::with_capacity(scene.materials.len());
     let mut glint_specs = Vec::new();
-    // Each measurement's table once, however many materials render it.
+    // Each measurement's table, and each fit's tabulated NDF, once, however many materials
+    // render it.
     let mut measured_at: Vec<(*const Measurement, u32)> = Vec::new();
+    let mut ndfs_at = materials::PlacedNdfs::new();
     for (mi, m) in scene.materials.iter().enumerate() {
         let mut plan = materials::plan(m)?;
         let what = match (&m.measured, &m.facet) {
@@ -393,7 +395,9 @@ fn plan_materials(
             (None, Some(f)) => format!("the fit {} of material `{}`", f.source.display(), m.name),
             (None, None) => String::new(),
         };
-        plan.place_tables(tables, &what);
+        if plan.place_tables(tables, &what, &mut ndfs_at) {
+            built.tabulated_tables += 1;
+        }
         if let Some(data) = plan.measured {
             let key = Arc::as_ptr(data);
             let offset = match measured_at.iter().find(|(k, _)| *k == key) {
@@ -406,9 +410,6 @@ fn plan_materials(
                 }
             };
             plan.slot.set_measured_offset(offset);
-        }
-        if plan.tabulated.is_some() {
-            built.tabulated_tables += 1;
         }
         if let Some((ndf, spec)) = plan.glint {
             plan.slot.set_queue(Queue::Glint(glint_specs.len() as u32));
