@@ -67,6 +67,7 @@ pub fn run(args: &DemoArgs) -> Result<ExitCode> {
             .iter()
             .map(|m| format!("{m}={fit}"))
             .collect(),
+        nbrdf: None,
         wavefront: 1 << 20,
         bvh: render_cmd::PresetArg::Medium,
         no_glint_filter: false,

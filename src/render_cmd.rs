@@ -61,6 +61,10 @@ pub struct RenderArgs {
     /// Camera by index or name (default: the first perspective camera).
     #[arg(long)]
     pub camera: Option<String>,
+    /// Neural proxy file for `nbrdf:` measurements (default: `$FACET_NBRDF`, else the
+    /// embedded MERL-100), as every command resolves `nbrdf:`.
+    #[arg(long, value_name = "FILE")]
+    pub nbrdf: Option<PathBuf>,
     /// Give the glTF material NAME a fit or a measurement (repeatable): NAME=FILE. A fit
     /// `.json` is rendered by its model; a measurement (a MERL `.binary`, an RGL `.bsdf`,
     /// `nbrdf:NAME`) is rendered as measured, a MERL-grid one sampled by a fit made on load.
@@ -194,13 +198,22 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
     let options = LoadOptions {
         camera: args.camera.clone(),
         materials,
+        nbrdf: args.nbrdf.clone(),
     };
     let scene = load_gltf(&args.scene, &options)?;
-    // Every file the scene read (its buffers, textures and fits), the scene and the
-    // environment: no output may replace one of them.
+    // Every file the scene read (its buffers, textures and fits), the scene, the
+    // environment and the proxy file `nbrdf:` resolves in: no output may replace one of them,
+    // and the shards' digest reads them all.
+    let names_proxy = |m: &facet_render::scene::Material| {
+        (m.measured.as_ref()).is_some_and(|mm| mm.source.starts_with("nbrdf:"))
+    };
+    let nbrdf = (scene.materials.iter().any(names_proxy))
+        .then(|| facet_fit::sources::nbrdf::NbrdfLibrary::override_path(args.nbrdf.as_deref()))
+        .flatten();
     let inputs: Vec<&Path> = std::iter::once(args.scene.as_path())
         .chain(args.env.as_deref())
         .chain(scene.inputs.iter().map(PathBuf::as_path))
+        .chain(nbrdf.as_deref())
         .collect();
     let (png, exr) = outputs(&args.out);
     // The folder is made (or refused) now, not after the render.

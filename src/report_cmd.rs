@@ -34,7 +34,8 @@ pub struct ReportArgs {
     /// .json (rendered by its models only: ΔE against its tabulated model).
     #[arg(required_unless_present = "all_proxies")]
     inputs: Vec<String>,
-    /// Add the 100 MERL proxies embedded in Facet (`nbrdf:NAME`) to the inputs.
+    /// Add every neural proxy (`nbrdf:NAME`) to the inputs: the 100 MERL proxies embedded in
+    /// Facet, or those of `$FACET_NBRDF`.
     #[arg(long)]
     all_proxies: bool,
     /// Output folder: index.html and img/. Refused when it exists and is not empty, unless
@@ -98,13 +99,14 @@ fn prepare_out(out: &Path, force: bool) -> Result<()> {
 }
 
 /// The inputs: as given, then the embedded proxies with --all-proxies.
-fn inputs(args: &ReportArgs) -> Vec<String> {
+fn inputs(args: &ReportArgs) -> Result<Vec<String>> {
     let mut v = args.inputs.clone();
     if args.all_proxies {
-        let lib = NbrdfLibrary::embedded();
+        // Those of the file `nbrdf:` resolves in ($FACET_NBRDF, else the embedded MERL-100).
+        let lib = NbrdfLibrary::open_or_embedded(None)?;
         v.extend(lib.names().map(|n| format!("nbrdf:{n}")));
     }
-    v
+    Ok(v)
 }
 
 /// Subfolder of the report's images.
@@ -159,7 +161,7 @@ fn progress_bar(n: usize) -> ProgressBar {
 
 pub fn run(args: &ReportArgs) -> Result<ExitCode> {
     let started = Instant::now();
-    let inputs = inputs(args);
+    let inputs = inputs(args)?;
     refuse_replacing_inputs(args, &inputs)?;
     prepare_out(&args.out, args.force)?;
     let gpu = crate::render_cmd::open_gpu()?;

@@ -68,3 +68,39 @@ fn convert_round_trips_and_refuses_to_overwrite() {
         "α {alpha} through .bsdf → MERL → .bsdf → fit"
     );
 }
+
+/// `nbrdf:` resolves the same way in every command: `--nbrdf`, else `$FACET_NBRDF`, else the
+/// embedded proxies. `facet convert` read `$FACET_NBRDF` nowhere (its `--help` said it did): a
+/// name only the variable's file holds is converted, and is unknown without it.
+#[test]
+fn convert_reads_the_proxy_file_in_facet_nbrdf() {
+    let dir = common::scratch("convert_facet_nbrdf");
+    let all: serde_json::Map<String, serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(common::nbrdf_path()).unwrap()).unwrap();
+    let lib = dir.join("lib.json");
+    let one = serde_json::json!({ "only-here": all["alum-bronze"] });
+    std::fs::write(&lib, one.to_string()).unwrap();
+    let convert = |env: Option<&std::path::Path>, out: &str| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_facet"));
+        c.args(["convert", "nbrdf:only-here", out])
+            .current_dir(&dir);
+        c.env_remove("FACET_NBRDF");
+        if let Some(p) = env {
+            c.env("FACET_NBRDF", p);
+        }
+        c.output().unwrap()
+    };
+    let with = convert(Some(&lib), "a.binary");
+    assert!(
+        with.status.success(),
+        "{}",
+        String::from_utf8_lossy(&with.stderr)
+    );
+    assert!(dir.join("a.binary").is_file());
+    let without = convert(None, "b.binary");
+    let stderr = String::from_utf8_lossy(&without.stderr);
+    assert!(
+        !without.status.success() && stderr.contains("only-here"),
+        "{stderr}"
+    );
+}

@@ -1096,8 +1096,13 @@ fn coated_sphere_in_a_white_furnace_renders_its_albedo() {
 /// CPU lookup of its filled table with the channels as stored and reversed (a broken renderer
 /// that reads the interleaved table backwards).
 fn measured_proxy(name: &str) -> (Material, MerlTable) {
-    let m = MeasuredMaterial::open(&format!("nbrdf:{name}"), std::path::Path::new(""), None)
-        .unwrap_or_else(|e| panic!("{e}"));
+    let m = MeasuredMaterial::open(
+        &format!("nbrdf:{name}"),
+        std::path::Path::new(""),
+        None,
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     let Measurement::Merl(table) = &*m.data else {
         panic!("a proxy is a MERL-grid table");
     };

@@ -673,11 +673,45 @@ fn measured_extras_and_overrides_name_a_measurement() {
             json!({"model": "measured", "source": "m.binary", "glint": {"density": 1e6}}),
             vec!["glint", "metal"],
         ),
+        // Relative to the glTF, as buffers and images are.
+        (
+            json!({"model": "measured", "source": dir.join("m.binary")}),
+            vec!["absolute path", "metal"],
+        ),
+        // A name is shown escaped, never as terminal escapes.
+        (
+            json!({"model": "measured", "source": "nbrdf:x\u{1b}[2J"}),
+            vec!["x\\u{1b}[2J", "metal"],
+        ),
     ] {
         let path = facet_scene(&dir, extras.clone());
         let e = load_err(&path, &LoadOptions::default());
         assert!(words.iter().all(|w| e.contains(w)), "{extras}: {e}");
+        assert!(!e.contains('\u{1b}'), "{e}");
     }
+    // `nbrdf:` resolves in the proxy file the options name (`facet render --nbrdf`), as every
+    // command resolves it: a name only that file holds.
+    let embedded = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fit/data/nbrdf/merl100.json"),
+    )
+    .unwrap();
+    let all: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&embedded).unwrap();
+    let lib = dir.join("lib.json");
+    std::fs::write(&lib, json!({"only-here": all["alum-bronze"]}).to_string()).unwrap();
+    let path = facet_scene(
+        &dir,
+        json!({"model": "measured", "source": "nbrdf:only-here"}),
+    );
+    assert!(load_err(&path, &LoadOptions::default()).contains("only-here"));
+    let o = LoadOptions {
+        nbrdf: Some(lib),
+        ..Default::default()
+    };
+    let m = load_gltf(&path, &o).unwrap().materials[0]
+        .measured
+        .clone()
+        .unwrap();
+    assert_eq!(m.source, "nbrdf:only-here");
     // A measurement cannot take a glint material's place.
     let path = facet_scene(
         &dir,

@@ -165,9 +165,10 @@ impl NbrdfLibrary {
             .or_else(|| std::env::var_os("FACET_NBRDF").map(PathBuf::from))
     }
 
-    /// `path` when given, else the embedded library.
+    /// The library `nbrdf:` names resolve in, the same in every command: `path` (`--nbrdf`)
+    /// when given, else `$FACET_NBRDF`, else the embedded library.
     pub fn open_or_embedded(path: Option<&Path>) -> Result<Self, FitError> {
-        match path {
+        match Self::override_path(path).as_deref() {
             Some(p) => Self::open(p),
             None => Ok(Self::embedded()),
         }
@@ -215,15 +216,20 @@ impl NbrdfLibrary {
                 .filter(|n| n.contains(name) || name.contains(*n))
                 .take(5)
                 .collect();
+            // Escaped: a name from a command line or a scene may hold terminal escapes.
             bad(format!(
-                "no material named `{name}`{}",
+                "no material named `{}`{}",
+                name.escape_debug(),
                 if near.is_empty() {
                     String::new()
                 } else {
+                    let near: Vec<String> =
+                        near.iter().map(|n| n.escape_debug().to_string()).collect();
                     format!(" (did you mean {}?)", near.join(", "))
                 }
             ))
         })?;
+        let name = name.escape_debug().to_string();
         let raw: RawWeights = serde_json::from_value(value.clone())
             .map_err(|e| bad(format!("material `{name}`: {e}")))?;
         let l1 = Layer::new(&raw.w1, &raw.b1, 6, "W1")

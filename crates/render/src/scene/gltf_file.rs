@@ -52,6 +52,9 @@ pub struct LoadOptions {
     /// `--material NAME=FILE`: attach the fitted material FILE to the glTF material NAME
     /// (model tabulated unless the material's extras say otherwise). An unknown NAME is an error.
     pub materials: Vec<(String, PathBuf)>,
+    /// The neural proxy file `nbrdf:` measurements resolve in (`--nbrdf`); `None`:
+    /// `$FACET_NBRDF`, else the embedded proxies, as in every command.
+    pub nbrdf: Option<PathBuf>,
 }
 
 /// Vertical field of view of the framing default camera: 45°.
@@ -153,6 +156,7 @@ fn load_document(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sce
 
     let mut scene = Scene::default();
     let mut loader = MaterialLoader::new(path, &buffers, &options.materials);
+    loader.nbrdf = options.nbrdf.as_deref();
     scene.materials = loader.load_all(&document, &mut scene.textures, &mut scene.warnings)?;
     scene.inputs = buffers
         .files()

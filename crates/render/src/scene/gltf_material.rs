@@ -26,6 +26,7 @@ use super::{Clearcoat, FacetMaterial, GlintParams, Material, MeasuredMaterial, T
 use crate::error::RenderError;
 use facet_fit::io::input::{self, Cap};
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
+use facet_fit::sources::InputSpec;
 use glam::{Vec3, Vec4};
 use serde_json::Value;
 use std::collections::HashMap;
@@ -171,6 +172,8 @@ pub(crate) struct MaterialLoader<'a> {
     pub buffers: &'a Buffers,
     /// `--material NAME=FILE` overrides.
     pub overrides: &'a [(String, PathBuf)],
+    /// The neural proxy file of `nbrdf:` measurements (`None`: `$FACET_NBRDF`, else embedded).
+    pub nbrdf: Option<&'a Path>,
     /// Decoded images (or why not) by what they were read from.
     images: HashMap<ImageKey, Result<Decoded, String>>,
     /// Texels of the scene textures made so far (against [`MAX_SCENE_TEXELS`]).
@@ -192,6 +195,7 @@ impl<'a> MaterialLoader<'a> {
             gltf_path,
             buffers,
             overrides,
+            nbrdf: None,
             images: HashMap::new(),
             texels: 0,
             textures: HashMap::new(),
@@ -388,6 +392,20 @@ impl<'a> MaterialLoader<'a> {
             .map(|(_, f)| f.clone())
             .or_else(|| extras.as_ref().and_then(|e| e.fit.clone()));
         if let Some(source) = extras.as_ref().and_then(|e| e.measured.clone()) {
+            // Relative to the glTF, as its buffers and images are.
+            if InputSpec::parse(&source)
+                .path()
+                .is_some_and(|p| p.has_root() || p.is_absolute())
+            {
+                return Err(RenderError::input(
+                    self.gltf_path,
+                    format!(
+                        "material `{name}`: the measurement `{}` is an absolute path; a \
+                         scene's files are relative to the glTF",
+                        source.escape_debug()
+                    ),
+                ));
+            }
             let fit = fit_file.map(|f| self.fit(name, &f)).transpose()?;
             let base = self.gltf_path.parent().unwrap_or(Path::new("")).to_owned();
             return Ok((None, Some(self.measured(name, &source, &base, fit)?)));
@@ -448,7 +466,7 @@ impl<'a> MaterialLoader<'a> {
         if let Some(m) = self.measurements.get(&key) {
             return Ok(m.clone());
         }
-        let mut m = MeasuredMaterial::open(source, base, fit)
+        let mut m = MeasuredMaterial::open(source, base, fit, self.nbrdf)
             .map_err(|e| RenderError::input(self.gltf_path, format!("material `{name}`: {e}")))?;
         // The same measurement with another fit: one table on the GPU for both.
         if let Some(same) = self.measurements.iter().find(|(k, _)| k.0 == key.0) {

@@ -70,13 +70,15 @@ pub struct MeasuredMaterial {
 }
 
 impl MeasuredMaterial {
-    /// Opens the measurement `source` (a path relative to `base`, or `nbrdf:NAME` from the
-    /// embedded proxies) and, for a MERL-grid table without a `fit`, fits it
-    /// ([`FitConfig::isotropic`]). A `fit` given with a `.bsdf` is not needed and not kept.
+    /// Opens the measurement `source` (a path relative to `base`, or `nbrdf:NAME` from
+    /// `nbrdf`, else `$FACET_NBRDF`, else the embedded proxies) and, for a MERL-grid table
+    /// without a `fit`, fits it ([`FitConfig::SINGLE_LAYER`]). A `fit` given with a `.bsdf` is
+    /// not needed and not kept.
     pub fn open(
         source: &str,
         base: &Path,
         fit: Option<Arc<FittedMaterial>>,
+        nbrdf: Option<&Path>,
     ) -> Result<Self, RenderError> {
         let spec = match InputSpec::parse(source) {
             InputSpec::Fit(p) => InputSpec::Fit(base.join(p)),
@@ -85,7 +87,9 @@ impl MeasuredMaterial {
             other => other,
         };
         let path = spec.path().map(Path::to_path_buf);
-        let named = path.clone().unwrap_or_else(|| PathBuf::from(source));
+        // A name (not a file) is shown escaped: it may hold terminal escapes.
+        let named =
+            (path.clone()).unwrap_or_else(|| PathBuf::from(source.escape_debug().to_string()));
         // An error that names the file already (the readers' do) is not prefixed twice.
         let fail = |e: &dyn std::fmt::Display| {
             let message = e.to_string();
@@ -103,7 +107,7 @@ impl MeasuredMaterial {
         }
         let mut library: Option<NbrdfLibrary> = None;
         let src = spec
-            .open(None, &mut library, Residence::Read)
+            .open(nbrdf, &mut library, Residence::Read)
             .map_err(|e| fail(&e))?;
         let data = Measurement::of(&spec, &*src).map_err(|e| fail(&e))?;
         let fit = match fit {
