@@ -390,6 +390,18 @@ fn damaged_bsdfs() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             patched(&good, "ndf", |_, x| -x),
             "`ndf` has no positive mass",
         ),
+        // Values a fit refuses on its grid (f cos θ past 1e12) are refused by the reader the
+        // renderer shares: rendered as a measured material they made infinite pixels.
+        (
+            "huge",
+            patched(&good, "rgb", |i, x| if i == 4 { 3e38 } else { x }),
+            "`rgb` holds 3.000e38 at 4",
+        ),
+        (
+            "huge-ndf",
+            patched(&good, "ndf", |_, _| 3e38),
+            "`ndf` holds 3.000e38 at 0",
+        ),
     ]
 }
 

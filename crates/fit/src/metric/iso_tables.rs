@@ -10,10 +10,7 @@ use crate::numerics::interp::fill_missing;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-/// The largest x = f_r cos θi a source may give on the MERL grid: a GGX mirror of α = 10⁻⁴ at
-/// its peak stays below 10⁹; beyond 10¹² the f32 sums over 1.5·10⁶ samples of the Fresnel
-/// average and the metric would overflow, so such values are refused with the value named.
-pub const MAX_X: f32 = 1e12;
+pub use crate::model::brdf::MAX_X;
 
 /// An isotropic microfacet model reduced to tables over the grid's bins.
 #[derive(Clone)]

@@ -37,7 +37,7 @@ pub mod tensor_file;
 pub mod warp2d;
 
 use crate::error::FitError;
-use crate::model::brdf::Brdf;
+use crate::model::brdf::{Brdf, MAX_X};
 use crate::model::rgb::Rgb;
 use crate::sources::rgl::cie::SpectrumToRgb;
 use crate::sources::rgl::tensor_file::TensorFile;
@@ -338,6 +338,16 @@ impl RglBsdf {
 /// negative values (noise, colours out of gamut) are kept: evaluation clips them at zero, as
 /// brdf-loader does with `POWITACQ_CLIP_RGB`; Mitsuba 3's `measured` plugin reads any values.
 fn check_values(tf: &TensorFile, field: &str, data: &[f64], jacobian: bool) -> Result<(), String> {
+    // f cos θo is data (times D / 4σ): no value past what the fit's grid takes ([`MAX_X`]),
+    // which the renderer, reading the file without the fit's grid, would turn into infinities.
+    let bounded = |field: &str, v: &[f64]| match v.iter().position(|x| x.abs() > f64::from(MAX_X)) {
+        None => Ok(()),
+        Some(i) => Err(format!(
+            "`{field}` holds {:.3e} at {i}: past {MAX_X:e}, the largest f cos θ a source may give",
+            v[i]
+        )),
+    };
+    bounded(field, data)?;
     let mass = |field: &str, v: &[f64]| {
         let sum: f64 = v.iter().sum();
         if sum > 0.0 {
@@ -353,7 +363,9 @@ fn check_values(tf: &TensorFile, field: &str, data: &[f64], jacobian: bool) -> R
     if !jacobian {
         return Ok(());
     }
-    mass("ndf", &tf.floats("ndf")?.0)?;
+    let ndf = tf.floats("ndf")?.0;
+    bounded("ndf", &ndf)?;
+    mass("ndf", &ndf)?;
     let (sigma, shape) = tf.floats("sigma")?;
     match sigma.iter().position(|&v| !(v > 0.0)) {
         None => Ok(()),
