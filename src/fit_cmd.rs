@@ -252,7 +252,7 @@ pub struct FitArgs {
     #[arg(long, value_enum, default_value = "table")]
     fresnel: FresnelArg,
     /// When to search a clear coat over a base (η 1.5; its α, its weight and the base under it
-    /// fitted; 0.5–1.5 s), kept where the coated sphere looks closer to the data (ΔE2000 under
+    /// fitted; 2–4 s), kept where the coated sphere looks closer to the data (ΔE2000 under
     /// the report's point light, at least 0.1 lower): `auto` (the default) where the single
     /// layer's sphere differs from the data by more than ΔE 0.9, `always`, or `off`. The
     /// single layer's models are written either way; a coat kept is the fit JSON's `coat`,

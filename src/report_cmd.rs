@@ -59,7 +59,7 @@ pub struct ReportArgs {
     #[arg(long, default_value_t = 90, value_parser = crate::args::resolution)]
     fit_resolution: usize,
     /// When the fits search a clear coat, as `facet fit --coat`: `auto` (the default) where
-    /// the single layer's sphere differs from the data by more than ΔE2000 0.9 (0.5–1.5 s more
+    /// the single layer's sphere differs from the data by more than ΔE2000 0.9 (2–4 s more
     /// for such a material on two cores), `always`, or `off`; kept where it looks better. A
     /// fit that keeps a coat gets one more sphere, its coated model, beside the single layer's
     /// three; a fit JSON that kept one shows it whatever this says.

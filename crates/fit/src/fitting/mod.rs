@@ -105,7 +105,7 @@ pub struct FitConfig {
 
 /// When a fit searches a clear coat over a base ([`coat`]); wherever it is searched, it is
 /// kept where it makes the look better ([`coat::CoatCandidate::keeps`]). A search costs about
-/// 40 cheap fits of the base (0.5–1.5 s on 2 cores), so by default it runs only where the
+/// 40 cheap fits of the base (2–4 s on 2 cores), so by default it runs only where the
 /// single layer looks off.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum CoatSearch {
