@@ -614,6 +614,7 @@ fn measured_extras_and_overrides_name_a_measurement() {
     MerlTable::sample(&ggx)
         .write(&dir.join("m.binary"))
         .unwrap();
+
     let path = facet_scene(
         &dir,
         json!({"model": "measured", "source": "m.binary", "fit": "fits/m.json"}),
@@ -697,7 +698,15 @@ fn measured_extras_and_overrides_name_a_measurement() {
     .unwrap();
     let all: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&embedded).unwrap();
     let lib = dir.join("lib.json");
-    std::fs::write(&lib, json!({"only-here": all["alum-bronze"]}).to_string()).unwrap();
+    // And a network that passes the proxy reader (its output below exp's range) but gives
+    // f = e¹⁰⁰: past what a source may give (f cos θi 1e12), refused with a fit beside it too,
+    // as `facet fit` refuses it (rendered unchecked, it made infinite pixels).
+    let mut bright = all["alum-bronze"].clone();
+    for b in bright["b3"].as_array_mut().unwrap() {
+        *b = json!(b.as_f64().unwrap() + 100.0);
+    }
+    let proxies = json!({"only-here": all["alum-bronze"], "too-bright": bright});
+    std::fs::write(&lib, proxies.to_string()).unwrap();
     let path = facet_scene(
         &dir,
         json!({"model": "measured", "source": "nbrdf:only-here"}),

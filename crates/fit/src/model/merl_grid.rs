@@ -7,6 +7,7 @@
 //! Sample (i, j, k) sits at the bin's lower edge: θh = (i/90)² π/2, θd = j/90 · π/2, φd = k/180 · π.
 
 use crate::io::mapped_file::MappedFile;
+use crate::model::brdf::MAX_X;
 use crate::model::geometry::{HalfDiff, to_half_diff};
 use crate::model::rgb::Rgb;
 use glam::DVec3;
@@ -288,6 +289,25 @@ impl MerlTable {
                 raw[c * SAMPLES + s] = (v * f).to_le_bytes();
             }
         }
+    }
+
+    /// The first valid sample whose x = f_r cos θi is not finite or beyond ±[`MAX_X`] (θi of
+    /// its bin's incoming direction): (flat sample, x). The fitter refuses such a source on its
+    /// grid; a renderer reading the table checks it here.
+    pub fn first_beyond_max_x(&self) -> Option<(usize, f64)> {
+        (0..SAMPLES)
+            .into_par_iter()
+            .find_first(|&s| self.x_beyond(s).is_some())
+            .map(|s| (s, self.x_beyond(s).expect("found above")))
+    }
+
+    fn x_beyond(&self, s: usize) -> Option<f64> {
+        let v = self.value_at(s)?;
+        let (i, j, k) = bin_of(s);
+        let cos_i = bin_directions(i, j, k).0.z.max(0.0);
+        v.iter()
+            .map(|f| f * cos_i)
+            .find(|x| !(x.abs() <= f64::from(MAX_X)))
     }
 
     /// The number of samples that hold no valid value.

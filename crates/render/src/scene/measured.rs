@@ -11,8 +11,9 @@
 //!   `measured` plugin does; they need no fit.
 
 use crate::error::RenderError;
+use facet_fit::model::brdf::MAX_X;
 use facet_fit::model::material::FittedMaterial;
-use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::model::merl_grid::{MerlTable, bin_of};
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::rgl::RglBsdf;
 use facet_fit::sources::{InputSpec, Residence};
@@ -42,7 +43,17 @@ impl Measurement {
                 "an anisotropic source has no MERL table (the MERL grid is isotropic)".into(),
             );
         }
-        Ok(Measurement::Merl(src.merl_table().filled()))
+        // The fitter's bound on what a source may give, checked here too: a table rendered
+        // with a fit given beside it is never fitted.
+        let table = src.merl_table();
+        if let Some((s, x)) = table.first_beyond_max_x() {
+            let (i, j, k) = bin_of(s);
+            return Err(format!(
+                "f cos θi = {x:.3e} at bin ({i}, {j}, {k}): past {MAX_X:e}, the largest a source \
+                 may give (`facet fit` refuses it too)"
+            ));
+        }
+        Ok(Measurement::Merl(table.filled()))
     }
 }
 
