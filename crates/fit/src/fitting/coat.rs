@@ -448,8 +448,8 @@ pub fn search(scorer: &Scorer) -> Coat {
     by_alpha(scorer, coat, (coat.alpha / 1.1, coat.alpha * 1.1), 0.0004)
 }
 
-/// `coat` with its α by Brent's method in ln α on [lo, hi], to `tol` times |ln α| (0.003:
-/// about 1 % of α).
+/// `coat` with its α by Brent's method in ln α on [lo, hi], to `tol` times |ln α| (0.01: about
+/// 3 % of α at 0.05; 0.0004: about 0.1 %).
 fn by_alpha(scorer: &Scorer, coat: Coat, (lo, hi): (f64, f64), tol: f64) -> Coat {
     let score = |x: f64| {
         scorer.score(Coat {
