@@ -97,7 +97,13 @@ fn split_preview_shows_the_measurement_beside_the_model() {
     let src = facet_fit::sources::nbrdf::NbrdfLibrary::embedded()
         .get("gold-metallic-paint")
         .unwrap();
-    let fit = facet_fit::fit_material(&src, "gold", &facet_fit::FitConfig::isotropic()).unwrap();
+    // The single layer: a coated model is rebuilt on an edit of α, not written in place (the
+    // default fit keeps a coat on this paint).
+    let cfg = facet_fit::FitConfig {
+        coat: facet_fit::fitting::CoatSearch::Off,
+        ..facet_fit::FitConfig::isotropic()
+    };
+    let fit = facet_fit::fit_material(&src, "gold", &cfg).unwrap();
     let measurement = facet_render::scene::Measurement::of(&spec, &src).unwrap();
     let mut app = ViewerApp::with_default_material().unwrap();
     assert!(
