@@ -10,7 +10,7 @@ use crate::numerics::interp::fill_missing;
 use glam::DVec3;
 use std::f64::consts::PI;
 
-pub use crate::model::brdf::MAX_X;
+pub use crate::model::merl_grid::MAX_X;
 
 /// An isotropic microfacet model reduced to tables over the grid's bins.
 #[derive(Clone)]

@@ -5,12 +5,6 @@ use crate::model::rgb::Rgb;
 use glam::DVec3;
 use std::borrow::Cow;
 
-/// The largest x = f_r cos θi a source may give: a GGX mirror of α = 10⁻⁴ at its peak stays
-/// below 10⁹; beyond 10¹² the f32 sums over the MERL grid's 1.5·10⁶ samples (the Fresnel
-/// average, the metric) would overflow, and the renderer's f32 products with radiance too, so
-/// the fitter and the renderer's readers refuse such values with the value named.
-pub const MAX_X: f32 = 1e12;
-
 /// A BRDF: measured, neural, analytic or fitted.
 ///
 /// `eval` returns f_r without the cosine, or `None` where the source has no sample (a

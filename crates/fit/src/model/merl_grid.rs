@@ -7,7 +7,6 @@
 //! Sample (i, j, k) sits at the bin's lower edge: θh = (i/90)² π/2, θd = j/90 · π/2, φd = k/180 · π.
 
 use crate::io::mapped_file::MappedFile;
-use crate::model::brdf::MAX_X;
 use crate::model::geometry::{HalfDiff, to_half_diff};
 use crate::model::rgb::Rgb;
 use glam::DVec3;
@@ -22,6 +21,12 @@ pub const THETA_D_RES: usize = 90;
 pub const PHI_D_RES: usize = 180;
 /// Samples per channel.
 pub const SAMPLES: usize = THETA_H_RES * THETA_D_RES * PHI_D_RES;
+
+/// The largest x = f_r cos θi a source may give: a GGX mirror of α = 10⁻⁴ at its peak stays
+/// below 10⁹; beyond 10¹² the f32 sums over the MERL grid's 1.5·10⁶ samples (the Fresnel
+/// average, the metric) would overflow, and the renderer's f32 products with radiance too, so
+/// the fitter and the renderer's readers refuse such values with the value named.
+pub const MAX_X: f32 = 1e12;
 /// f_r = stored value × `SCALE[channel]`.
 pub const SCALE: Rgb = [1.0 / 1500.0, 1.15 / 1500.0, 1.66 / 1500.0];
 /// Bytes of a MERL file's header (three `i32` dimensions) before the values.

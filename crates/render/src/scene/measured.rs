@@ -11,9 +11,9 @@
 //!   `measured` plugin does; they need no fit.
 
 use crate::error::RenderError;
-use facet_fit::model::brdf::MAX_X;
+
 use facet_fit::model::material::FittedMaterial;
-use facet_fit::model::merl_grid::{MerlTable, bin_of};
+use facet_fit::model::merl_grid::{MAX_X, MerlTable, bin_of};
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::rgl::RglBsdf;
 use facet_fit::sources::{InputSpec, Residence};

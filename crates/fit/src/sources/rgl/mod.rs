@@ -37,7 +37,8 @@ pub mod tensor_file;
 pub mod warp2d;
 
 use crate::error::FitError;
-use crate::model::brdf::{Brdf, MAX_X};
+use crate::model::brdf::Brdf;
+use crate::model::merl_grid::MAX_X;
 use crate::model::rgb::Rgb;
 use crate::sources::rgl::cie::SpectrumToRgb;
 use crate::sources::rgl::tensor_file::TensorFile;
