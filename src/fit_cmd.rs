@@ -107,7 +107,10 @@ fn open_gpu_during<T>(
 }
 
 /// A source opened, and the milliseconds it took.
-type Opened = (Result<Box<dyn facet_fit::Brdf>, facet_fit::FitError>, f64);
+type Opened = (
+    Result<Box<dyn facet_fit::Brdf + Send>, facet_fit::FitError>,
+    f64,
+);
 
 fn open_timed(
     input: &InputSpec,

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use facet_fit::io::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::camera::CameraFrame;
-use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, load_gltf};
+use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, Scene, load_gltf};
 use facet_render::shard::{PixelKind, ShardRecord};
 use facet_render::{
     ImageConfig, Integrator, LightSelection, RenderConfig, ResourceConfig, SampleConfig,
@@ -17,6 +17,7 @@ use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 #[derive(Args, Clone, Debug)]
 #[command(allow_negative_numbers = true)]
@@ -67,7 +68,8 @@ pub struct RenderArgs {
     pub nbrdf: Option<PathBuf>,
     /// Give the glTF material NAME a fit or a measurement (repeatable): NAME=FILE. A fit
     /// `.json` is rendered by its model; a measurement (a MERL `.binary`, an RGL `.bsdf`,
-    /// `nbrdf:NAME`) is rendered as measured, a MERL-grid one sampled by a fit made on load.
+    /// `nbrdf:NAME`) is rendered as measured, a MERL-grid one sampled by a fit made before the
+    /// render (shown with its time).
     #[arg(long = "material", value_name = "NAME=FILE")]
     pub materials: Vec<String>,
     /// Paths in flight at once, 64 to 2^24.
@@ -200,7 +202,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         materials,
         nbrdf: args.nbrdf.clone(),
     };
-    let scene = load_gltf(&args.scene, &options)?;
+    let mut scene = load_gltf(&args.scene, &options)?;
     // Every file the scene read (its buffers, textures and fits), the scene, the
     // environment and the proxy file `nbrdf:` resolves in: no output may replace one of them,
     // and the shards' digest reads them all.
@@ -270,6 +272,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         ..ResourceConfig::standard()
     };
     let digest = digest::digest(args, &inputs)?;
+    fit_measured(&mut scene)?;
     Ok(Job {
         scene,
         environment,
@@ -401,4 +404,21 @@ pub fn run(args: &RenderArgs) -> Result<ExitCode> {
     let timings = render_job(&gpu, &job, &args.out, args.exposure)?;
     print_timings(&timings, job.scene.indices.len());
     Ok(ExitCode::SUCCESS)
+}
+
+/// Fits the sampling NDF of each MERL-grid measurement the scene names without a fit, once per
+/// source, as a step of its own shown with its time (loading never fits). The fit only samples
+/// the measurement: a single layer, no coat searched.
+fn fit_measured(scene: &mut Scene) -> Result<()> {
+    scene.fit_measured(|source, brdf| {
+        let t = Instant::now();
+        let fit = facet_fit::fit_material(brdf, source, &facet_fit::FitConfig::SINGLE_LAYER);
+        println!(
+            "fitted the sampling NDF of {} (no fit named beside it) in {:.2} s",
+            source.escape_debug(),
+            t.elapsed().as_secs_f64()
+        );
+        fit
+    })?;
+    Ok(())
 }

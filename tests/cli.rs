@@ -524,6 +524,40 @@ fn render_demo_scene_writes_png_and_exr() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A measurement named without a fit is fitted by `facet render` in a step of its own, shown
+/// with its time, once however many materials name it (the renderer's loader never fits).
+#[test]
+fn render_fits_a_measurement_named_without_a_fit_in_a_visible_step() {
+    if facet_gpu::gpu_for_tests("render_fits_a_measurement_named_without_a_fit").is_none() {
+        return;
+    }
+    let dir = common::scratch("cli_render_fits");
+    let out = dir.join("measured.png");
+    let demo = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let (ok, stdout, err) = facet(&[
+        "render",
+        demo,
+        "--material",
+        "ggx=nbrdf:alum-bronze",
+        "--material",
+        "tabulated=nbrdf:alum-bronze",
+        "--env-color",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "9",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}\n{err}");
+    let step = "fitted the sampling NDF of nbrdf:alum-bronze (no fit named beside it) in ";
+    assert_eq!(stdout.matches(step).count(), 1, "{stdout}");
+    assert!(out.exists());
+}
+
 // ---- features that must visibly act -------------------------------------------------------
 
 #[path = "../crates/render/tests/common/mod.rs"]

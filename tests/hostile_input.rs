@@ -372,7 +372,7 @@ fn outputs_stay_inside_out_and_never_replace_an_input() {
     let climbing = root.join("climbing.json");
     std::fs::write(&climbing, serde_json::to_string(&record).unwrap()).unwrap();
     let lib: serde_json::Value =
-        serde_json::from_str(include_str!("../crates/fit/data/nbrdf/merl100.json")).unwrap();
+        serde_json::from_str(include_str!("../crates/brdf/data/nbrdf/merl100.json")).unwrap();
     let evil = serde_json::json!({ "/tmp/evil": lib["alum-bronze"], "..": lib["alum-bronze"] });
     let nbrdf = root.join("evil-lib.json");
     std::fs::write(&nbrdf, evil.to_string()).unwrap();

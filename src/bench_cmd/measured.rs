@@ -35,6 +35,7 @@ fn materials() -> Result<[(&'static str, Material); 3]> {
             path: None,
             data: Arc::new(data),
             fit: Some(fit.clone()),
+            unfitted: None,
         }),
         ..Default::default()
     };

@@ -135,6 +135,7 @@ pub fn material(
                 path: None,
                 data: data.clone(),
                 fit: Some(fit.clone()),
+                unfitted: None,
             }),
             ..Default::default()
         },

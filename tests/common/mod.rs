@@ -9,7 +9,7 @@ use std::process::Command;
 
 /// The neural proxies' file inside the repository (the one facet-fit embeds).
 pub fn nbrdf_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("crates/fit/data/nbrdf/merl100.json")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("crates/brdf/data/nbrdf/merl100.json")
 }
 
 /// A scratch folder under target/ for one test.

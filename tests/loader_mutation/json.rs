@@ -19,7 +19,7 @@ pub fn check_fit(path: &Path, bytes: &[u8]) -> Result<bool, String> {
 
 /// The first `n` networks of the embedded MERL-100 file, as a JSON object.
 pub fn nbrdf_entries(n: usize) -> Vec<u8> {
-    let text = std::fs::read_to_string(repo("crates/fit/data/nbrdf/merl100.json")).unwrap();
+    let text = std::fs::read_to_string(repo("crates/brdf/data/nbrdf/merl100.json")).unwrap();
     let all: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&text).unwrap();
     let some: serde_json::Map<String, serde_json::Value> = all.into_iter().take(n).collect();
     serde_json::to_vec(&some).unwrap()

@@ -23,7 +23,9 @@
 //!
 //! ## Layers
 //!
-//! Each folder imports only the folders above it in this list (and [`error`]):
+//! Each folder imports only the folders above it in this list (and [`error`]). The first four
+//! are facet-brdf's (re-exported here under their old paths), which the renderer depends on
+//! without the fitter:
 //!
 //! | layer | what it holds |
 //! |---|---|
@@ -56,11 +58,10 @@ pub mod extract;
 pub mod fitting;
 #[cfg(feature = "gpu")]
 pub mod gpu;
-pub mod io;
 pub mod metric;
-pub mod model;
-pub mod numerics;
-pub mod sources;
+
+// The layers below the fit, in facet-brdf, under the paths they have always had here.
+pub use facet_brdf::{io, model, numerics, sources};
 
 pub use error::FitError;
 pub use fitting::{FitConfig, fit_material};

@@ -17,8 +17,8 @@
 
 use crate::lobe_rule::LobeRule;
 use bytemuck::{Pod, Zeroable};
-use facet_fit::model::microfacet::Ndf;
-use facet_fit::numerics::quadrature::gauss_legendre;
+use facet_brdf::model::microfacet::Ndf;
+use facet_brdf::numerics::quadrature::gauss_legendre;
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, PI};
 

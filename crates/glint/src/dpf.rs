@@ -11,7 +11,7 @@
 
 use crate::cone_rule::{ConeRule, LevelRule, Ring, lobe_width};
 use crate::lobe_rule::LobeRule;
-use facet_fit::model::microfacet::Ndf;
+use facet_brdf::model::microfacet::Ndf;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::{FRAC_PI_2, PI};

@@ -8,8 +8,8 @@
 use crate::dpf::cone_solid_angle;
 use crate::flakes::{FlakeField, Footprint, direction_coords};
 use crate::lit::{LitKey, blend_cells};
-use facet_fit::model::microfacet::{MicrofacetBrdf, correlation, g2};
-use facet_fit::model::rgb::Rgb;
+use facet_brdf::model::microfacet::{MicrofacetBrdf, correlation, g2};
+use facet_brdf::model::rgb::Rgb;
 use glam::{DVec2, DVec3};
 
 /// How glints are counted.
@@ -100,7 +100,7 @@ pub fn glint_eval(
     if count == 0.0 {
         return diffuse;
     }
-    let phi = facet_fit::model::geometry::azimuth_between(wi, wo);
+    let phi = facet_brdf::model::geometry::azimuth_between(wi, wo);
     let g = g2(model.ndf.lambda(wi), model.ndf.lambda(wo), correlation(phi));
     let f = model.fresnel.eval(wi.dot(h));
     let scale = g * h.dot(wo) * count

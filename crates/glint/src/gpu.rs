@@ -6,8 +6,8 @@ use crate::dpf::{DpfConfig, DpfPyramid, DpfTable, LEVELS_DEG};
 use crate::lobe_rule::{LOBE_EPS, TAIL_START, TOUCH_MERGE};
 use crate::tags::NdfTag;
 use bytemuck::{Pod, Zeroable};
-use facet_fit::model::geometry::spherical;
-use facet_fit::model::microfacet::Ndf;
+use facet_brdf::model::geometry::spherical;
+use facet_brdf::model::microfacet::Ndf;
 use facet_gpu::{Gpu, GpuError, buffer, dispatch, shader};
 
 /// Uniforms of the build (WGSL `Params`).
@@ -466,8 +466,8 @@ impl GlintEvaluator {
         gpu: &Gpu,
         field: &crate::flakes::FlakeField,
         cfg: &crate::glint_brdf::GlintConfig,
-        ndf: &facet_fit::model::microfacet::AnalyticNdf,
-        fresnel: &facet_fit::model::fresnel::FresnelTable,
+        ndf: &facet_brdf::model::microfacet::AnalyticNdf,
+        fresnel: &facet_brdf::model::fresnel::FresnelTable,
         dpf: &GpuDpf,
         queries: &[GlintEvalQuery],
     ) -> Result<Vec<[f64; 3]>, GpuError> {

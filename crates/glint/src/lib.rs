@@ -12,7 +12,7 @@
 //! it.
 //!
 //! ```
-//! use facet_fit::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
+//! use facet_brdf::model::microfacet::{AnalyticNdf, Ndf, NdfKind};
 //! use facet_glint::dpf::{dpf, query_directions};
 //!
 //! let ndf = Ndf::Analytic(AnalyticNdf::isotropic(NdfKind::Beckmann, 0.1));

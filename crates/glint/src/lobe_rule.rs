@@ -17,7 +17,7 @@
 //! cone; each ring gets `angular` nodes over its arc (`tail_angular` beyond 4w). The
 //! cost per cell depends on the lobe, not on γ.
 
-use facet_fit::numerics::quadrature::gauss_legendre;
+use facet_brdf::numerics::quadrature::gauss_legendre;
 use glam::DVec3;
 use std::f64::consts::PI;
 

@@ -8,7 +8,7 @@
 //! which adds the tabulated NDF, is declared here, where both GPU users (this crate and
 //! facet-render) see it.
 
-use facet_fit::model::microfacet::{Ndf, NdfKind};
+use facet_brdf::model::microfacet::{Ndf, NdfKind};
 use facet_gpu::tags;
 pub use facet_gpu::tags::TagSet;
 

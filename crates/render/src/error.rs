@@ -59,8 +59,8 @@ impl RenderError {
     }
 }
 
-impl From<facet_fit::io::input::InputError> for RenderError {
-    fn from(e: facet_fit::io::input::InputError) -> Self {
+impl From<facet_brdf::io::input::InputError> for RenderError {
+    fn from(e: facet_brdf::io::input::InputError) -> Self {
         RenderError::Input {
             path: e.path,
             message: e.problem,

@@ -163,7 +163,7 @@ fn encode_srgb(v: f32) -> u8 {
 }
 
 /// Writes through a temporary file beside `path` and renames it
-/// ([`facet_fit::io::output::write_atomically`]), so a failed write never leaves a truncated
+/// ([`facet_brdf::io::output::write_atomically`]), so a failed write never leaves a truncated
 /// file where a good one was; creates the folder first.
 fn write_atomically(
     path: &Path,
@@ -179,6 +179,6 @@ fn write_atomically(
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| err(e.to_string()))?;
     }
-    facet_fit::io::output::write_atomically(path, |tmp| write(tmp).map_err(std::io::Error::other))
+    facet_brdf::io::output::write_atomically(path, |tmp| write(tmp).map_err(std::io::Error::other))
         .map_err(|e| err(e.to_string()))
 }

@@ -68,7 +68,7 @@ pub enum StageClock {
 /// tabulated, whether f is a measured MERL table (sampled by its fit's tabulated NDF), and the
 /// MERL grid's sizes.
 fn microfacet_constants(q: Queue) -> [(&'static str, f64); 6] {
-    use facet_fit::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES};
+    use facet_brdf::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES};
     let flag = |b: bool| b as u32 as f64;
     [
         ("Q_SHADE", q.index() as f64),

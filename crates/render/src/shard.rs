@@ -9,7 +9,7 @@
 
 use crate::error::RenderError;
 use crate::film::Image;
-use facet_fit::io::input::{self, Cap};
+use facet_brdf::io::input::{self, Cap};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
 use std::io::BufReader;

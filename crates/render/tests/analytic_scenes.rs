@@ -1092,17 +1092,24 @@ fn coated_sphere_in_a_white_furnace_renders_its_albedo() {
 
 // ---- measured materials ----------------------------------------------------------------------
 
-/// The embedded MERL-100 proxy `name` as a measured material (its fit made on load), and the
-/// CPU lookup of its filled table with the channels as stored and reversed (a broken renderer
-/// that reads the interleaved table backwards).
+/// The embedded MERL-100 proxy `name` as a measured material (its sampling fit made after
+/// loading, as `facet render` makes it), and the CPU lookup of its filled table with the
+/// channels as stored and reversed (a broken renderer that reads the interleaved table
+/// backwards).
 fn measured_proxy(name: &str) -> (Material, MerlTable) {
-    let m = MeasuredMaterial::open(
+    let mut m = MeasuredMaterial::open(
         &format!("nbrdf:{name}"),
         std::path::Path::new(""),
         None,
         None,
     )
     .unwrap_or_else(|e| panic!("{e}"));
+    let src = m
+        .unfitted
+        .take()
+        .expect("loading leaves the fit to the caller");
+    let fit = facet_fit::fit_material(&*src, &m.source, &facet_fit::FitConfig::SINGLE_LAYER);
+    m.fit = Some(std::sync::Arc::new(fit.unwrap_or_else(|e| panic!("{e}"))));
     let Measurement::Merl(table) = &*m.data else {
         panic!("a proxy is a MERL-grid table");
     };
@@ -1286,6 +1293,7 @@ fn rgl_material(spec: &str) -> (Material, Arc<RglBsdf>, MicrofacetBrdf) {
                 RglBsdf::parse("ggx", bytes).unwrap(),
             ))),
             fit: None,
+            unfitted: None,
         }),
         ..Default::default()
     };

@@ -602,7 +602,8 @@ fn regenerate_demo_assets() {
 
 /// `model: "measured"` renders the measurement named by `source` (relative to the glTF), with
 /// the optional `fit` as its sampling fit; `--material NAME=FILE` naming a measurement makes a
-/// material measured (its fit made on load), sharing the table with the other; the files are
+/// material measured (its fit made by the caller after loading, never on load), sharing the
+/// table with the other; the files are
 /// the scene's inputs; what cannot work is an error naming the material.
 #[test]
 fn measured_extras_and_overrides_name_a_measurement() {
@@ -623,7 +624,16 @@ fn measured_extras_and_overrides_name_a_measurement() {
         materials: vec![("plain".into(), dir.join("m.binary"))],
         ..Default::default()
     };
-    let s = load_gltf(&path, &o).unwrap();
+    let mut s = load_gltf(&path, &o).unwrap();
+    // Loading never fits: the measurement named without a fit waits for the caller's step,
+    // which fits it once and leaves the one with a fit beside it alone.
+    let plain_source = dir.join("m.binary").display().to_string();
+    assert_eq!(s.unfitted_measurements(), [plain_source.as_str()]);
+    let fitted = s.fit_measured(|source, brdf| {
+        facet_fit::fit_material(brdf, source, &facet_fit::FitConfig::SINGLE_LAYER)
+    });
+    assert_eq!(fitted.unwrap(), 1);
+    assert!(s.unfitted_measurements().is_empty());
     let (metal, plain) = (&s.materials[0], &s.materials[1]);
     assert!(metal.facet.is_none() && plain.facet.is_none());
     let (a, b) = (
@@ -637,7 +647,7 @@ fn measured_extras_and_overrides_name_a_measurement() {
     assert_ne!(
         b.fit.as_ref().unwrap().record.source,
         "test ggx 0.3",
-        "fitted on load"
+        "fitted by the caller"
     );
     assert!(
         std::sync::Arc::ptr_eq(&a.data, &b.data),
@@ -693,7 +703,7 @@ fn measured_extras_and_overrides_name_a_measurement() {
     // `nbrdf:` resolves in the proxy file the options name (`facet render --nbrdf`), as every
     // command resolves it: a name only that file holds.
     let embedded = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fit/data/nbrdf/merl100.json"),
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../brdf/data/nbrdf/merl100.json"),
     )
     .unwrap();
     let all: serde_json::Map<String, serde_json::Value> = serde_json::from_str(&embedded).unwrap();

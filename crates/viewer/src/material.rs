@@ -323,6 +323,7 @@ impl EditedMaterial {
                 path: None,
                 data,
                 fit: Some(self.base.clone()),
+                unfitted: None,
             }),
             ..Material::default()
         })

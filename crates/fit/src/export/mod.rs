@@ -39,6 +39,7 @@ mod pbrt;
 pub mod rgl;
 
 use crate::error::FitError;
+use crate::fitting::fresnel_fit::FitFresnelCurves;
 use crate::model::fresnel_curves::{FitQuality, FresnelChoice, FresnelFits};
 use crate::model::material::{FitRecord, FittedMaterial, ModelChoice, ParamRecord};
 use crate::model::microfacet::NdfKind;

@@ -336,7 +336,7 @@ mod tests {
         let mut checked = 0;
         for (i, j) in [(3, 5), (10, 12), (20, 2), (7, 20)] {
             let s = [i as f64 / 23.0, j as f64 / 23.0];
-            let (u_m, _) = file.vndf.sample(s, &[0.0, ti]);
+            let (u_m, _) = file.vndf().sample(s, &[0.0, ti]);
             let m = crate::model::geometry::spherical(u2theta(u_m[0]), u2phi(u_m[1]) + 0.7);
             let wo = 2.0 * m.dot(wi) * m - wi;
             if wo.z <= 0.0 {

@@ -14,6 +14,7 @@
 //! single layer's.
 
 use crate::error::FitError;
+use crate::fitting::optim::brent;
 use crate::fitting::{CoatSearch, FitConfig, Models};
 use crate::metric::grid::{GridSamples, error_metric};
 use crate::metric::look::SphereScene;
@@ -31,7 +32,6 @@ use crate::model::microfacet::{
     AnalyticNdf, MicrofacetBrdf, NdfKind, correlation, g2, lambda_from_alpha_tan,
 };
 use crate::model::rgb::Rgb;
-use crate::numerics::optim::brent;
 use crate::sources::merl::MerlBrdf;
 use glam::DVec3;
 use rayon::prelude::*;

@@ -179,7 +179,7 @@ fn separation_search(error: impl Fn(f64) -> f64, start: f64, hi: f64) -> f64 {
         e
     };
     let brent =
-        |lo: f64, start: f64, hi: f64| crate::numerics::optim::brent_to(error, lo, start, hi, tol);
+        |lo: f64, start: f64, hi: f64| crate::fitting::optim::brent_to(error, lo, start, hi, tol);
     let (step, inside) = (2.0 * tol(0.0), hi - 2.0 * tol(hi));
     let s0 = start.clamp(step, hi);
     if error(0.0) <= error(s0) {

@@ -8,19 +8,25 @@
 //! alternating Brent steps). The record keeps every fit with its RMS distance to the
 //! table and its error in Facet's metric, and names the one the renderer uses (`used`).
 
+use crate::fitting::optim::brent;
 use crate::model::fresnel::{Fresnel, FresnelTable, conductor, dielectric};
 use crate::model::fresnel_curves::{FitQuality, FresnelChoice, FresnelFits};
 use crate::model::rgb::Rgb;
-use crate::numerics::optim::brent;
 use rayon::prelude::*;
 
 /// The largest θd fitted, degrees.
 pub const MAX_THETA_D: f64 = 80.0;
 
-impl FresnelFits {
+/// The fitting of the record's Fresnel curves ([`FresnelFits`] is facet-brdf's, read by the
+/// renderer; fitting it is the fitter's).
+pub trait FitFresnelCurves: Sized {
     /// The three fits of `table`; `errors` gives the metric's errors of the candidate Fresnels
     /// (Schlick, dielectric, conductor), all three at once so that one pass can measure them.
-    pub fn of(table: &FresnelTable, errors: impl FnOnce(&[Fresnel; 3]) -> [f64; 3]) -> Self {
+    fn of(table: &FresnelTable, errors: impl FnOnce(&[Fresnel; 3]) -> [f64; 3]) -> Self;
+}
+
+impl FitFresnelCurves for FresnelFits {
+    fn of(table: &FresnelTable, errors: impl FnOnce(&[Fresnel; 3]) -> [f64; 3]) -> Self {
         let bins: Vec<(f64, Rgb)> = table
             .theta_d
             .iter()

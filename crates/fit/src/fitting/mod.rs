@@ -14,6 +14,7 @@ pub mod diffuse;
 mod evaluator;
 pub mod fresnel_fit;
 mod grids;
+pub(crate) mod optim;
 pub mod params;
 pub(crate) mod refine;
 mod solve;

@@ -1,6 +1,7 @@
 //! GGX and Beckmann parameters from an extracted NDF: by first absolute slope moments (the
 //! paper) and by least squares in the space of the error metric.
 
+use crate::fitting::optim::{brent_to, nelder_mead};
 use crate::metric::grid::{
     GridSamples, fresnel_and_error, fresnel_average, fresnel_diffuse_and_error, microfacet_error,
     tables_error,
@@ -9,7 +10,6 @@ use crate::metric::iso_tables::IsoTables;
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 use crate::model::tabulated::TabulatedNdf;
-use crate::numerics::optim::{brent_to, nelder_mead};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 /// Bounds of any fitted α.

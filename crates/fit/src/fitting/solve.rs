@@ -3,6 +3,7 @@
 
 use super::{FINAL_IRLS, Fit};
 use crate::error::FitError;
+use crate::fitting::fresnel_fit::FitFresnelCurves;
 use crate::metric::grid::{GridModel, GridSamples, microfacet_errors};
 use crate::model::fresnel::FresnelTable;
 use crate::model::fresnel_curves::FresnelFits;

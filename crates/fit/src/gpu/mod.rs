@@ -96,6 +96,6 @@ impl<'g> GpuFitter<'g> {
 pub(crate) fn gpu_error(name: &str, e: GpuError) -> FitError {
     FitError::Gpu {
         name: name.to_owned(),
-        source: e,
+        source: Box::new(e),
     }
 }

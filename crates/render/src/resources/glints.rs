@@ -6,7 +6,7 @@ use super::{GlintResources, ResourceConfig};
 use crate::error::RenderError;
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::scene::GlintParams;
-use facet_fit::model::microfacet::Ndf;
+use facet_brdf::model::microfacet::Ndf;
 use facet_glint::dpf::{DpfPyramid, LEVELS_DEG};
 use facet_glint::flakes::FlakeField;
 use facet_glint::glint_brdf::GlintConfig;

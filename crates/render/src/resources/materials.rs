@@ -6,11 +6,11 @@ use crate::error::RenderError;
 use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
 use crate::queues::Queue;
 use crate::scene::{GlintParams, Material, MeasuredMaterial, Measurement};
-use facet_fit::model::coat::CoatLayer;
-use facet_fit::model::material::FittedMaterial;
-use facet_fit::model::merl_grid::{MerlTable, SAMPLES};
-use facet_fit::model::microfacet::{MicrofacetBrdf, Ndf, NdfKind};
-use facet_fit::model::tabulated::TabulatedNdf;
+use facet_brdf::model::coat::CoatLayer;
+use facet_brdf::model::material::FittedMaterial;
+use facet_brdf::model::merl_grid::{MerlTable, SAMPLES};
+use facet_brdf::model::microfacet::{MicrofacetBrdf, Ndf, NdfKind};
+use facet_brdf::model::tabulated::TabulatedNdf;
 use facet_glint::tags::NdfTag;
 use std::sync::Arc;
 
@@ -355,8 +355,9 @@ fn plan_measured<'a>(
     let mut plan = match (&*measured.data, &measured.fit) {
         (Measurement::Merl(_), None) => {
             return Err(RenderError::Scene(format!(
-                "material `{}`: the MERL-grid measurement {} has no fit to be sampled by \
-                 (MeasuredMaterial::open fits one)",
+                "material `{}`: the MERL-grid measurement {} has no fit to be sampled by: name \
+                 one beside it (`extras.facet.fit`, or a fit JSON as the source), \
+                 or fit it before building the scene (`Scene::fit_measured`, as `facet render` does)",
                 m.name, measured.source
             )));
         }

@@ -22,7 +22,7 @@ use crate::gpu_types::{GpuLight, GpuMaterial, GpuSceneInfo};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::Queue;
 use crate::scene::{Environment, GlintParams, Measurement, Scene};
-use facet_fit::model::microfacet::Ndf;
+use facet_brdf::model::microfacet::Ndf;
 use facet_glint::dpf::DpfConfig;
 use facet_glint::gpu::GpuDpf;
 use facet_gpu::{Gpu, buffer};

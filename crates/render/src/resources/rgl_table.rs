@@ -18,9 +18,9 @@
 //! (slices are consecutive). An interpolant's marginal and conditional offsets are 0, and a
 //! warp without parameters (`ndf`, `sigma`) has both strides 0.
 
-use facet_fit::Brdf;
-use facet_fit::sources::rgl::RglBsdf;
-use facet_fit::sources::rgl::warp2d::Warp2D;
+use facet_brdf::Brdf;
+use facet_brdf::sources::rgl::RglBsdf;
+use facet_brdf::sources::rgl::warp2d::Warp2D;
 
 /// Words of the block's header.
 pub const RGL_HEADER_WORDS: usize = 8;

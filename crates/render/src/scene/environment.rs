@@ -14,7 +14,7 @@
 
 use crate::error::RenderError;
 use crate::scene::gltf_file::guard;
-use facet_fit::io::input::{self, Cap};
+use facet_brdf::io::input::{self, Cap};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
@@ -85,10 +85,10 @@ fn check_env_size(width: u64, height: u64) -> Result<(), String> {
     Ok(())
 }
 
-/// Rec. 709 luminance ([`facet_fit::model::rgb::LUMINANCE`]) in f32.
+/// Rec. 709 luminance ([`facet_brdf::model::rgb::LUMINANCE`]) in f32.
 pub fn luminance(c: Vec3) -> f32 {
     c.dot(Vec3::from(
-        facet_fit::model::rgb::LUMINANCE.map(|w| w as f32),
+        facet_brdf::model::rgb::LUMINANCE.map(|w| w as f32),
     ))
 }
 
@@ -114,7 +114,7 @@ pub struct EnvironmentMap {
 impl EnvironmentMap {
     /// Reads the first RGB(A) layer of an OpenEXR file (alpha ignored). Texels that are
     /// negative or not finite become 0; the returned strings say how many. The file is read
-    /// through [`facet_fit::io::input`] ([`Cap::EXR`]), then [`Self::from_exr_bytes`].
+    /// through [`facet_brdf::io::input`] ([`Cap::EXR`]), then [`Self::from_exr_bytes`].
     pub fn load(path: &Path) -> Result<(EnvironmentMap, Vec<String>), RenderError> {
         let bytes = input::read(path, Cap::EXR)?;
         Self::from_exr_bytes(path, &bytes)

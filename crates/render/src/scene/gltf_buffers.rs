@@ -3,14 +3,14 @@
 //!
 //! Each buffer is the GLB's binary chunk (buffer 0 without a `uri`, in a `.glb`), a `data:` URI,
 //! or a relative file beside the glTF ([`super::uri`]) read through
-//! [`facet_fit::io::input::read`] with [`Cap::BUFFER`]. The bytes must cover the declared
+//! [`facet_brdf::io::input::read`] with [`Cap::BUFFER`]. The bytes must cover the declared
 //! `byteLength` (the GLB chunk may be up to 3 bytes longer, padding; a file may be longer), and
 //! only `byteLength` bytes are kept visible, so every later range check is against the declared
 //! length. A file named by several buffers is read once.
 
 use super::uri::{UriTarget, resolve, shorten};
 use crate::error::RenderError;
-use facet_fit::io::input::{self, Cap};
+use facet_brdf::io::input::{self, Cap};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -19,7 +19,7 @@
 //!
 //! Hostile input is an error naming the file and the field at fault, or (for what only costs a
 //! texture, a light or an unused camera) a warning; never a panic, a hang or a huge allocation:
-//! - files are read through [`facet_fit::io::input`]: regular files only (no FIFO, device,
+//! - files are read through [`facet_brdf::io::input`]: regular files only (no FIFO, device,
 //!   directory), each under its [`Cap`];
 //! - buffers are loaded here (`gltf_buffers`): the GLB chunk, `data:` URIs, relative
 //!   files; absolute paths and schemes refused ([`super::uri`]); their bytes cover byteLength;
@@ -38,7 +38,7 @@ use super::gltf_material::MaterialLoader;
 use super::mesh::{CleanPrimitive, RawPrimitive, clean_primitive};
 use super::{Camera, Light, Material, Scene};
 use crate::error::RenderError;
-use facet_fit::io::input::{self, Cap};
+use facet_brdf::io::input::{self, Cap};
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::khr_lights_punctual::Kind;
 use std::path::{Path, PathBuf};
@@ -62,8 +62,8 @@ pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 
 /// Loads a glTF 2.0 file into a world-space [`Scene`]. Bad input is a [`RenderError::Input`]
 /// naming the file; a scene without any renderable triangle is a [`RenderError::Scene`].
-/// The file is read through [`facet_fit::io::input`] (a regular file of at most
-/// [`Cap::GLTF`](facet_fit::io::input::Cap::GLTF) bytes), then [`load_gltf_bytes`].
+/// The file is read through [`facet_brdf::io::input`] (a regular file of at most
+/// [`Cap::GLTF`](facet_brdf::io::input::Cap::GLTF) bytes), then [`load_gltf_bytes`].
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderError> {
     let bytes = input::read(path, Cap::GLTF)?;
     load_gltf_bytes(path, &bytes, options)

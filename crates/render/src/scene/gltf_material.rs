@@ -12,10 +12,11 @@
 //! Paths are relative to the glTF file's folder; `model` defaults to `tabulated`;
 //! `glint.density` is required, `gamma_deg` defaults to 2 and `threshold` to 50. A `measured`
 //! material renders its `source` ([`MeasuredMaterial`]); its `fit`, optional, is the NDF that
-//! samples a MERL-grid table (one is fitted on load without it).
+//! samples a MERL-grid table (without it the caller fits one after loading:
+//! [`Scene::fit_measured`](super::Scene::fit_measured); loading never fits).
 //! Images are decoded here, one at a time, so that a missing or broken image only costs its
 //! texture (a warning naming the image, its file and the problem, and the material), never the
-//! whole scene. An image file is read through [`facet_fit::io::input`] ([`Cap::TEXTURE`]); its header
+//! whole scene. An image file is read through [`facet_brdf::io::input`] ([`Cap::TEXTURE`]); its header
 //! is read first and a size over [`MAX_TEXTURE_SIDE`] on a side, or one that would bring the
 //! scene's textures past [`MAX_SCENE_TEXELS`], is refused before any pixel is decoded; the
 //! decoder then runs under [`image::Limits`] (the same sides, [`MAX_DECODE_BYTES`]).
@@ -24,9 +25,9 @@ use super::gltf_buffers::Buffers;
 use super::uri::{UriTarget, resolve};
 use super::{Clearcoat, FacetMaterial, GlintParams, Material, MeasuredMaterial, Texture};
 use crate::error::RenderError;
-use facet_fit::io::input::{self, Cap};
-use facet_fit::model::material::{FittedMaterial, ModelChoice};
-use facet_fit::sources::InputSpec;
+use facet_brdf::io::input::{self, Cap};
+use facet_brdf::model::material::{FittedMaterial, ModelChoice};
+use facet_brdf::sources::InputSpec;
 use glam::{Vec3, Vec4};
 use serde_json::Value;
 use std::collections::HashMap;
@@ -544,8 +545,8 @@ impl<'a> MaterialLoader<'a> {
 /// Whether an override names a fit JSON (else a measurement).
 fn is_fit_file(file: &Path) -> bool {
     matches!(
-        facet_fit::sources::InputSpec::parse(&file.to_string_lossy()),
-        facet_fit::sources::InputSpec::Fit(_)
+        facet_brdf::sources::InputSpec::parse(&file.to_string_lossy()),
+        facet_brdf::sources::InputSpec::Fit(_)
     )
 }
 

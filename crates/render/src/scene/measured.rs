@@ -11,13 +11,16 @@
 //!   `measured` plugin does; they need no fit.
 
 use crate::error::RenderError;
+use crate::scene::Scene;
 
-use facet_fit::model::material::FittedMaterial;
-use facet_fit::model::merl_grid::{MAX_X, MerlTable, bin_of};
-use facet_fit::sources::nbrdf::NbrdfLibrary;
-use facet_fit::sources::rgl::RglBsdf;
-use facet_fit::sources::{InputSpec, Residence};
-use facet_fit::{Brdf, FitConfig};
+use facet_brdf::Brdf;
+use facet_brdf::model::material::FittedMaterial;
+use facet_brdf::model::merl_grid::{MAX_X, MerlTable, bin_of};
+use facet_brdf::sources::nbrdf::NbrdfLibrary;
+use facet_brdf::sources::rgl::RglBsdf;
+use facet_brdf::sources::{InputSpec, Residence};
+use std::collections::HashMap;
+use std::fmt::Display;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -67,7 +70,7 @@ impl std::fmt::Debug for Measurement {
 }
 
 /// A material rendered as its measurement.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct MeasuredMaterial {
     /// The measurement as named: a path, or `nbrdf:NAME` / `analytic:SPEC`.
     pub source: String,
@@ -75,16 +78,35 @@ pub struct MeasuredMaterial {
     pub path: Option<PathBuf>,
     /// The data, shared by every material that names the same source.
     pub data: Arc<Measurement>,
-    /// The fit whose tabulated NDF samples a MERL-grid table (`None` for a `.bsdf`, which
-    /// samples by its own warps).
+    /// The fit whose tabulated NDF samples a MERL-grid table: the one named beside it, or the
+    /// caller's ([`Scene::fit_measured`]). `None` for a `.bsdf`, which samples by its own
+    /// warps, and for a table loaded without a fit until the caller fits it.
     pub fit: Option<Arc<FittedMaterial>>,
+    /// The opened source of a MERL-grid table loaded without a fit: what the caller fits
+    /// (`None` once it has a fit, and for a `.bsdf`).
+    pub unfitted: Option<Arc<dyn Brdf + Send>>,
+}
+
+impl std::fmt::Debug for MeasuredMaterial {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MeasuredMaterial")
+            .field("source", &self.source)
+            .field("path", &self.path)
+            .field("data", &self.data)
+            .field("fit", &self.fit)
+            .field(
+                "unfitted",
+                &self.unfitted.as_ref().map(|s| s.name().to_owned()),
+            )
+            .finish()
+    }
 }
 
 impl MeasuredMaterial {
     /// Opens the measurement `source` (a path relative to `base`, or `nbrdf:NAME` from
-    /// `nbrdf`, else `$FACET_NBRDF`, else the embedded proxies) and, for a MERL-grid table
-    /// without a `fit`, fits it ([`FitConfig::SINGLE_LAYER`]). A `fit` given with a `.bsdf` is
-    /// not needed and not kept.
+    /// `nbrdf`, else `$FACET_NBRDF`, else the embedded proxies). A MERL-grid table without a
+    /// `fit` keeps its opened source in [`unfitted`](Self::unfitted) for the caller to fit
+    /// ([`Scene::fit_measured`]); a `fit` given with a `.bsdf` is not needed and not kept.
     pub fn open(
         source: &str,
         base: &Path,
@@ -114,6 +136,7 @@ impl MeasuredMaterial {
                 path,
                 data: Arc::new(Measurement::Rgl(Box::new(bsdf))),
                 fit: None,
+                unfitted: None,
             });
         }
         let mut library: Option<NbrdfLibrary> = None;
@@ -121,19 +144,71 @@ impl MeasuredMaterial {
             .open(nbrdf, &mut library, Residence::Read)
             .map_err(|e| fail(&e))?;
         let data = Measurement::of(&spec, &*src).map_err(|e| fail(&e))?;
-        let fit = match fit {
-            Some(f) => f,
-            // The fit only samples the measurement: no coat is searched.
-            None => Arc::new(
-                facet_fit::fit_material(&*src, source, &FitConfig::SINGLE_LAYER)
-                    .map_err(|e| fail(&format!("fitting its sampling NDF: {e}")))?,
-            ),
-        };
+        let unfitted = fit.is_none().then(|| Arc::from(src));
         Ok(MeasuredMaterial {
             source: source.to_owned(),
             path,
             data: Arc::new(data),
-            fit: Some(fit),
+            fit,
+            unfitted,
         })
+    }
+
+    /// The file or name its errors name (a name shown escaped: it may hold terminal escapes).
+    fn named(&self) -> PathBuf {
+        (self.path.clone()).unwrap_or_else(|| PathBuf::from(self.source.escape_debug().to_string()))
+    }
+}
+
+impl Scene {
+    /// Gives every MERL-grid measurement loaded without a fit the one `fit` makes of its source
+    /// (`fit(source, brdf)`, e.g. facet-fit's `fit_material` with `FitConfig::SINGLE_LAYER`),
+    /// once per source however many materials name it. The renderer never fits: this is the
+    /// caller's step, to be shown with its time. Returns how many sources were fitted.
+    pub fn fit_measured<E: Display>(
+        &mut self,
+        mut fit: impl FnMut(&str, &dyn Brdf) -> Result<FittedMaterial, E>,
+    ) -> Result<usize, RenderError> {
+        let mut done: HashMap<*const (), Arc<FittedMaterial>> = HashMap::new();
+        for m in self
+            .materials
+            .iter_mut()
+            .filter_map(|m| m.measured.as_mut())
+        {
+            let Some(src) = m.unfitted.take() else {
+                continue;
+            };
+            let key = Arc::as_ptr(&src) as *const ();
+            let f = match done.get(&key) {
+                Some(f) => f.clone(),
+                None => {
+                    let f = fit(&m.source, &*src).map_err(|e| {
+                        RenderError::input(m.named(), format!("fitting its sampling NDF: {e}"))
+                    })?;
+                    let f = Arc::new(f);
+                    done.insert(key, f.clone());
+                    f
+                }
+            };
+            m.fit = Some(f);
+        }
+        Ok(done.len())
+    }
+
+    /// The sources of the MERL-grid measurements still without a fit (what
+    /// [`fit_measured`](Self::fit_measured) would fit), each once.
+    pub fn unfitted_measurements(&self) -> Vec<&str> {
+        let mut seen = Vec::<*const ()>::new();
+        let mut names = Vec::new();
+        for m in self.materials.iter().filter_map(|m| m.measured.as_ref()) {
+            if let Some(src) = &m.unfitted {
+                let key = Arc::as_ptr(src) as *const ();
+                if !seen.contains(&key) {
+                    seen.push(key);
+                    names.push(m.source.as_str());
+                }
+            }
+        }
+        names
     }
 }

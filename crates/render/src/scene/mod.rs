@@ -4,7 +4,7 @@
 //! material per triangle, textures as RGBA8, punctual lights, one camera. glTF is Y-up and
 //! right-handed; so is the scene.
 
-use facet_fit::model::material::ModelChoice;
+use facet_brdf::model::material::ModelChoice;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -162,7 +162,7 @@ pub struct FacetMaterial {
     /// The fit JSON it was loaded from.
     pub source: PathBuf,
     /// The fit.
-    pub fit: Arc<facet_fit::model::material::FittedMaterial>,
+    pub fit: Arc<facet_brdf::model::material::FittedMaterial>,
     /// Which of its models to render.
     pub model: ModelChoice,
     /// Glint parameters: render the model's NDF as discrete flakes.

@@ -5,7 +5,7 @@
 //! Anything else is refused with a message saying why: an absolute path (`/x.bin`, `C:\x.bin`,
 //! `\\server\x`), a scheme (`file:`, `http:`, …), a query or fragment, an empty URI. A relative
 //! path may still climb out of the folder with `..`; that is allowed (glTF files do it), and the
-//! file read is still a regular file under its cap ([`facet_fit::io::input`]).
+//! file read is still a regular file under its cap ([`facet_brdf::io::input`]).
 
 use super::data_uri::decode_data_uri;
 use std::path::{Path, PathBuf};

@@ -5,7 +5,7 @@ pub mod merl;
 pub mod nbrdf;
 pub mod rgl;
 
-use crate::error::FitError;
+use crate::error::BrdfError;
 use crate::model::analytic::parse_analytic;
 use crate::model::brdf::Brdf;
 use crate::model::material::FittedMaterial;
@@ -77,7 +77,7 @@ impl InputSpec {
         nbrdf: Option<&Path>,
         library: &mut Option<NbrdfLibrary>,
         merl: Residence,
-    ) -> Result<Box<dyn Brdf>, FitError> {
+    ) -> Result<Box<dyn Brdf + Send>, BrdfError> {
         Ok(match self {
             InputSpec::Nbrdf(name) => {
                 if library.is_none() {

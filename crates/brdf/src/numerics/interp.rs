@@ -5,7 +5,7 @@ type Rgb = [f64; 3];
 
 /// Fills `None` entries by linear interpolation between the nearest valid neighbours (constant
 /// beyond the ends). `None` if nothing is valid.
-pub(crate) fn fill_missing(v: &[Option<Rgb>]) -> Option<Vec<Rgb>> {
+pub fn fill_missing(v: &[Option<Rgb>]) -> Option<Vec<Rgb>> {
     let valid: Vec<usize> = (0..v.len()).filter(|&i| v[i].is_some()).collect();
     let (&first, &last) = (valid.first()?, valid.last()?);
     Some(

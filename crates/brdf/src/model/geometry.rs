@@ -96,7 +96,7 @@ pub fn u_to_theta(u: f64) -> f64 {
 /// acos |x| = √(1 − |x|) P(|x|), P of degree 7): cheaper than libm's acos, and branch-free
 /// but for a select, so loops over it vectorise (the MERL grid's 737 000 angles, the
 /// extraction's azimuthal integrals).
-pub(crate) fn acos_poly(x: f64) -> f64 {
+pub fn acos_poly(x: f64) -> f64 {
     const P: [f64; 8] = [
         1.570_796_305_0,
         -0.214_598_801_6,

@@ -2,7 +2,7 @@
 //! a 6-21-21-3 MLP per material, `f_r = exp(relu(relu(x W1 + b1) W2 + b2) W3 + b3) − 1`,
 //! x = (h, d) of the Rusinkiewicz parameterisation with φh = 0.
 
-use crate::error::FitError;
+use crate::error::BrdfError;
 use crate::model::brdf::Brdf;
 use crate::model::geometry::{spherical, to_half_diff};
 use crate::model::rgb::Rgb;
@@ -152,7 +152,7 @@ pub struct NbrdfLibrary {
 
 impl NbrdfLibrary {
     /// The neural proxies of the 100 MERL materials, embedded in the library
-    /// (`crates/fit/data/nbrdf/`, MIT licence, see its README). Parsed on each call: keep it.
+    /// (`crates/brdf/data/nbrdf/`, MIT licence, see its README). Parsed on each call: keep it.
     pub fn embedded() -> Self {
         Self::parse(Path::new(EMBEDDED_LABEL), EMBEDDED)
             .expect("the embedded MERL-100 file is valid JSON of networks")
@@ -167,7 +167,7 @@ impl NbrdfLibrary {
 
     /// The library `nbrdf:` names resolve in, the same in every command: `path` (`--nbrdf`)
     /// when given, else `$FACET_NBRDF`, else the embedded library.
-    pub fn open_or_embedded(path: Option<&Path>) -> Result<Self, FitError> {
+    pub fn open_or_embedded(path: Option<&Path>) -> Result<Self, BrdfError> {
         match Self::override_path(path).as_deref() {
             Some(p) => Self::open(p),
             None => Ok(Self::embedded()),
@@ -175,7 +175,7 @@ impl NbrdfLibrary {
     }
 
     /// Reads a file of proxies in the format of the embedded one.
-    pub fn open(path: &Path) -> Result<Self, FitError> {
+    pub fn open(path: &Path) -> Result<Self, BrdfError> {
         Self::parse(
             path,
             &crate::io::input::read_to_string(path, crate::io::input::Cap::NBRDF)?,
@@ -183,8 +183,8 @@ impl NbrdfLibrary {
     }
 
     /// A library from the text of its JSON; `path` names it in errors.
-    pub fn parse(path: &Path, text: &str) -> Result<Self, FitError> {
-        let bad = |problem: String| FitError::Nbrdf {
+    pub fn parse(path: &Path, text: &str) -> Result<Self, BrdfError> {
+        let bad = |problem: String| BrdfError::Nbrdf {
             path: path.to_owned(),
             problem,
         };
@@ -205,8 +205,8 @@ impl NbrdfLibrary {
     }
 
     /// The proxy of material `name`; an unknown name is an error that lists near names.
-    pub fn get(&self, name: &str) -> Result<NeuralBrdf, FitError> {
-        let bad = |problem: String| FitError::Nbrdf {
+    pub fn get(&self, name: &str) -> Result<NeuralBrdf, BrdfError> {
+        let bad = |problem: String| BrdfError::Nbrdf {
             path: self.path.clone(),
             problem,
         };

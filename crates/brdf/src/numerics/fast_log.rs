@@ -167,7 +167,7 @@ mod tests {
         let mut worst = 0.0f64;
         for k in 0..200_000 {
             let x = 1e-9f32 * 1.0002f32.powi(k);
-            if x > crate::metric::iso_tables::MAX_X {
+            if x > crate::model::merl_grid::MAX_X {
                 break;
             }
             let back = super::exp_m1(super::ln_1p(x)) as f64;

@@ -36,7 +36,7 @@ mod sample;
 pub mod tensor_file;
 pub mod warp2d;
 
-use crate::error::FitError;
+use crate::error::BrdfError;
 use crate::model::brdf::Brdf;
 use crate::model::merl_grid::MAX_X;
 use crate::model::rgb::Rgb;
@@ -64,22 +64,22 @@ pub struct RglBsdf {
 }
 
 /// θ to the format's u = √(θ / (π/2)).
-pub(crate) fn theta2u(theta: f64) -> f64 {
+pub fn theta2u(theta: f64) -> f64 {
     (theta / FRAC_PI_2).max(0.0).sqrt()
 }
 
 /// u to θ = u² π/2.
-pub(crate) fn u2theta(u: f64) -> f64 {
+pub fn u2theta(u: f64) -> f64 {
     u * u * FRAC_PI_2
 }
 
 /// φ ∈ [−π, π] to u = (φ + π) / 2π.
-pub(crate) fn phi2u(phi: f64) -> f64 {
+pub fn phi2u(phi: f64) -> f64 {
     (phi + PI) / (2.0 * PI)
 }
 
 /// u to φ = (2u − 1) π.
-pub(crate) fn u2phi(u: f64) -> f64 {
+pub fn u2phi(u: f64) -> f64 {
     (2.0 * u - 1.0) * PI
 }
 
@@ -106,7 +106,7 @@ fn fold_like(d: DVec3, wi: DVec3, reduction: i32) -> DVec3 {
 
 impl RglBsdf {
     /// Reads a `.bsdf` file.
-    pub fn open(path: &Path) -> Result<Self, FitError> {
+    pub fn open(path: &Path) -> Result<Self, BrdfError> {
         Self::from_bytes(
             path,
             crate::io::input::read(path, crate::io::input::Cap::BSDF)?,
@@ -115,12 +115,12 @@ impl RglBsdf {
 
     /// Parses the bytes of the `.bsdf` file at `path` (named in errors; its stem names the
     /// material).
-    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, FitError> {
+    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, BrdfError> {
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        Self::parse(&name, bytes).map_err(|problem| FitError::Bsdf {
+        Self::parse(&name, bytes).map_err(|problem| BrdfError::Bsdf {
             path: path.to_owned(),
             problem,
         })

@@ -12,7 +12,7 @@
 /// above 10 the lobe is flatter than Lambertian and nothing is left to fit.
 pub const ALPHA_RANGE: std::ops::RangeInclusive<f64> = 1e-4..=10.0;
 
-use crate::error::FitError;
+use crate::error::BrdfError;
 use crate::model::fresnel::Fresnel;
 use crate::model::microfacet::{AnalyticNdf, MicrofacetBrdf, Ndf, NdfKind};
 
@@ -30,8 +30,8 @@ fn conflicting(a: &str, b: &str) -> bool {
 }
 
 /// Parses the part after `analytic:`.
-pub fn parse_analytic(spec: &str) -> Result<MicrofacetBrdf, FitError> {
-    let bad = |problem: String| FitError::Spec {
+pub fn parse_analytic(spec: &str) -> Result<MicrofacetBrdf, BrdfError> {
+    let bad = |problem: String| BrdfError::Spec {
         spec: format!("analytic:{spec}"),
         problem,
     };
@@ -112,8 +112,8 @@ impl Keys {
         &mut self,
         key: &str,
         value: &str,
-        bad: &impl Fn(String) -> FitError,
-    ) -> Result<(), FitError> {
+        bad: &impl Fn(String) -> BrdfError,
+    ) -> Result<(), BrdfError> {
         // `x` is one component of the value `v`; an error names the whole value.
         let num_of = |x: &str, v: &str, range: &std::ops::RangeInclusive<f64>, what: &str| {
             let x = x

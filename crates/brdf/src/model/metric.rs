@@ -1,5 +1,5 @@
 //! The objective a fit minimises, named in its record: the error metric's space
-//! (the passes over the grid that compute it are in [`crate::metric`]).
+//! (the passes over the grid that compute it are in facet-fit's `metric`).
 
 use serde::{Deserialize, Serialize};
 

@@ -1,7 +1,7 @@
 //! A fitted material: the tabulated NDF with its Fresnel table, the GGX and Beckmann fits, and
 //! the record written as `<name>.json`. Each model is itself a [`Brdf`].
 
-use crate::error::FitError;
+use crate::error::BrdfError;
 use crate::model::brdf::Brdf;
 use crate::model::coat::{Coat, CoatLayer, Coated};
 use crate::model::fresnel::{Fresnel, FresnelTable};
@@ -197,7 +197,7 @@ pub struct MetricErrors {
 }
 
 /// The mean CIEDE2000 between a model and its source on a sphere under the report's point
-/// light ([`crate::metric::look::SphereScene::REPORT`], the source read from its MERL-grid
+/// light (facet-fit's `metric::look::SphereScene::REPORT`, the source read from its MERL-grid
 /// table): below 1 the eye sees no difference.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LookRecord {
@@ -363,7 +363,7 @@ impl FittedMaterial {
     }
 
     /// Reads a fit JSON written by [`FittedMaterial::save`].
-    pub fn load(path: &Path) -> Result<Self, FitError> {
+    pub fn load(path: &Path) -> Result<Self, BrdfError> {
         Self::parse(
             path,
             &crate::io::input::read_to_string(path, crate::io::input::Cap::FIT_JSON)?,
@@ -371,8 +371,8 @@ impl FittedMaterial {
     }
 
     /// A fit from the text of its JSON; `path` names it in errors.
-    pub fn parse(path: &Path, text: &str) -> Result<Self, FitError> {
-        let bad = |problem: String| FitError::Material {
+    pub fn parse(path: &Path, text: &str) -> Result<Self, BrdfError> {
+        let bad = |problem: String| BrdfError::Material {
             path: path.to_owned(),
             problem,
         };
@@ -381,10 +381,10 @@ impl FittedMaterial {
     }
 
     /// Writes the record as pretty JSON, through a temporary file renamed into place.
-    pub fn save(&self, path: &Path) -> Result<(), FitError> {
+    pub fn save(&self, path: &Path) -> Result<(), BrdfError> {
         let text =
             serde_json::to_string_pretty(&self.record).expect("a fit record always serialises");
-        crate::io::output::write_bytes_atomically(path, text).map_err(|e| FitError::io(path, e))
+        crate::io::output::write_bytes_atomically(path, text).map_err(|e| BrdfError::io(path, e))
     }
 
     /// One of the fitted models, if it was fitted.

@@ -274,7 +274,7 @@ impl TabulatedNdf {
     }
 
     /// Λ = 1/G1₀(θ₀) − 1 of an isotropic NDF at the unstretched polar angle θ₀.
-    pub(crate) fn lambda_of_theta0(&self, theta0: f64) -> f64 {
+    pub fn lambda_of_theta0(&self, theta0: f64) -> f64 {
         let g1 = self.base_g1(theta0, 0.0);
         if g1 <= 0.0 {
             f64::INFINITY

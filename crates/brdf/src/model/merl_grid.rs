@@ -239,7 +239,7 @@ impl MerlTable {
 
     /// The stored values of channel `c` (0 red, 1 green, 2 blue) in flat bin order, as
     /// little-endian bytes: f_r is a value times `SCALE[c]`, negative where missing.
-    pub(crate) fn channel(&self, c: usize) -> &[[u8; 8]] {
+    pub fn channel(&self, c: usize) -> &[[u8; 8]] {
         &self.raw.values()[c * SAMPLES..(c + 1) * SAMPLES]
     }
 

@@ -6,7 +6,7 @@
 
 /// Asks the kernel to back the 2 MiB-aligned part of `buf` with huge pages, before it is first
 /// written (untouched pages of a fresh zeroed allocation are not yet mapped).
-pub(crate) fn advise<T>(buf: &mut [T]) {
+pub fn advise<T>(buf: &mut [T]) {
     #[cfg(target_os = "linux")]
     {
         const HUGE: usize = 2 << 20;

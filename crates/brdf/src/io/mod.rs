@@ -1,7 +1,7 @@
 //! The floor everything stands on: reading input files safely (regular files of bounded size,
 //! memory-mapped where that is faster) and writing outputs atomically ([`output`]).
 
-pub(crate) mod huge_pages;
+pub mod huge_pages;
 pub mod input;
-pub(crate) mod mapped_file;
+pub mod mapped_file;
 pub mod output;

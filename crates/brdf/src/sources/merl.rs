@@ -7,7 +7,7 @@
 //! (1, 1.15, 1.66) / 1500 is f_r; a negative value marks a missing sample.
 //! Sample (i, j, k) sits at the bin's lower edge: θh = (i/90)² π/2, θd = j/90 · π/2, φd = k/180 · π.
 
-use crate::error::FitError;
+use crate::error::BrdfError;
 use crate::io::mapped_file::MappedFile;
 use crate::model::brdf::Brdf;
 use crate::model::geometry::from_half_diff;
@@ -25,7 +25,7 @@ use std::path::Path;
 
 impl MerlTable {
     /// Reads and validates a MERL `.binary` file into memory.
-    pub fn read(path: &Path) -> Result<Self, FitError> {
+    pub fn read(path: &Path) -> Result<Self, BrdfError> {
         if let Some(table) = Self::read_standard(path, false)? {
             return Ok(table);
         }
@@ -40,7 +40,7 @@ impl MerlTable {
     /// system without `mmap`, is read). The file must not be truncated or rewritten in place
     /// while the table lives: a read of the lost part would fault (see `mapped_file.rs`).
     /// Replacing it by a rename, as [`MerlTable::write`] does, is safe.
-    pub fn map(path: &Path) -> Result<Self, FitError> {
+    pub fn map(path: &Path) -> Result<Self, BrdfError> {
         if let Some(table) = Self::read_standard(path, true)? {
             return Ok(table);
         }
@@ -53,13 +53,13 @@ impl MerlTable {
     /// A file of exactly the standard size with the standard header, mapped (`map`) or read
     /// straight into the table (one 35 MB buffer, not a byte copy beside it); `None` for any
     /// other file, which [`MerlTable::parse`] then reads and explains.
-    fn read_standard(path: &Path, map: bool) -> Result<Option<Self>, FitError> {
+    fn read_standard(path: &Path, map: bool) -> Result<Option<Self>, BrdfError> {
         use std::io::Read;
         let (mut file, len) = crate::io::input::open(path, crate::io::input::Cap::MERL)?;
         if len != HEADER_BYTES + (3 * 8 * SAMPLES) as u64 {
             return Ok(None);
         }
-        let io = |e| FitError::io(path, e);
+        let io = |e| BrdfError::io(path, e);
         let mut header = [0u8; HEADER_BYTES as usize];
         let raw = match map.then(|| MappedFile::map(&file, len as usize)).flatten() {
             Some(m) => {
@@ -103,8 +103,8 @@ impl MerlTable {
     }
 
     /// Validates the bytes of a MERL file; `path` names it in errors.
-    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, FitError> {
-        let bad = |problem: String| FitError::Merl {
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Self, BrdfError> {
+        let bad = |problem: String| BrdfError::Merl {
             path: path.to_owned(),
             problem,
         };
@@ -173,7 +173,7 @@ impl MerlTable {
 
     /// Writes the table as a MERL file. The file is written beside its destination and renamed
     /// into place, so a failed write never leaves a half-written file.
-    pub fn write(&self, path: &Path) -> Result<(), FitError> {
+    pub fn write(&self, path: &Path) -> Result<(), BrdfError> {
         crate::io::output::write_atomically(path, |tmp| {
             let mut file = std::io::BufWriter::new(std::fs::File::create(tmp)?);
             for d in [THETA_H_RES, THETA_D_RES, PHI_D_RES] {
@@ -182,7 +182,7 @@ impl MerlTable {
             file.write_all(bytemuck::cast_slice(self.raw.values()))?;
             file.into_inner().map_err(|e| e.into_error())?.sync_all()
         })
-        .map_err(|e| FitError::io(path, e))
+        .map_err(|e| BrdfError::io(path, e))
     }
 }
 
@@ -197,23 +197,23 @@ pub struct MerlBrdf {
 
 impl MerlBrdf {
     /// Reads a MERL `.binary` file into memory.
-    pub fn open(path: &Path) -> Result<Self, FitError> {
+    pub fn open(path: &Path) -> Result<Self, BrdfError> {
         Self::named(path, MerlTable::read(path)?)
     }
 
     /// Maps a MERL `.binary` file ([`MerlTable::map`]: faster, for a short-lived process; the
     /// file must not be truncated in place while the source lives).
-    pub fn map(path: &Path) -> Result<Self, FitError> {
+    pub fn map(path: &Path) -> Result<Self, BrdfError> {
         Self::named(path, MerlTable::map(path)?)
     }
 
     /// The table of the file at `path`, named after the file's stem.
-    fn named(path: &Path, table: MerlTable) -> Result<Self, FitError> {
+    fn named(path: &Path, table: MerlTable) -> Result<Self, BrdfError> {
         let name = path
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        Self::from_table(name, table).map_err(|problem| FitError::Merl {
+        Self::from_table(name, table).map_err(|problem| BrdfError::Merl {
             path: path.to_owned(),
             problem,
         })

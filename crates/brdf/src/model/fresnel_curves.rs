@@ -1,6 +1,6 @@
 //! The physical Fresnel curves recorded with a fit (Schlick, dielectric, conductor), their
 //! qualities and which one the renderer uses. Fitting them to a table is
-//! [`crate::fitting::fresnel_fit`]'s.
+//! facet-fit's `fitting::fresnel_fit`'s.
 
 use crate::model::fresnel::{Fresnel, FresnelTable};
 use crate::model::rgb::Rgb;

@@ -4,7 +4,6 @@
 
 pub mod chi2;
 pub mod fast_log;
-pub(crate) mod interp;
-pub(crate) mod optim;
+pub mod interp;
 pub mod quadrature;
 pub mod stats;
