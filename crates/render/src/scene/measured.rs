@@ -5,8 +5,9 @@
 //!   [`InputSpec`] opens (an `analytic:` spec, a fit JSON) sampled onto the MERL grid — are
 //!   evaluated by trilinear interpolation in MERL's (√θh, θd, φd) coordinates on the table's
 //!   [`filled`](MerlTable::filled) samples, and importance-sampled by the visible normals of a
-//!   fit's tabulated NDF: the fit named beside the measurement, or one made from it on load
-//!   (Dupuy & Jakob 2018 sample their measurements the same way).
+//!   fit's tabulated NDF (Dupuy & Jakob 2018 sample their measurements the same way): the fit
+//!   named beside the measurement, or one the caller makes after loading
+//!   ([`Scene::fit_measured`]). Loading never fits.
 //! - **RGL `.bsdf` files** are evaluated and sampled by their own stored warps, as Mitsuba 3's
 //!   `measured` plugin does; they need no fit.
 
