@@ -6,13 +6,24 @@
 //! working symbolic links (Git on Windows without `core.symlinks` writes the link as a one-line
 //! text file), the workspace root's `../../shaders` is used instead. Finding no WGSL file at all
 //! is a build error: a facet-gpu without shaders would build and then fail on every GPU path.
+//!
+//! `shaders/tests/` holds the test-only pipelines (probes that read a WGSL include's answers
+//! back for a test to compare with the CPU): embedded only with the feature `test-shaders`,
+//! which the crates' tests ask for, and left out of the published package.
 
 use std::path::{Path, PathBuf};
 
+/// The test-only pipelines' folder under the shader root.
+const TESTS: &str = "tests";
+
 fn collect(dir: &Path, root: &Path, out: &mut Vec<(String, PathBuf)>) -> std::io::Result<()> {
+    let with_tests = std::env::var_os("CARGO_FEATURE_TEST_SHADERS").is_some();
     for e in std::fs::read_dir(dir)? {
         let p = e?.path();
         if p.is_dir() {
+            if dir == root && p.file_name().is_some_and(|n| n == TESTS) && !with_tests {
+                continue;
+            }
             collect(&p, root, out)?;
         } else if p.extension().is_some_and(|x| x == "wgsl") {
             let name = p

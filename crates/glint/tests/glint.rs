@@ -117,14 +117,14 @@ fn tea_in_wgsl_matches_rust() {
         .collect();
     let pipeline = shader::compute_pipeline(
         &gpu.device,
-        "glint/tea_check.wgsl",
+        "tests/glint/tea_check.wgsl",
         "tea_check",
         &pipeline_constants(),
     )
     .unwrap();
     let kb = buffer::storage(&gpu.device, "keys", &keys);
     let hb = buffer::storage_zeroed(&gpu.device, "hashes", (keys.len() * 16) as u64);
-    let wg = facet_gpu::shader::workgroup_size("glint/tea_check.wgsl", "tea_check").unwrap();
+    let wg = facet_gpu::shader::workgroup_size("tests/glint/tea_check.wgsl", "tea_check").unwrap();
     facet_gpu::dispatch::run(
         &gpu.device,
         &gpu.queue,
@@ -174,14 +174,15 @@ fn cell_choice_in_wgsl_matches_rust() {
         .collect();
     let pipeline = shader::compute_pipeline(
         &gpu.device,
-        "glint/select_check.wgsl",
+        "tests/glint/select_check.wgsl",
         "select_check",
         &facet_glint::gpu::flake_constants(),
     )
     .unwrap();
     let qb = buffer::storage(&gpu.device, "queries", &queries);
     let cb = buffer::storage_zeroed(&gpu.device, "chosen", (queries.len() * 8) as u64);
-    let wg = facet_gpu::shader::workgroup_size("glint/select_check.wgsl", "select_check").unwrap();
+    let wg =
+        facet_gpu::shader::workgroup_size("tests/glint/select_check.wgsl", "select_check").unwrap();
     facet_gpu::dispatch::run(
         &gpu.device,
         &gpu.queue,

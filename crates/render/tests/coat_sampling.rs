@@ -47,7 +47,7 @@ fn coat_sampling_matches_its_pdf() {
     let Some(gpu) = gpu_for_tests("coat_sampling_matches_its_pdf") else {
         return;
     };
-    let file = "render/coat_probe.wgsl";
+    let file = "tests/render/coat_probe.wgsl";
     let pipeline = shader::compute_pipeline(&gpu.device, file, "coat_sample", &[]).unwrap();
     let wg = shader::workgroup_size(file, "coat_sample").unwrap();
     let n = 200_000u32;

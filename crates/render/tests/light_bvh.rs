@@ -137,7 +137,7 @@ fn no_light_that_reaches_the_point_is_excluded() {
     assert!(checked > 200, "{checked} cases");
 }
 
-/// The WGSL's choices equal the CPU's (`shaders/render/light_tree_probe.wgsl`): at 4096 random
+/// The WGSL's choices equal the CPU's (`shaders/tests/render/light_tree_probe.wgsl`): at 4096 random
 /// points, normals and random numbers, the pmf of a random light (f32 on both, products in the
 /// same order: 1e-5 relative) and the light the walk picks with its probability.
 #[test]
@@ -168,7 +168,7 @@ fn gpu_light_tree_matches_the_cpu() {
         .collect();
     let (d, q) = (&gpu.device, &gpu.queue);
     let pipeline =
-        facet_gpu::shader::compute_pipeline(d, "render/light_tree_probe.wgsl", "probe", &[])
+        facet_gpu::shader::compute_pipeline(d, "tests/render/light_tree_probe.wgsl", "probe", &[])
             .unwrap();
     let nodes = facet_gpu::buffer::storage(d, "light tree", &tree.nodes);
     let probe_buf = facet_gpu::buffer::storage(d, "probes", &probes);

@@ -57,7 +57,7 @@ fn gpu_lookup(gpu: &Gpu, table: &MerlTable, pairs: &[[f32; 8]]) -> Vec<[f32; 4]>
         ("MERL_THETA_D", THETA_D_RES as f64),
         ("MERL_PHI_D", PHI_D_RES as f64),
     ];
-    let pipeline = shader::compute_pipeline(d, "render/merl_probe.wgsl", "probe", &constants)
+    let pipeline = shader::compute_pipeline(d, "tests/render/merl_probe.wgsl", "probe", &constants)
         .unwrap_or_else(|e| panic!("{e}"));
     let tables = buffer::storage(d, "merl table", &merl_block(table));
     let input = buffer::storage(d, "pairs", pairs);

@@ -1,5 +1,5 @@
 //! RGL `.bsdf` materials in WGSL (shaders/render/rgl.inc.wgsl through the probe
-//! shaders/render/rgl_probe.wgsl) against the CPU reader (facet_fit::sources::rgl::RglBsdf):
+//! shaders/tests/render/rgl_probe.wgsl) against the CPU reader (facet_fit::sources::rgl::RglBsdf):
 //! `rgl_eval` and `rgl_pdf` at 10⁵ direction pairs, `rgl_sample` at 2·10⁴ (ωi, u), on files
 //! Facet writes from analytic GGX: isotropic, anisotropic, and anisotropic cut to a half and a
 //! quarter of φi (the format's folds by 2 and 4). The repository holds no measured `.bsdf`.
@@ -24,7 +24,7 @@ fn files() -> Vec<(&'static str, RglBsdf)> {
 /// The probe's results for `probes` ((ωi, u0), (ωo, u1) per probe) on `file`'s block, placed
 /// at word 3 of the tables.
 fn run_probe(gpu: &Gpu, file: &RglBsdf, probes: &[[f32; 4]]) -> Vec<[f32; 4]> {
-    let file_name = "render/rgl_probe.wgsl";
+    let file_name = "tests/render/rgl_probe.wgsl";
     let pipeline = shader::compute_pipeline(&gpu.device, file_name, "rgl_probe", &[]).unwrap();
     let wg = shader::workgroup_size(file_name, "rgl_probe").unwrap();
     let mut tables = vec![f32::from_bits(3), -1.0, -1.0];

@@ -72,12 +72,13 @@ fn gpu_visible_sampling_of_tabulated_ndfs_follows_its_pdf() {
     ];
     let pipeline = shader::compute_pipeline(
         &gpu.device,
-        "render/tabulated_sample.wgsl",
+        "tests/render/tabulated_sample.wgsl",
         "tabulated_sample",
         &[],
     )
     .unwrap();
-    let wg = shader::workgroup_size("render/tabulated_sample.wgsl", "tabulated_sample").unwrap();
+    let wg =
+        shader::workgroup_size("tests/render/tabulated_sample.wgsl", "tabulated_sample").unwrap();
     let n = 200_000u32;
     for (what, ndf) in &cases {
         let s = ndf.stretch;
