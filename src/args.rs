@@ -55,7 +55,7 @@ fn real(s: &str, range: RangeInclusive<f64>) -> Result<f64, String> {
     }
 }
 
-pub use facet_render::shard::MAX_SAMPLE_INDEX;
+pub use facet_render::output::shard::MAX_SAMPLE_INDEX;
 
 /// A shard's sample indices `A..B`: 0 ≤ A < B ≤ [`MAX_SAMPLE_INDEX`], at most [`MAX_SPP`] of them.
 pub fn sample_range(s: &str) -> Result<std::ops::Range<u32>, String> {

@@ -5,7 +5,7 @@ use anyhow::{Result, bail};
 use clap::Args;
 use facet_fit::io::input::same_file;
 use facet_render::Image;
-use facet_render::merge::{Part, merge};
+use facet_render::output::merge::{Part, merge};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 

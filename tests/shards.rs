@@ -5,7 +5,7 @@
 mod common;
 
 use facet_render::Image;
-use facet_render::shard::{PixelKind, ShardRecord};
+use facet_render::output::shard::{PixelKind, ShardRecord};
 use std::path::{Path, PathBuf};
 
 /// The render of the test scene: 48 × 27 pixels, `samples` ("A..B") or `--spp N`, with

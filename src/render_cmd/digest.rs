@@ -1,4 +1,4 @@
-//! The identity of a render, written into its EXRs (`facet_render::shard`): SHA-256 of every file
+//! The identity of a render, written into its EXRs (`facet_render::output::shard`): SHA-256 of every file
 //! the scene reads and of the settings that decide its pixels, so that `facet merge` joins only
 //! parts of one render. Left out: the seed (recorded and checked on its own), the sample range
 //! (what a part holds), and what changes speed but not pixels (--wavefront, --bvh, --time-limit,

@@ -1,7 +1,7 @@
 //! Colour differences between two renders, as the page shows them: CIEDE2000 and ΔE_ITP.
 //!
 //! A pixel's colour is what its PNG shows: the renderer's tone map at exposure 0,
-//! d = 1 − exp(−L) per channel (`facet_render::film`), kept in f32 rather than rounded to 8 bits,
+//! d = 1 − exp(−L) per channel (`facet_render::output::film`), kept in f32 rather than rounded to 8 bits,
 //! read as linear sRGB (Rec. 709 primaries, D65). Two differences are taken of it:
 //!
 //! - **ΔE2000**: to CIE L*a*b* (D65), compared by CIEDE2000 (Sharma, Wu & Dalal 2005) — both by
@@ -102,7 +102,7 @@ pub struct DeltaE {
 
 /// The displayed colour of a linear radiance: the PNG's tone map at exposure 0, unrounded.
 pub fn displayed(radiance: [f32; 3]) -> LinSrgb {
-    // d = 1 − exp(−L): facet_render::film's tone map, before its sRGB encoding.
+    // d = 1 − exp(−L): facet_render::output::film's tone map, before its sRGB encoding.
     let d = radiance.map(|v| 1.0 - (-v.max(0.0)).exp());
     LinSrgb::new(d[0], d[1], d[2])
 }

@@ -15,7 +15,7 @@
 use crate::camera::CameraFrame;
 use crate::config::{ImageConfig, RenderConfig, SampleConfig};
 use crate::error::RenderError;
-use crate::film::Image;
+use crate::output::film::Image;
 use crate::gpu_types::GpuFrame;
 use crate::queues::{COUNTERS, FETCH_COUNTER, GLINT_SORT_KEYS, Queue, SORT_COUNTERS};
 use crate::resources::SceneResources;

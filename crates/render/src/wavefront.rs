@@ -8,14 +8,14 @@
 use crate::bindings::{Group, bind_group};
 use crate::config::ImageConfig;
 use crate::error::RenderError;
-use crate::film::{Image, to_f32_saturated};
+use crate::output::film::{Image, to_f32_saturated};
 use crate::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::queues::{COUNTERS, FETCH_COUNTER};
 use crate::resources::SceneResources;
 use crate::stages::Layouts;
 use crate::tags::SlotState;
-use crate::tonemap::ToneMap;
+use crate::output::tonemap::ToneMap;
 use facet_gpu::{Gpu, buffer};
 
 /// Paths in flight and film for one image, bound to one scene's resources.
@@ -202,7 +202,7 @@ impl Wavefront {
     /// Per pixel, the variance of its mean (the estimate the image shows): the samples' unbiased
     /// variance over n, (r² − m²) / (n − 1) from their mean m and root mean square r (in f64),
     /// 0 with fewer than two samples, at most `f32::MAX` (an image holds no more: a variance
-    /// past it, from radiance past 1.8e19, is saturated, [`crate::film::saturated_count`] counts them).
+    /// past it, from radiance past 1.8e19, is saturated, [`crate::output::film::saturated_count`] counts them).
     /// `None` unless made by
     /// [`Integrator::wavefront_with_variance`](crate::Integrator::wavefront_with_variance).
     pub fn variance(&self, gpu: &Gpu) -> Result<Option<Image>, RenderError> {

@@ -1,5 +1,5 @@
 //! The written images read back: the EXR holds the rendered pixels bit for bit, the PNG holds
-//! them through the tone map of `facet_render::film` (v = 1 − exp(−2^exposure · L), sRGB, 8 bits).
+//! them through the tone map of `facet_render::output::film` (v = 1 − exp(−2^exposure · L), sRGB, 8 bits).
 
 use facet_gpu::gpu_for_tests;
 use facet_render::camera::CameraFrame;

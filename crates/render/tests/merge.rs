@@ -3,8 +3,8 @@
 //! strangers are refused.
 
 use facet_render::Image;
-use facet_render::merge::{MergeError, Part, merge};
-use facet_render::shard::{PixelKind, ShardRecord};
+use facet_render::output::merge::{MergeError, Part, merge};
+use facet_render::output::shard::{PixelKind, ShardRecord};
 use std::path::PathBuf;
 
 /// Radiance of sample `s` of pixel `k`, channel `c`: spread over four decades, with a rare

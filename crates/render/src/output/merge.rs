@@ -1,10 +1,10 @@
-//! Merging shards ([`crate::shard`]): parts of one render holding disjoint sample ranges become
+//! Merging shards ([`crate::output::shard`]): parts of one render holding disjoint sample ranges become
 //! the render of their union — each pixel's mean weighted by the parts' sample counts, its
 //! variance by the exact pairwise formula (Chan, Golub & LeVeque 1979) — after checking that
 //! the parts belong together. Parts come in any order; the result is a part too, so merges nest.
 
-use crate::film::{Image, to_f32_saturated};
-use crate::shard::{PixelKind, ShardRecord};
+use crate::output::film::{Image, to_f32_saturated};
+use crate::output::shard::{PixelKind, ShardRecord};
 use std::path::PathBuf;
 
 /// One part to merge: its image, and its variance when the merge takes variances.

@@ -88,7 +88,7 @@ impl Image {
     }
 
     /// Linear f32 RGB EXR with a text attribute `(name, text)` in its header when given (a
-    /// shard's record, [`crate::shard`]).
+    /// shard's record, [`crate::output::shard`]).
     pub(crate) fn write_exr_with(
         &self,
         path: &Path,

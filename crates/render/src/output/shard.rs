@@ -1,5 +1,5 @@
 //! A shard: a part of a render that holds some of its sample indices, rendered apart (on another
-//! machine of a farm) and merged later ([`crate::merge`]). What a merge must know of a part —
+//! machine of a farm) and merged later ([`crate::output::merge`]). What a merge must know of a part —
 //! which samples it holds, with which seed, of which scene and settings, by which Facet — travels
 //! in its EXR header as the text attribute [`EXR_ATTRIBUTE`] (a JSON [`ShardRecord`]), so a part is
 //! an ordinary EXR that any viewer opens.
@@ -8,7 +8,7 @@
 //! over the image ([`Integrator::render_more`](crate::Integrator::render_more)).
 
 use crate::error::RenderError;
-use crate::film::Image;
+use crate::output::film::Image;
 use facet_brdf::io::input::{self, Cap};
 use serde::{Deserialize, Serialize};
 use std::fs::File;
