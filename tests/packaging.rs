@@ -1,6 +1,7 @@
-//! What a library user gets from the packages (issue 16): facet-gpu's package carries every WGSL
-//! file of `shaders/` (the crates' GPU paths load them at build time), and facet-fit without its
-//! default `gpu` feature has no wgpu in its dependency tree. Both ask cargo itself, offline
+//! What a library user gets from the packages (issue 16): facet-gpu's package carries every
+//! production WGSL file of `shaders/` (the crates' GPU paths load them at build time) and none
+//! of the test-only ones, facet-fit without its default `gpu` feature has no wgpu in its
+//! dependency tree, and the renderer's has no fitter (issue 61). Both ask cargo itself, offline
 //! (the test build has fetched everything).
 
 use std::collections::BTreeSet;
@@ -63,8 +64,44 @@ fn the_gpu_package_carries_every_shader() {
         "{} WGSL files in shaders/",
         shaders.len()
     );
-    let missing: Vec<&String> = shaders.difference(&listed).collect();
+    // The test-only pipelines (shaders/tests/) stay in the repository.
+    let (tests, production): (BTreeSet<String>, BTreeSet<String>) = shaders
+        .into_iter()
+        .partition(|s| s.starts_with("shaders/tests/"));
+    assert!(!tests.is_empty(), "no test-only pipeline in shaders/tests/");
+    let missing: Vec<&String> = production.difference(&listed).collect();
     assert!(missing.is_empty(), "facet-gpu's package lacks {missing:?}");
+    let shipped: Vec<&String> = tests.intersection(&listed).collect();
+    assert!(shipped.is_empty(), "facet-gpu's package ships {shipped:?}");
+}
+
+/// The renderer and the glint crate depend on facet-brdf, not on the fitter: their normal
+/// dependency trees hold no facet-fit (the viewer's, an application, does).
+#[test]
+fn the_renderer_depends_on_no_fitter() {
+    let tree = |package: &str| {
+        cargo(&[
+            "tree",
+            "-p",
+            package,
+            "-e",
+            "normal",
+            "--prefix",
+            "none",
+            "--offline",
+        ])
+    };
+    let has = |tree: &str, name: &str| tree.lines().any(|l| l.starts_with(&format!("{name} ")));
+    // The check has the power to fail: the viewer's tree does hold the fitter.
+    assert!(has(&tree("facet-viewer"), "facet-fit"));
+    for package in ["facet-render", "facet-glint"] {
+        let t = tree(package);
+        assert!(has(&t, "facet-brdf"), "{package}: {t}");
+        assert!(
+            !has(&t, "facet-fit"),
+            "{package} depends on facet-fit:\n{t}"
+        );
+    }
 }
 
 #[test]

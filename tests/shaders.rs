@@ -184,8 +184,8 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
     use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial, GpuSceneInfo};
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
-    use facet_render::resources::light_bvh::GpuLightNode;
     use facet_render::output::tonemap::ToneMapParams;
+    use facet_render::resources::light_bvh::GpuLightNode;
     use facet_render::trace::{GpuHit, GpuRay};
     vec![
         layout_check!(GpuNode, "fit/kernel.wgsl", "Node", {

@@ -15,8 +15,8 @@
 use crate::camera::CameraFrame;
 use crate::config::{ImageConfig, RenderConfig, SampleConfig};
 use crate::error::RenderError;
-use crate::output::film::Image;
 use crate::gpu_types::GpuFrame;
+use crate::output::film::Image;
 use crate::queues::{COUNTERS, FETCH_COUNTER, GLINT_SORT_KEYS, Queue, SORT_COUNTERS};
 use crate::resources::SceneResources;
 use crate::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};

@@ -35,8 +35,8 @@ pub mod config;
 mod error;
 pub mod gpu_types;
 mod integrator;
-pub mod output;
 pub(crate) mod limits;
+pub mod output;
 pub mod pacing;
 pub mod procedural;
 pub(crate) mod queues;
@@ -51,12 +51,12 @@ pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
 pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Sequence, Strategy};
 pub use error::RenderError;
 pub use facet_gpu::{Gpu, GpuError};
-pub use output::film::Image;
 /// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
 pub use glam;
 pub use integrator::{Integrator, RenderStats, StageClock, StageTime, StageVariants};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
+pub use output::film::Image;
 pub use resources::{Built, LightSelection, ResourceConfig, SceneResources};
 pub use trace::{GpuHit, GpuRay, RayTracer};
 pub use wavefront::Wavefront;

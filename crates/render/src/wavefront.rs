@@ -8,14 +8,14 @@
 use crate::bindings::{Group, bind_group};
 use crate::config::ImageConfig;
 use crate::error::RenderError;
-use crate::output::film::{Image, to_f32_saturated};
 use crate::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
 use crate::limits::{DeviceLimits, Planned, product};
+use crate::output::film::{Image, to_f32_saturated};
+use crate::output::tonemap::ToneMap;
 use crate::queues::{COUNTERS, FETCH_COUNTER};
 use crate::resources::SceneResources;
 use crate::stages::Layouts;
 use crate::tags::SlotState;
-use crate::output::tonemap::ToneMap;
 use facet_gpu::{Gpu, buffer};
 
 /// Paths in flight and film for one image, bound to one scene's resources.

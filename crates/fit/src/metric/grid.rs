@@ -8,6 +8,7 @@
 //! direct evaluation.
 
 use crate::metric::Metric;
+use crate::metric::fast_log::{ln_1p, ln_1p_abs};
 use crate::metric::iso::{CoarseSamples, IsoSamples, median_x};
 use crate::metric::iso_tables::{IsoTables, MAX_X, fresnel_from_sums};
 use crate::model::brdf::Brdf;
@@ -16,7 +17,6 @@ use crate::model::geometry::{HalfDiff, from_half_diff};
 use crate::model::merl_grid::{MerlTable, PHI_D_RES, SAMPLES, THETA_D_RES, bin_angles, bin_of};
 use crate::model::microfacet::MicrofacetBrdf;
 use crate::model::rgb::Rgb;
-use crate::numerics::fast_log::{ln_1p, ln_1p_abs};
 use crate::numerics::stats::median_in_place;
 use glam::DVec3;
 use rayon::prelude::*;

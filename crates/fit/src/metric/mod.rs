@@ -3,6 +3,7 @@
 //! Fresnel average and the linear solves for F and a diffuse albedo, on the CPU (the GPU twins
 //! are in [`crate::gpu`]).
 
+pub mod fast_log;
 pub mod grid;
 pub(crate) mod iso;
 pub mod iso_tables;

@@ -4,12 +4,12 @@
 
 use super::lanes::sum_f64;
 use super::{IsoData, IsoSamples, PADDED};
+use crate::metric::fast_log::ln_1p;
 use crate::metric::iso_tables::MAX_X;
 use crate::metric::merl_geometry::{
     COARSE_ROW, COARSE_STRIDE, MU_ROW, MerlGeometry, ROW, ROWS, merl_geometry,
 };
 use crate::model::merl_grid::{MerlTable, SCALE, THETA_D_RES};
-use crate::numerics::fast_log::ln_1p;
 use crate::numerics::stats::median_in_place;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;

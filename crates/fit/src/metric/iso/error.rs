@@ -6,10 +6,10 @@ use super::ideal::formed_ideal;
 use super::lanes::{lanes_total, valid_chunks};
 use super::rows::RowPass;
 use super::{IsoData, IsoSamples, RowIdeals};
+use crate::metric::fast_log::ln_1p_fused;
 use crate::metric::iso_tables::IsoTables;
 use crate::model::merl_grid::THETA_D_RES;
 use crate::model::rgb::Rgb;
-use crate::numerics::fast_log::ln_1p_fused;
 
 impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
     /// Σ over samples of Σ_c |ln(1 + x_model) − ln(1 + x_data)|, x_model = F D G2 / (4 cos θo)

@@ -3,9 +3,9 @@
 
 use super::rows::RowPass;
 use super::{IsoSamples, RowIdeals};
+use crate::metric::fast_log::ln_positive_fused;
 use crate::metric::iso_tables::IsoTables;
 use crate::model::merl_grid::{THETA_D_RES, THETA_H_RES};
-use crate::numerics::fast_log::ln_positive_fused;
 
 impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
     /// Per θh bin, the histogram of the scales of D at which each sample's model meets its

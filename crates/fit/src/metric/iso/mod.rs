@@ -32,8 +32,8 @@ mod solve;
 pub(crate) use build::median_x;
 pub(crate) use medians::MEDIAN_BUCKETS;
 
+use crate::metric::fast_log::exp_m1;
 use crate::metric::merl_geometry::{COARSE_MU_ROW, COARSE_ROW, MU_ROW, ROW, row_geometry};
-use crate::numerics::fast_log::exp_m1;
 use std::sync::Arc;
 
 /// Bins per row rounded up to the sums' eight lanes.

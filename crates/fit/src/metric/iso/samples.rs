@@ -3,9 +3,9 @@
 
 use super::lanes::sum_f64;
 use super::{CoarseSamples, IsoData, IsoSamples};
+use crate::metric::fast_log::exp_m1;
 use crate::metric::merl_geometry::{COARSE_STRIDE, ROW, ROWS};
 use crate::model::merl_grid::THETA_D_RES;
-use crate::numerics::fast_log::exp_m1;
 use rayon::prelude::*;
 use std::sync::Arc;
 

@@ -6,11 +6,11 @@ use super::error::ErrorSum;
 use super::lanes::{lanes_total, valid_chunks};
 use super::rows::{RowFill, RowPass};
 use super::{IsoData, IsoSamples, RowIdeals, RowSums};
+use crate::metric::fast_log::ln_1p_fused;
 use crate::metric::iso_tables::IsoTables;
 use crate::metric::sums::LinearSums;
 use crate::model::merl_grid::THETA_D_RES;
 use crate::model::rgb::Rgb;
-use crate::numerics::fast_log::ln_1p_fused;
 
 impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
     /// F per θd bin and ρd/π solved for a model's D and G ([`LinearSums::solve`]), and the
