@@ -191,7 +191,7 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         layout_check!(GpuNode, "fit/kernel.wgsl", "Node", {
             x, y, z, row_scale, col_weight, norm_weight, pad0, pad1,
         }),
-        layout_check!(GpuState, "fit/normalise.wgsl", "State", {
+        layout_check!(GpuState, "fit/normalise_reduce.wgsl", "State", {
             iteration, lambda, pad0, pad1,
         }),
         layout_check!(DpfParams, "glint/dpf_build.wgsl", "Params", {

@@ -1,5 +1,5 @@
 //! The fitter on the GPU: the power iteration's kernel–vector product, its normalisation and
-//! the D / G1 table integrals (`shaders/fit/kernel.wgsl`, `normalise.wgsl`), and the passes over
+//! the D / G1 table integrals (`shaders/fit/kernel.wgsl`, `normalise_reduce.wgsl`, `normalise_rescale.wgsl`), and the passes over
 //! the whole MERL grid, its samples uploaded once per source: the Fresnel average
 //! (`shaders/fit/fresnel.wgsl`) and the error metric (`shaders/fit/error.wgsl`). f32
 //! throughout; the CPU f64 path is the reference the tests compare against.

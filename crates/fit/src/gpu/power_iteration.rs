@@ -1,4 +1,5 @@
-//! Host driver of `shaders/fit/kernel.wgsl` and `shaders/fit/normalise.wgsl`.
+//! Host driver of `shaders/fit/kernel.wgsl` and the normalisation's two passes,
+//! `shaders/fit/normalise_reduce.wgsl` and `normalise_rescale.wgsl`.
 //!
 //! Iterations run in batches of [`BATCH`] per submission: kernel (y = K v), reduce (λ and the
 //! residual into `stats`, on the GPU), rescale (v = y / λ). Only the batch's `stats` come back,
@@ -15,7 +16,7 @@ const BATCH: usize = 8;
 /// a tighter tolerance is taken as this one on the GPU.
 const F32_RESIDUAL_FLOOR: f64 = 1e-6;
 
-/// The power iteration and the D / G1 table integrals on the GPU (`shaders/fit/kernel.wgsl`, `normalise.wgsl`).
+/// The power iteration and the D / G1 table integrals on the GPU (`shaders/fit/kernel.wgsl`, `normalise_*.wgsl`).
 pub struct PowerIteration {
     kernel_iso: wgpu::ComputePipeline,
     kernel_aniso: wgpu::ComputePipeline,
@@ -45,11 +46,11 @@ impl PowerIteration {
     /// Builds the pipelines on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
         let k = "fit/kernel.wgsl";
-        let n = "fit/normalise.wgsl";
+        let (r, n) = ("fit/normalise_reduce.wgsl", "fit/normalise_rescale.wgsl");
         Ok(PowerIteration {
             kernel_iso: shader::compute_pipeline(device, k, "kernel", &[("ISOTROPIC", 1.0)])?,
             kernel_aniso: shader::compute_pipeline(device, k, "kernel", &[("ISOTROPIC", 0.0)])?,
-            reduce: shader::compute_pipeline(device, n, "reduce", &[])?,
+            reduce: shader::compute_pipeline(device, r, "reduce", &[])?,
             rescale: shader::compute_pipeline(device, n, "rescale", &[])?,
             kernel_wg: shader::workgroup_size(k, "kernel")?,
             rescale_wg: shader::workgroup_size(n, "rescale")?,

@@ -1,7 +1,7 @@
 // The normalisation of the power iteration, on the GPU so that no read-back is needed per
-// iteration: `reduce` (one workgroup) computes λ = Σ c_j y_j and the residual
+// iteration, first pass: `reduce` (one workgroup) computes λ = Σ c_j y_j and the residual
 // Σ c_j |y_j/λ − v_j| (the L1 change of the normalised NDF), stores both in stats[iteration]
-// and advances the iteration; `rescale` sets v = y / λ.
+// and advances the iteration. The second pass is normalise_rescale.wgsl.
 
 #include "fit/node.inc.wgsl"
 
@@ -49,13 +49,5 @@ fn reduce(@builtin(local_invocation_id) lid: vec3<u32>) {
         }
         state.lambda = lambda;
         state.iteration = it + 1u;
-    }
-}
-
-@compute @workgroup_size(WG)
-fn rescale(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let j = gid.x + gid.y * nwg.x * WG;
-    if (j < arrayLength(&v)) {
-        v[j] = y[j] / state.lambda;
     }
 }
