@@ -55,8 +55,8 @@ pub struct BenchArgs {
     /// Time every variant of the stages, alternating them run by run: the trace section every
     /// traversal variant (workgroup sizes, persistent threads, the stack partly in workgroup
     /// memory) with GPU timestamps where the adapter has them; the integrator section
-    /// (`stage_variants`) the demo with each as its extend stage, and with glints with the glint
-    /// queue sorted by footprint class and not (default: only what every renderer uses).
+    /// (`stage_variants`) the demo with each as its extend stage (default: only what every
+    /// renderer uses).
     #[arg(long)]
     pub variants: bool,
 }

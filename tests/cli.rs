@@ -971,7 +971,7 @@ fn bench_smoke_reports_every_section() {
 /// `facet bench --only trace,integrator --variants`: every traversal variant on every case
 /// (camera and random rays × closest and any), positive rates, each against the default variant
 /// of the same case (itself: exactly 1), the clock GPU timestamps where the adapter has them;
-/// the integrator with each as its extend stage, and with the glint queue sorted and not.
+/// the integrator with each as its extend stage.
 #[test]
 fn bench_times_every_trace_variant() {
     if facet_gpu::gpu_for_tests("bench_times_every_trace_variant").is_none() {
@@ -1015,21 +1015,10 @@ fn bench_times_every_trace_variant() {
     };
     assert!(rows.iter().all(|row| row["clock"] == clock), "{clock}");
     let stages = r["stage_variants"].as_array().unwrap();
-    let mut want: Vec<(String, bool, bool)> =
-        variants.iter().map(|v| (v.key(), false, false)).collect();
-    let default = facet_render::trace::TraceVariant::DEFAULT.key();
-    for (sorted, descent) in [(false, false), (true, false), (false, true), (true, true)] {
-        want.push((default.clone(), sorted, descent));
-    }
-    let got: Vec<(String, bool, bool)> = stages
+    let want: Vec<String> = variants.iter().map(|v| v.key()).collect();
+    let got: Vec<String> = stages
         .iter()
-        .map(|row| {
-            (
-                row["extend"].as_str().unwrap().into(),
-                row["sort_glints"] == true,
-                row["glint_descent"] == true,
-            )
-        })
+        .map(|row| row["extend"].as_str().unwrap().into())
         .collect();
     assert_eq!(got, want);
     for row in stages {

@@ -199,11 +199,10 @@ impl Case<'_> {
     }
 }
 
-/// The integrator with each [`StageVariants`] on the demo scene at the integrator section's
-/// size: without glints, the extend stage in every [`TraceVariant`]; with glints, the glint
-/// stage's queue unsorted and grouped by footprint class. Within each scene the variants take
-/// turns run by run after one warm-up each; Msamples/s of whole renders, against the scene's
-/// first (the default), and the time in one iteration of the stages a variant changes.
+/// The integrator with each [`StageVariants`] on the demo scene without glints at the
+/// integrator section's size: the extend stage in every [`TraceVariant`]. The variants take
+/// turns run by run after one warm-up each; Msamples/s of whole renders, against the first (the
+/// default), and the time in one iteration of the extend stage.
 pub fn stage_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let (w, h, spp) = sizes.render;
     println!(
@@ -212,24 +211,9 @@ pub fn stage_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     );
     let extend: Vec<StageVariants> = runnable_variants(&gpu.device)
         .into_iter()
-        .map(|extend| StageVariants {
-            extend,
-            ..StageVariants::DEFAULT
-        })
+        .map(|extend| StageVariants { extend })
         .collect();
-    // The glint stage as it is, sorted, with the fixed-shape descent, and with both.
-    let sort = [(false, false), (true, false), (false, true), (true, true)].map(
-        |(sort_glints, glint_descent)| StageVariants {
-            sort_glints,
-            glint_descent,
-            ..StageVariants::DEFAULT
-        },
-    );
-    let mut rows = Vec::new();
-    for (glints, variants, stage) in [(false, &extend[..], "extend"), (true, &sort[..], "glint")] {
-        rows.extend(compare(gpu, sizes, glints, variants, stage)?);
-    }
-    Ok(Value::Array(rows))
+    Ok(Value::Array(compare(gpu, sizes, false, &extend, "extend")?))
 }
 
 /// One scene's rows of [`stage_variants`]; `stage` names the stages whose time is reported
@@ -277,12 +261,7 @@ fn compare(
             .map(|t| t.ms)
             .sum();
         let v = integrator.variants();
-        let key = format!(
-            "extend {}, glints {}{}",
-            v.extend.key(),
-            if v.sort_glints { "sorted" } else { "unsorted" },
-            if v.glint_descent { ", descent" } else { "" }
-        );
+        let key = format!("extend {}", v.extend.key());
         println!(
             "  {:<15} {key:<54} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; {stage} stages {stage_ms:.3} ms of one iteration, {clock:?})",
             if glints {
@@ -293,8 +272,7 @@ fn compare(
             msps / base,
         );
         rows.push(json!({
-            "glints": glints, "extend": v.extend.key(), "sort_glints": v.sort_glints,
-            "glint_descent": v.glint_descent,
+            "glints": glints, "extend": v.extend.key(),
             "msamples_per_s": msps, "ms": ms, "vs_default": msps / base,
             "stage": stage, "stage_iteration_ms": stage_ms,
             "stage_clock": format!("{clock:?}").to_lowercase(),

@@ -8,16 +8,8 @@ pub const MAX_GLINT_MATERIALS: u32 = 8;
 /// ([`crate::trace::TraceSchedule::Persistent`]; zeroed when the extend queue is closed).
 pub const FETCH_COUNTER: u32 = Queue::count(MAX_GLINT_MATERIALS);
 
-/// Footprint classes of the glint stage's grouping ([`crate::StageVariants::sort_glints`]):
-/// the path's last bounce, then octaves of the flakes under the footprint.
-pub const GLINT_SORT_KEYS: u32 = 16;
-
-/// The first counter of glint material 0's footprint histogram; material k's follow at
-/// k × [`GLINT_SORT_KEYS`] (zeroed when the shading queues are closed).
-pub const SORT_COUNTERS: u32 = FETCH_COUNTER + 1;
-
-/// How many counters a wavefront holds: every queue's, the fetch counter, the histograms.
-pub const COUNTERS: u32 = SORT_COUNTERS + MAX_GLINT_MATERIALS * GLINT_SORT_KEYS;
+/// How many counters a wavefront holds: every queue's, the fetch counter.
+pub const COUNTERS: u32 = FETCH_COUNTER + 1;
 
 /// A queue; its index is the WGSL queue number.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

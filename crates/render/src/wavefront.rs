@@ -306,7 +306,7 @@ impl Buffers {
             frame: buffer::uniform(d, "frame", &GpuFrame::default()),
             paths: buffer::storage_zeroed(d, "paths", PATH_REGIONS * w * 16),
             info: buffer::storage_zeroed(d, "path info", w * 16),
-            // Every queue's, then the persistent extend stage's and the glint histograms.
+            // Every queue's, then the persistent extend stage's.
             counters: buffer::storage_zeroed(d, "queue counters", COUNTERS as u64 * 4),
             sizes: buffer::storage_zeroed(d, "queue sizes", nq * 4),
             args: d.create_buffer(&wgpu::BufferDescriptor {

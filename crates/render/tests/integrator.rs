@@ -475,63 +475,6 @@ fn extend_variants_render_the_same_image() {
     }
 }
 
-/// The glint stages' queues grouped by footprint class (a counting sort before shading) render
-/// the unsorted image to the bit: two glint materials, each with its own histogram, a second
-/// sphere that the first reflects (larger footprints on later bounces), several tiles. The walks
-/// stay short: past llvmpipe's cap of 65 535 iterations of a loop, where a walk ends depends on
-/// the invocations run beside it, sorted or not (with a density of 10⁸ and a threshold of 10⁴ on
-/// the second sphere, 11 of its 4096 pixels differ). The same for the fixed-shape descent
-/// (`glint_descent`), alone and with the sorting.
-#[test]
-fn sorted_glints_render_the_same_image() {
-    let Some(gpu) = gpu_for_tests("sorted_glints_render_the_same_image") else {
-        return;
-    };
-    let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let mut scene = sphere_scene(glint(1e6, 50.0));
-    scene.materials.push(glint(3e6, 50.0));
-    scene.add_uv_sphere(Vec3::new(0.9, 0.6, 0.5), 0.4, 64, 32, 1);
-    let mut c = config(2);
-    c.image.wavefront = 1000; // several tiles
-    let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
-    let camera = CameraFrame::new(&scene.camera).unwrap();
-    let image = |variants: StageVariants| {
-        let integrator = Integrator::with_variants(&gpu.device, &res, variants).unwrap();
-        let (image, _) = integrator
-            .render(&gpu, &res, &camera, &c, &mut |_| {})
-            .unwrap();
-        (image, integrator.stage_names())
-    };
-    let (plain, _) = image(StageVariants::DEFAULT);
-    let (sorted, stages) = image(StageVariants {
-        sort_glints: true,
-        ..StageVariants::DEFAULT
-    });
-    let histograms = stages.iter().filter(|&&s| s == "glint_histogram").count();
-    assert_eq!(histograms, 2, "{stages:?}");
-    assert!(plain.pixels.iter().flatten().any(|&v| v > 0.0));
-    let descent = |sort_glints| {
-        image(StageVariants {
-            sort_glints,
-            glint_descent: true,
-            ..StageVariants::DEFAULT
-        })
-        .0
-    };
-    for (label, other) in [
-        ("sorted", sorted),
-        ("descent", descent(false)),
-        ("sorted, descent", descent(true)),
-    ] {
-        let differ = other
-            .pixels
-            .iter()
-            .zip(&plain.pixels)
-            .filter(|(a, b)| a != b);
-        assert_eq!(differ.count(), 0, "{label}: pixels differ");
-    }
-}
-
 /// A scene built in code with a NaN vertex or an index out of range is refused with a message,
 /// before anything reaches the GPU.
 #[test]
