@@ -968,67 +968,6 @@ fn bench_smoke_reports_every_section() {
     positive(&r["viewer"]["msamples_per_s"], "viewer Msamples/s");
 }
 
-/// `facet bench --only trace,integrator --variants`: every traversal variant on every case
-/// (camera and random rays × closest and any), positive rates, each against the default variant
-/// of the same case (itself: exactly 1), the clock GPU timestamps where the adapter has them;
-/// the integrator with each as its extend stage.
-#[test]
-fn bench_times_every_trace_variant() {
-    if facet_gpu::gpu_for_tests("bench_times_every_trace_variant").is_none() {
-        return;
-    }
-    let dir = common::scratch("cli_bench_variants");
-    let json = dir.join("bench.json");
-    let (ok, stdout, err) = facet(&[
-        "bench",
-        "--smoke",
-        "--only",
-        "trace,integrator",
-        "--variants",
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stdout}\n{err}");
-    let r: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let rows = r["trace"].as_array().unwrap();
-    let variants = facet_render::trace::TraceVariant::ALL;
-    assert_eq!(rows.len(), 4 * variants.len());
-    for v in variants {
-        let mine: Vec<_> = rows
-            .iter()
-            .filter(|row| row["variant"] == v.key())
-            .collect();
-        assert_eq!(mine.len(), 4, "{}", v.key());
-        for row in mine {
-            let rate = row["mrays_per_s"].as_f64().unwrap();
-            assert!(rate.is_finite() && rate > 0.0, "{row}");
-            if v == facet_render::trace::TraceVariant::DEFAULT {
-                assert_eq!(row["vs_default"], 1.0, "{row}");
-            }
-        }
-    }
-    let clock = if r["adapter"]["timestamps"] == true {
-        "gpu"
-    } else {
-        "wall"
-    };
-    assert!(rows.iter().all(|row| row["clock"] == clock), "{clock}");
-    let stages = r["stage_variants"].as_array().unwrap();
-    let want: Vec<String> = variants.iter().map(|v| v.key()).collect();
-    let got: Vec<String> = stages
-        .iter()
-        .map(|row| row["extend"].as_str().unwrap().into())
-        .collect();
-    assert_eq!(got, want);
-    for row in stages {
-        let rate = row["msamples_per_s"].as_f64().unwrap();
-        assert!(rate.is_finite() && rate > 0.0, "{row}");
-        let ms = row["stage_iteration_ms"].as_f64().unwrap();
-        assert!(ms > 0.0, "{row}");
-    }
-}
-
 /// `--variance` writes STEM.variance.exr beside the image: the same size, finite, non-negative,
 /// not all zero; without the flag there is none.
 #[test]

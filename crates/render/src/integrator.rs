@@ -17,10 +17,9 @@ use crate::config::{ImageConfig, RenderConfig, SampleConfig};
 use crate::error::RenderError;
 use crate::film::Image;
 use crate::gpu_types::GpuFrame;
-use crate::queues::{FETCH_COUNTER, Queue};
+use crate::queues::Queue;
 use crate::resources::SceneResources;
 use crate::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};
-use crate::trace::{TraceSchedule, TraceVariant};
 use crate::wavefront::Wavefront;
 use facet_gpu::timer::GpuTimer;
 use facet_gpu::{Gpu, GpuError};
@@ -99,41 +98,11 @@ pub struct Integrator {
     n_queues: u32,
     /// Workgroup size of the stages dispatched over every slot.
     wg: u32,
-    /// The variants its stages were built in.
-    variants: StageVariants,
-}
-
-/// How the integrator's stages schedule their work: variants chosen when its pipelines are
-/// built, each rendering the default's image to the bit at another speed (`facet bench
-/// --variants` times them side by side).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StageVariants {
-    /// How the extend stage hands rays to threads (its workgroup size; persistent threads).
-    pub extend: TraceVariant,
-}
-
-impl StageVariants {
-    /// What every renderer uses.
-    pub const DEFAULT: StageVariants = StageVariants {
-        extend: TraceVariant::DEFAULT,
-    };
 }
 
 impl Integrator {
     /// The pipelines for the material classes of `scene`.
     pub fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
-        Self::with_variants(device, scene, StageVariants::DEFAULT)
-    }
-
-    /// [`Integrator::new`] with its stages scheduled as `variants` says: the same image, at
-    /// another speed.
-    pub fn with_variants(
-        device: &wgpu::Device,
-        scene: &SceneResources,
-        variants: StageVariants,
-    ) -> Result<Self, RenderError> {
-        let extend = variants.extend;
-        extend.validate(device)?;
         let layouts = Layouts::new(device);
         let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
             Stage::new(device, &layouts, file, entry, queue, extra)
@@ -141,18 +110,6 @@ impl Integrator {
         let shade = shading_stages(device, &layouts, scene)?;
         let n_queues = Queue::count(scene.glints.len() as u32);
         let wg = STAGE_WORKGROUP;
-        let extend_wg = extend.constants();
-        let (extend_entry, extend_close) = match extend.schedule {
-            TraceSchedule::PerRay => ("extend", Vec::new()),
-            TraceSchedule::Persistent { groups } => (
-                "extend_persistent",
-                vec![
-                    ("MAX_GROUPS", groups as f64),
-                    ("ZERO_FIRST", FETCH_COUNTER as f64),
-                    ("ZERO_COUNT", 1.0),
-                ],
-            ),
-        };
         Ok(Integrator {
             logic: stage("render/logic.wgsl", "logic", None, &[])?,
             generate: stage(
@@ -161,45 +118,23 @@ impl Integrator {
                 Some(Queue::Generate),
                 &[],
             )?,
-            extend: Stage::swapping(
-                device,
-                &layouts,
-                "render/extend.wgsl",
-                extend.swaps(),
-                extend_entry,
-                Some(Queue::Extend),
-                &extend_wg,
-            )?,
+            extend: stage("render/extend.wgsl", "extend", Some(Queue::Extend), &[])?,
             connect: stage("render/connect.wgsl", "connect", Some(Queue::Shadow), &[])?,
-            close_gen: queue_args(device, &layouts, Queue::Generate.index(), 1, wg, &[])?,
-            close_extend: queue_args(
-                device,
-                &layouts,
-                Queue::Extend.index(),
-                1,
-                extend.workgroup,
-                &extend_close,
-            )?,
+            close_gen: queue_args(device, &layouts, Queue::Generate.index(), 1, wg)?,
+            close_extend: queue_args(device, &layouts, Queue::Extend.index(), 1, wg)?,
             close_shade: queue_args(
                 device,
                 &layouts,
                 Queue::Diffuse.index(),
                 n_queues - Queue::Diffuse.index(),
                 wg,
-                &[],
             )?,
-            close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg, &[])?,
+            close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg)?,
             shade,
             layouts,
             n_queues,
             wg,
-            variants,
         })
-    }
-
-    /// The variants its stages were built in.
-    pub fn variants(&self) -> StageVariants {
-        self.variants
     }
 
     /// Names of the stages built (shading stages once per class).

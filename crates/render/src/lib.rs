@@ -57,7 +57,7 @@ pub use facet_gpu::{Gpu, GpuError};
 pub use film::Image;
 /// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
 pub use glam;
-pub use integrator::{Integrator, RenderStats, StageClock, StageTime, StageVariants};
+pub use integrator::{Integrator, RenderStats, StageClock, StageTime};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
 pub use resources::{Built, LightSelection, ResourceConfig, SceneResources};

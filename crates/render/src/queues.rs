@@ -4,13 +4,6 @@
 /// The most glint materials one scene may have (one queue and one shading dispatch each).
 pub const MAX_GLINT_MATERIALS: u32 = 8;
 
-/// The counter after every queue's: a persistent extend stage takes its batches from it
-/// ([`crate::trace::TraceSchedule::Persistent`]; zeroed when the extend queue is closed).
-pub const FETCH_COUNTER: u32 = Queue::count(MAX_GLINT_MATERIALS);
-
-/// How many counters a wavefront holds: every queue's, the fetch counter.
-pub const COUNTERS: u32 = FETCH_COUNTER + 1;
-
 /// A queue; its index is the WGSL queue number.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Queue {
@@ -67,13 +60,12 @@ impl Queue {
         8 + glints
     }
 
-    /// Override constants naming the fixed queues and [`FETCH_COUNTER`] in WGSL.
-    pub fn constants() -> [(&'static str, f64); 4] {
+    /// Override constants naming the fixed queues in WGSL.
+    pub fn constants() -> [(&'static str, f64); 3] {
         [
             ("Q_GEN", Queue::Generate.index() as f64),
             ("Q_EXTEND", Queue::Extend.index() as f64),
             ("Q_SHADOW", Queue::Shadow.index() as f64),
-            ("Q_FETCH", FETCH_COUNTER as f64),
         ]
     }
 }
