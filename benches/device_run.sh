@@ -7,8 +7,8 @@
 # one log go to $OUT (default ./device_out). To stage (Vulkan loader packages from Debian's
 # libvulkan1 in .gpu/debs): cargo build --release, cargo bench --no-run, cargo test --release
 # --no-run -p facet-glint --test glint_flakes --test glint, -p facet-fit --test gpu_fit and
-# -p facet-render --test bvh --test integrator (every traversal, extend and glint variant against
-# obvhs and the default's image on the real GPU), copied and stripped into .gpu/bin as test-NAME.
+# -p facet-render --test bvh --test integrator (the traversal against obvhs and the integrator's
+# tests on the real GPU), copied and stripped into .gpu/bin as test-NAME.
 # The working tree that travels is limited to 64 MiB, and these seven binaries take about 65 MB
 # stripped: pack them, and only them, into .gpu/bin.tar.gz (about 26 MB), which this script
 # unpacks into .gpu/bin:
@@ -39,12 +39,11 @@ step() { echo; echo "== $1 ($(date +%T))"; }
 {
     command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,clocks.sm,clocks.max.sm,power.draw,temperature.gpu,utilization.gpu --format=csv
     echo "cores: $(nproc)"
-    # Two runs, two JSONs: a section past its timeout loses only its own figures (14 traversal
-    # variants, 18 integrators with --variants).
-    step "facet bench --mode $mode (trace, every variant)"
-    timeout 150 $b/facet bench --mode "$mode" --only trace --variants --json "$out/bench_trace.json"
+    # Two runs, two JSONs: a section past its timeout loses only its own figures.
+    step "facet bench --mode $mode (trace)"
+    timeout 150 $b/facet bench --mode "$mode" --only trace --json "$out/bench_trace.json"
     step "facet bench --mode $mode (GPU sections)"
-    timeout 200 $b/facet bench --mode "$mode" --only integrator,dpf,viewer,noise --variants --json "$out/bench_gpu.json"
+    timeout 200 $b/facet bench --mode "$mode" --only integrator,dpf,viewer,noise --json "$out/bench_gpu.json"
     step "facet demo"
     timeout 45 $b/facet demo --out /tmp/facet_demo && cp /tmp/facet_demo/demo.png "$out/demo.png"
     step "glint_gpu_count (criterion)"

@@ -52,13 +52,6 @@ pub struct BenchArgs {
     /// Only these sections (comma-separated; default: all).
     #[arg(long, value_enum, value_delimiter = ',')]
     pub only: Vec<Section>,
-    /// Time every variant of the stages, alternating them run by run: the trace section every
-    /// traversal variant (workgroup sizes, persistent threads, the stack partly in workgroup
-    /// memory) with GPU timestamps where the adapter has them; the integrator section
-    /// (`stage_variants`) the demo with each as its extend stage, and with glints with the glint
-    /// queue sorted by footprint class and not (default: only what every renderer uses).
-    #[arg(long)]
-    pub variants: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -266,16 +259,13 @@ pub fn run(args: &BenchArgs) -> Result<ExitCode> {
     }
     if let Some(g) = &gpu {
         if on(Section::Trace) {
-            report["trace"] = trace::trace(g, &sizes, args.variants)?;
+            report["trace"] = trace::trace(g, &sizes)?;
         }
         if on(Section::Integrator) {
             let (integrator, stages, glint) = integrator(g, &sizes)?;
             report["integrator"] = integrator;
             report["stages"] = stages;
             report["glint"] = glint;
-            if args.variants {
-                report["stage_variants"] = trace::stage_variants(g, &sizes)?;
-            }
         }
         if on(Section::Viewer) {
             report["viewer"] = viewer(g, &sizes)?;

@@ -13,17 +13,10 @@ fn every_wgsl_file_validates() {
         shader::validate(name, &src).unwrap_or_else(|e| panic!("{e}"));
         println!("{name}: valid");
     }
-    // The traversal variants' swapped includes, in both files that trace.
-    let mut expanded: Vec<String> = Vec::new();
-    for v in facet_render::trace::TraceVariant::ALL {
-        for name in ["render/trace.wgsl", "render/extend.wgsl"] {
-            let src = shader::expand_with(name, v.swaps()).unwrap();
-            shader::validate(name, &src).unwrap_or_else(|e| panic!("{} {e}", v.key()));
-            expanded.push(src);
-        }
-    }
     // Every include-only file is validated as part of some pipeline file.
-    expanded.extend(shader::pipeline_files().map(|n| shader::expand(n).unwrap()));
+    let expanded: Vec<String> = shader::pipeline_files()
+        .map(|n| shader::expand(n).unwrap())
+        .collect();
     for (name, src) in shader::SHADERS
         .iter()
         .filter(|(n, _)| n.ends_with(".inc.wgsl"))
@@ -368,8 +361,8 @@ fn glint_stack_is_sized_to_the_tree() {
     );
 }
 
-/// The BVH traversal's stack has the depth the host's variants count with (a private array's
-/// size cannot be an override).
+/// The BVH traversal's stack has the depth the host counts with (a private array's size cannot
+/// be an override).
 #[test]
 fn bvh_stack_is_the_hosts() {
     assert_eq!(

@@ -164,10 +164,6 @@ struct LitNode {
 
 var<private> lit_stack: array<LitNode, STACK>;
 
-// Walks take their top levels breadth-first (descend_lit; facet_render's
-// StageVariants::glint_descent) at 1; at 0, the default, the test folds away.
-override GLINT_DESCENT: u32 = 0u;
-
 // Only the first nc chains are live (llvmpipe caps each loop's iterations per invocation, so
 // loops run over live chains only).
 fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root: array<u32, CHAINS>, keys_in: array<vec2<u32>, CHAINS>, nc: u32) -> array<u32, CHAINS> {
@@ -178,44 +174,11 @@ fn walk_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, root: array<u32
     }
     lit_stack[0] = LitNode(0u, 0u, 0u, field.root_count, root);
     var top = 1u;
-    if (GLINT_DESCENT != 0u) {
-        descend_lit(center, inv, ext, &keys, nc, &acc, &top);
-    }
     while (top > 0u) {
         top -= 1u;
         visit_lit(lit_stack[top], center, inv, ext, &keys, nc, &acc, &top);
     }
     return acc;
-}
-
-// The fixed-shape descent (issue 51): down to the level whose nodes are at least as wide as the
-// footprint's box, the box meets at most 2 × 2 nodes a level, so those levels are walked one at
-// a time in four fixed slots, the same loop for every invocation however its footprint lies;
-// the stack takes the nodes left at that level. The same nodes are visited and split with the
-// same draws as by the depth-first walk alone, so the counts are the same (only the order of
-// adding them differs).
-fn descend_lit(center: vec2<f32>, inv: mat2x2<f32>, ext: vec2<f32>, keys: ptr<function, array<vec2<u32>, CHAINS>>, nc: u32, acc: ptr<function, array<u32, CHAINS>>, top: ptr<function, u32>) {
-    // Nodes of level L are 2^-L wide: L = floor(-log2(the box's width)), within 0..MAX_DEPTH.
-    let width = 2.0 * max(ext.x, ext.y);
-    let levels = u32(clamp(floor(-log2(width)), 0.0, f32(MAX_DEPTH)));
-    var window: array<LitNode, 4>;
-    for (var l = 0u; l < levels; l++) {
-        let n = *top;
-        if (n == 0u || n > 4u) {
-            break;
-        }
-        for (var s = 0u; s < 4u; s++) {
-            if (s < n) {
-                window[s] = lit_stack[s];
-            }
-        }
-        *top = 0u;
-        for (var s = 0u; s < 4u; s++) {
-            if (s < n) {
-                visit_lit(window[s], center, inv, ext, keys, nc, acc, top);
-            }
-        }
-    }
 }
 
 // One node of the walk: nothing outside the footprint's box; its lit count inside the

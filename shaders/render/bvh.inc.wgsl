@@ -8,9 +8,7 @@
 //   var<storage, read> bvh_primitives: array<u32>;          // slot -> original triangle index
 //   var<storage, read> bvh_triangles: array<vec4<f32>>;     // slot -> 3 vertices (xyz, w unused)
 // (facet_render::bvh::GpuBvh holds the three buffers.) An empty scene is one zeroed node: it has
-// no children, so every ray misses. The includer also declares `override WG: u32`, its workgroup
-// size, and an entry point that wants its stack's top in workgroup memory (BVH_WG_STACK > 0) sets
-// `bvh_lane` to its local invocation index before tracing.
+// no children, so every ray misses.
 
 // obvhs's CwBvhNode, byte for byte (little endian). Worked example of the byte packing: child 5's
 // meta is byte 1 of child_meta[1], i.e. (child_meta[5 >> 2] >> (8 * (5 & 3))) & 0xff.
@@ -51,20 +49,8 @@ struct Hit {
 const BVH_MISS: u32 = 0xffffffffu;
 // obvhs cwbvh::node::EPSILON: nodes are clipped to t >= 1e-4 (it is not the triangles' tmin).
 const BVH_NODE_TMIN: f32 = 0.0001;
-#include "render/bvh_postpone.inc.wgsl"
-
 // obvhs TRAVERSAL_STACK_SIZE; CwBvh::validate asserts the depth stays below it.
 const BVH_STACK_SIZE: u32 = 32u;
-
-// The stack's first BVH_WG_STACK entries in workgroup memory rather than in the invocation's own
-// array (facet_render::trace::TraceVariant::wg_stack; 0, the default: none), entry e of lane l at
-// e * WG + l, so that a warp's lanes touch consecutive words. Used only by an invocation whose
-// entry point set bvh_lane: any other (a shading stage's shadow rays) keeps the whole stack its own.
-override BVH_WG_STACK: u32 = 0u;
-override BVH_WG_STACK_WORDS: u32 = max(1u, BVH_WG_STACK * WG);
-var<workgroup> bvh_wg_stack: array<vec2<u32>, BVH_WG_STACK_WORDS>;
-const BVH_NO_LANE: u32 = 0xffffffffu;
-var<private> bvh_lane: u32 = BVH_NO_LANE;
 
 // obvhs ray::safe_inverse: |x| <= f32::EPSILON (2^-23) -> signum(x) / EPSILON, where signum
 // reads the sign bit (signum(-0.0) = -1, unlike WGSL sign()).
@@ -153,27 +139,11 @@ fn bvh_intersect_triangle(slot: u32, origin: vec3<f32>, dir: vec3<f32>, tmax: f3
     return vec3<f32>(bitcast<f32>(0x7f800000u), 0.0, 0.0);
 }
 
-// Pushes `group`: entries below wg_depth in workgroup memory, the others in `stack`. A full
-// stack drops the group (obvhs asserts the depth stays below 32).
-fn bvh_push(stack: ptr<function, array<vec2<u32>, BVH_STACK_SIZE>>, sp: ptr<function, u32>,
-            wg_depth: u32, group: vec2<u32>) {
-    if (BVH_WG_STACK > 0u && *sp < wg_depth) {
-        bvh_wg_stack[*sp * WG + bvh_lane] = group;
-        *sp += 1u;
-    } else if (*sp < BVH_STACK_SIZE) {
-        (*stack)[*sp] = group;
-        *sp += 1u;
-    }
-}
-
 // The traversal of obvhs's traverse! macro. A group is (base index, bit mask): the node group's
 // mask holds the internal children still to visit in bits 24..31 (and the node's imask in bits
 // 0..7, for the relative index), the primitive group's the leaf primitive slots still to test.
 // any_hit: stop at the first primitive with t < tmax (ray_traverse_miss); otherwise shrink tmax
-// to each closer hit (ray_traverse). Returns the hit with the primitive SLOT in prim. Where
-// bvh_postpone says so (Ylitie et al. 2017's postponed triangle tests; never by default), a
-// primitive group goes onto the stack while nodes are left; popped, it is told from a node group
-// by its empty bits 24..31 (a node group is pushed only with children left there).
+// to each closer hit (ray_traverse). Returns the hit with the primitive SLOT in prim.
 fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: bool) -> Hit {
     // Deviation from obvhs (as facet_render::bvh::Bvh::ray): -0.0 becomes +0.0, or safe_inverse
     // (sign bit: -1/eps) and the slab order (d < 0: false) disagree and the ray misses every box
@@ -186,23 +156,12 @@ fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: boo
 
     var stack: array<vec2<u32>, BVH_STACK_SIZE>;
     var sp = 0u;
-    // Entries below this depth live in workgroup memory. (Each use of the workgroup stack or of
-    // postponing is behind a constant test, BVH_WG_STACK > 0u or BVH_POSTPONES, that leaves the
-    // default's traversal as it was once the compiler folds it.)
-    let wg_depth = select(0u, BVH_WG_STACK, BVH_WG_STACK > 0u && bvh_lane != BVH_NO_LANE);
     // Start with the root alone: bit 31 maps to slot 7 ^ octant with no imask bits below it, so
     // the relative index is 0.
     var current_group = vec2<u32>(0u, 0x80000000u);
     var primitive_group = vec2<u32>(0u, 0u);
-    let lanes = bvh_lanes();
 
     loop {
-        if (BVH_POSTPONES && primitive_group.y != 0u && bvh_postpone(lanes)) {
-            if ((current_group.y & 0xff000000u) != 0u && sp < BVH_STACK_SIZE) {
-                bvh_push(&stack, &sp, wg_depth, primitive_group);
-                primitive_group = vec2<u32>(0u, 0u);
-            }
-        }
         while (primitive_group.y != 0u) {
             let local = firstLeadingBit(primitive_group.y);
             primitive_group.y &= ~(1u << local);
@@ -223,7 +182,11 @@ fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: boo
             let child_bit = firstLeadingBit(hits_imask);
             current_group.y &= ~(1u << child_bit);
             if ((current_group.y & 0xff000000u) != 0u) {
-                bvh_push(&stack, &sp, wg_depth, current_group);
+                // A full stack drops the group (obvhs asserts the depth stays below 32).
+                if (sp < BVH_STACK_SIZE) {
+                    stack[sp] = current_group;
+                    sp += 1u;
+                }
             }
             // Undo the octant swizzle; the child's index is the number of internal siblings
             // in lower slots: child_base_idx + popcount(imask & ((1 << slot) - 1)).
@@ -242,15 +205,7 @@ fn bvh_traverse(origin: vec3<f32>, dir_in: vec3<f32>, tmax_in: f32, any_hit: boo
                 break;
             }
             sp -= 1u;
-            var popped = stack[sp];
-            if (BVH_WG_STACK > 0u && sp < wg_depth) {
-                popped = bvh_wg_stack[sp * WG + bvh_lane];
-            }
-            if (!BVH_POSTPONES || (popped.y & 0xff000000u) != 0u) {
-                current_group = popped;
-            } else {
-                primitive_group = popped;
-            }
+            current_group = stack[sp];
         }
     }
     return hit;

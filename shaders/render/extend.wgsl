@@ -7,38 +7,9 @@
 #include "render/bvh.inc.wgsl"
 #include "render/scene.inc.wgsl"
 
-// One thread per queued ray.
 @compute @workgroup_size(WG)
-fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
-          @builtin(local_invocation_index) lid: u32) {
-    bvh_lane = lid;
-    extend_slot(queue_slot(Q_EXTEND, thread_index(gid, nwg)));
-}
-
-// Persistent threads (facet_render::trace::TraceSchedule::Persistent, as trace.wgsl's): a capped
-// number of workgroups loops over the queue, each taking the next WG entries with one atomic add
-// on counters[Q_FETCH] (zeroed when the extend queue is closed). The paths' random numbers
-// depend on their pixel and sample, not on the thread: the image is the same.
-var<workgroup> batch_start: u32;
-
-@compute @workgroup_size(WG)
-fn extend_persistent(@builtin(local_invocation_index) lid: u32) {
-    bvh_lane = lid;
-    let n = sizes[Q_EXTEND];
-    loop {
-        if (lid == 0u) {
-            batch_start = atomicAdd(&counters[Q_FETCH], WG);
-        }
-        let start = workgroupUniformLoad(&batch_start);
-        if (start >= n) {
-            break;
-        }
-        extend_slot(queue_slot(Q_EXTEND, start + lid));
-    }
-}
-
-// The closest hit of the path in `slot` (0xffffffff: none, past the queue's end).
-fn extend_slot(slot: u32) {
+fn extend(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let slot = queue_slot(Q_EXTEND, thread_index(gid, nwg));
     if (slot == 0xffffffffu) {
         return;
     }

@@ -4,16 +4,13 @@
 // Path state: `paths` holds one vec4 region per field, W = frame.wavefront slots each:
 // region r of slot s is paths[r * W + s]. `info` is per slot (flags, next sample, depth, -).
 
-// The stage's workgroup size, from Rust: facet_render::stages::STAGE_WORKGROUP, the extend
-// stage's its facet_render::trace::TraceVariant's.
+// The stage's workgroup size, from Rust: facet_render::stages::STAGE_WORKGROUP.
 override WG: u32;
 
-// Queues, numbered from Rust (facet_render::queues::Queue), and the counter a persistent extend
-// stage takes its batches from (facet_render::queues::FETCH_COUNTER).
+// Queues, numbered from Rust (facet_render::queues::Queue).
 override Q_GEN: u32;
 override Q_EXTEND: u32;
 override Q_SHADOW: u32;
-override Q_FETCH: u32;
 
 // Path-state regions R_*, slot states SLOT_* (info.x), strategies STRATEGY_*.
 #include "render/tags.inc.wgsl"

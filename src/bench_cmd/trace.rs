@@ -1,54 +1,32 @@
 //! The trace section: closest- and any-hit rays a second through `trace.wgsl` against procedural
-//! scenes of the mode's sizes, camera and random rays. With `--variants` every
-//! [`TraceVariant`] is timed side by side: within each case the variants take turns run by run
-//! (one warm-up each first), so that a clock drifting during the section touches them alike.
-//! Each run is timed by the wall clock (submit to idle) and, where the adapter has timestamp
-//! queries, by GPU timestamps around its passes; rays a second come from the GPU's time then.
+//! scenes of the mode's sizes, camera and random rays, the median of the mode's runs after one
+//! warm-up. Each run is timed by the wall clock (submit to idle) and, where the adapter has
+//! timestamp queries, by GPU timestamps around its passes; rays a second come from the GPU's
+//! time then.
 
 use super::{Sizes, median};
 use anyhow::Result;
 use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
-use facet_render::StageVariants;
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
 use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, RayTracer, TraceBatch, TraceQuery, TraceVariant};
+use facet_render::trace::{GpuHit, RayTracer, TraceBatch, TraceQuery};
 use glam::Vec3;
 use serde_json::{Value, json};
 use std::time::Instant;
 
-/// Every [`TraceVariant`] `device` can run, each one it cannot named on the terminal.
-fn runnable_variants(device: &wgpu::Device) -> Vec<TraceVariant> {
-    let runnable = TraceVariant::runnable(device);
-    for v in TraceVariant::ALL.iter().filter(|v| !runnable.contains(v)) {
-        if let Err(e) = v.validate(device) {
-            println!("  not timed: {e}");
-        }
-    }
-    runnable
-}
-
 /// The section's rows, printed as they come.
-pub fn trace(gpu: &Gpu, sizes: &Sizes, all_variants: bool) -> Result<Value> {
+pub fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     let d = &gpu.device;
-    let variants = if all_variants {
-        runnable_variants(d)
-    } else {
-        vec![TraceVariant::DEFAULT]
-    };
-    let tracers = variants
-        .iter()
-        .map(|&v| RayTracer::with_variant(d, v))
-        .collect::<Result<Vec<_>, _>>()?;
+    let tracer = RayTracer::new(d)?;
     let n = sizes.rays.min(RayTracer::max_rays_per_dispatch(d) as u32);
     let hits = facet_gpu::buffer::storage_zeroed(d, "hits", n as u64 * size_of::<GpuHit>() as u64);
     let occluded = facet_gpu::buffer::storage_zeroed(d, "occluded", n as u64 * 4);
     let mut timer = GpuTimer::new(d, &gpu.queue, 1);
     let clock = if timer.is_some() { "gpu" } else { "wall" };
     println!(
-        "\ntrace: Mrays/s ({clock} clock), {n} rays a dispatch, median of {}, {} variant(s)",
-        sizes.runs,
-        variants.len()
+        "\ntrace: Mrays/s ({clock} clock), {n} rays a dispatch, median of {}",
+        sizes.runs
     );
     let mut rows = Vec::new();
     for &tris in sizes.triangles {
@@ -68,26 +46,20 @@ pub fn trace(gpu: &Gpu, sizes: &Sizes, all_variants: bool) -> Result<Value> {
                     query,
                     batch,
                 };
-                let times = case.time(gpu, &tracers, sizes.runs, timer.as_mut())?;
-                let base = times[0].rate(n);
-                for (tracer, t) in tracers.iter().zip(&times) {
-                    let rate = t.rate(n);
-                    let key = tracer.variant().key();
-                    let query = format!("{query:?}").to_lowercase();
-                    println!(
-                        "  {tris:>9} triangles {set:<7} {query:<8} {key:<30} {rate:>10.1} Mrays/s  {:>5.2}×   (wall {:.3} ms; BVH {} nodes, built in {:.0} ms)",
-                        rate / base,
-                        t.wall_ms,
-                        bvh.cwbvh.nodes.len(),
-                        bvh.build_ms
-                    );
-                    rows.push(json!({
-                        "triangles": tris, "rays": set, "query": query, "variant": key,
-                        "mrays_per_s": rate, "clock": clock, "ms": t.wall_ms, "gpu_ms": t.gpu_ms,
-                        "vs_default": rate / base,
-                        "bvh_nodes": bvh.cwbvh.nodes.len(), "bvh_build_ms": bvh.build_ms,
-                    }));
-                }
+                let t = case.time(gpu, &tracer, sizes.runs, timer.as_mut())?;
+                let rate = t.rate(n);
+                let query = format!("{query:?}").to_lowercase();
+                println!(
+                    "  {tris:>9} triangles {set:<7} {query:<8} {rate:>10.1} Mrays/s   (wall {:.3} ms; BVH {} nodes, built in {:.0} ms)",
+                    t.wall_ms,
+                    bvh.cwbvh.nodes.len(),
+                    bvh.build_ms
+                );
+                rows.push(json!({
+                    "triangles": tris, "rays": set, "query": query,
+                    "mrays_per_s": rate, "clock": clock, "ms": t.wall_ms, "gpu_ms": t.gpu_ms,
+                    "bvh_nodes": bvh.cwbvh.nodes.len(), "bvh_build_ms": bvh.build_ms,
+                }));
             }
         }
         gpu.check_lost()?;
@@ -120,7 +92,7 @@ struct Case<'a> {
     batch: TraceBatch<'a>,
 }
 
-/// The medians of one variant on one case.
+/// The medians of one case.
 struct Times {
     wall_ms: f64,
     /// `None` without timestamp queries.
@@ -135,34 +107,26 @@ impl Times {
 }
 
 impl Case<'_> {
-    /// Each tracer once untimed, then `runs` rounds of each in turn; the medians per tracer.
+    /// Once untimed, then `runs` times; the medians.
     fn time(
         &self,
         gpu: &Gpu,
-        tracers: &[RayTracer],
+        tracer: &RayTracer,
         runs: usize,
         mut timer: Option<&mut GpuTimer>,
-    ) -> Result<Vec<Times>> {
-        for tracer in tracers {
-            self.run(gpu, tracer, None)?;
-        }
-        let mut wall = vec![Vec::new(); tracers.len()];
-        let mut on_gpu = vec![Vec::new(); tracers.len()];
+    ) -> Result<Times> {
+        self.run(gpu, tracer, None)?;
+        let mut wall = Vec::new();
+        let mut on_gpu = Vec::new();
         for _ in 0..runs.max(1) {
-            for (k, tracer) in tracers.iter().enumerate() {
-                let (ms, passes) = self.run(gpu, tracer, timer.as_deref_mut())?;
-                wall[k].push(ms);
-                on_gpu[k].extend(passes);
-            }
+            let (ms, passes) = self.run(gpu, tracer, timer.as_deref_mut())?;
+            wall.push(ms);
+            on_gpu.extend(passes);
         }
-        Ok(wall
-            .iter_mut()
-            .zip(&mut on_gpu)
-            .map(|(w, g)| Times {
-                wall_ms: median(w),
-                gpu_ms: (!g.is_empty()).then(|| median(g)),
-            })
-            .collect())
+        Ok(Times {
+            wall_ms: median(&mut wall),
+            gpu_ms: (!on_gpu.is_empty()).then(|| median(&mut on_gpu)),
+        })
     }
 
     /// One submission of the query, waited for: its wall time (encoding to idle) and, when
@@ -197,109 +161,4 @@ impl Case<'_> {
         };
         Ok((wall, passes))
     }
-}
-
-/// The integrator with each [`StageVariants`] on the demo scene at the integrator section's
-/// size: without glints, the extend stage in every [`TraceVariant`]; with glints, the glint
-/// stage's queue unsorted and grouped by footprint class. Within each scene the variants take
-/// turns run by run after one warm-up each; Msamples/s of whole renders, against the scene's
-/// first (the default), and the time in one iteration of the stages a variant changes.
-pub fn stage_variants(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
-    let (w, h, spp) = sizes.render;
-    println!(
-        "\nstage variants: the demo at {w} × {h}, depth 5, {spp} spp, median of {}",
-        sizes.runs
-    );
-    let extend: Vec<StageVariants> = runnable_variants(&gpu.device)
-        .into_iter()
-        .map(|extend| StageVariants {
-            extend,
-            ..StageVariants::DEFAULT
-        })
-        .collect();
-    // The glint stage as it is, sorted, with the fixed-shape descent, and with both.
-    let sort = [(false, false), (true, false), (false, true), (true, true)].map(
-        |(sort_glints, glint_descent)| StageVariants {
-            sort_glints,
-            glint_descent,
-            ..StageVariants::DEFAULT
-        },
-    );
-    let mut rows = Vec::new();
-    for (glints, variants, stage) in [(false, &extend[..], "extend"), (true, &sort[..], "glint")] {
-        rows.extend(compare(gpu, sizes, glints, variants, stage)?);
-    }
-    Ok(Value::Array(rows))
-}
-
-/// One scene's rows of [`stage_variants`]; `stage` names the stages whose time is reported
-/// (those whose name contains it).
-fn compare(
-    gpu: &Gpu,
-    sizes: &Sizes,
-    glints: bool,
-    variants: &[StageVariants],
-    stage: &str,
-) -> Result<Vec<Value>> {
-    let (w, h, spp) = sizes.render;
-    let (image, sampling) = super::demo_render(sizes);
-    let (scene, env) = super::demo_scene(glints)?;
-    let config = facet_render::ResourceConfig::standard();
-    let res = facet_render::SceneResources::new(gpu, &scene, Some(&env), config)?;
-    let camera = facet_render::camera::CameraFrame::new(&scene.camera)?;
-    let mut runs = Vec::new();
-    for &v in variants {
-        let integrator = facet_render::Integrator::with_variants(&gpu.device, &res, v)?;
-        let wf = integrator.wavefront(gpu, &res, image)?;
-        runs.push((integrator, wf, Vec::new()));
-    }
-    // Round 0 warms up.
-    for round in 0..=sizes.runs.max(1) {
-        for (integrator, wf, ms) in &mut runs {
-            wf.clear(gpu);
-            let stats = integrator.render_more(gpu, wf, &camera, &sampling, &mut |_| {})?;
-            if round > 0 {
-                ms.push(stats.ms);
-            }
-        }
-    }
-    let mut rows = Vec::new();
-    let mut base = None;
-    for (integrator, wf, ms) in &mut runs {
-        let ms = median(ms);
-        let msps = w as f64 * h as f64 * spp as f64 / (ms * 1e3);
-        let base = *base.get_or_insert(msps);
-        let (times, clock) =
-            integrator.profile_iteration(gpu, wf, &camera, &sampling, sizes.stage_warm)?;
-        let stage_ms: f64 = times
-            .iter()
-            .filter(|t| t.stage.contains(stage))
-            .map(|t| t.ms)
-            .sum();
-        let v = integrator.variants();
-        let key = format!(
-            "extend {}, glints {}{}",
-            v.extend.key(),
-            if v.sort_glints { "sorted" } else { "unsorted" },
-            if v.glint_descent { ", descent" } else { "" }
-        );
-        println!(
-            "  {:<15} {key:<54} {msps:>10.2} Msamples/s  {:>5.2}×   ({ms:.0} ms a render; {stage} stages {stage_ms:.3} ms of one iteration, {clock:?})",
-            if glints {
-                "with glints"
-            } else {
-                "without glints"
-            },
-            msps / base,
-        );
-        rows.push(json!({
-            "glints": glints, "extend": v.extend.key(), "sort_glints": v.sort_glints,
-            "glint_descent": v.glint_descent,
-            "msamples_per_s": msps, "ms": ms, "vs_default": msps / base,
-            "stage": stage, "stage_iteration_ms": stage_ms,
-            "stage_clock": format!("{clock:?}").to_lowercase(),
-            "width": w, "height": h, "spp": spp, "depth": 5,
-        }));
-    }
-    Ok(rows)
 }

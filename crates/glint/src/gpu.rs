@@ -330,14 +330,7 @@ pub struct GlintCounter {
 impl GlintCounter {
     /// Builds the pipeline on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
-        Self::with_descent(device, false)
-    }
-
-    /// [`GlintCounter::new`] with walks that take their top levels breadth-first, four fixed
-    /// slots a level (WGSL `GLINT_DESCENT`, issue 51's fixed-shape descent): the same counts.
-    pub fn with_descent(device: &wgpu::Device, descent: bool) -> Result<Self, GpuError> {
-        let mut constants = flake_constants();
-        constants.push(("GLINT_DESCENT", u32::from(descent) as f64));
+        let constants = flake_constants();
         Ok(GlintCounter {
             pipeline: shader::compute_pipeline(
                 device,

@@ -317,8 +317,7 @@ fn sampling_estimates_the_albedo() {
 /// without blending the direction cells. Lit counts are integers drawn from the same hashes;
 /// f32 against f64 can still move a flake across the ellipse's edge or a uniform across a
 /// CDF step (about 1e-7 apart): stated budget, at most 0.1 % of the queries may differ (by more
-/// than 1e-4 relative), by at most 2 flakes per flake counted. The walk with the fixed-shape
-/// descent (its top 5 to 7 levels here breadth-first) gives the GPU's counts to the bit.
+/// than 1e-4 relative), by at most 2 flakes per flake counted.
 #[test]
 fn gpu_counts_match_cpu_counts() {
     let Some(gpu) = facet_gpu::gpu_for_tests("gpu_counts_match_cpu_counts") else {
@@ -328,7 +327,6 @@ fn gpu_counts_match_cpu_counts() {
     use facet_glint::glint_brdf::glint_count_at;
     use facet_glint::gpu::{GlintCounter, GlintQuery};
     let counter = GlintCounter::new(&gpu.device).unwrap();
-    let descent = GlintCounter::with_descent(&gpu.device, true).unwrap();
     let field = FlakeField {
         density: 3.0e5,
         seed: 21,
@@ -367,13 +365,12 @@ fn gpu_counts_match_cpu_counts() {
             }
             qs.push(GlintQuery::pair(&fp, p, coords));
         }
-        let counts = |c: &GlintCounter| -> Vec<f64> {
-            let pairs = c.count(&gpu, &field, &cfg, &qs).unwrap();
-            pairs.into_iter().flatten().collect()
-        };
-        let (g, by_descent) = (counts(&counter), counts(&descent));
-        let moved = g.iter().zip(&by_descent).filter(|(a, b)| a != b).count();
-        assert_eq!(moved, 0, "blend {blend}: the descent moved {moved} counts");
+        let g: Vec<f64> = counter
+            .count(&gpu, &field, &cfg, &qs)
+            .unwrap()
+            .into_iter()
+            .flatten()
+            .collect();
         let n = g.len();
         let differ = g
             .iter()

@@ -9,12 +9,6 @@
 use crate::error::GpuError;
 use std::sync::{Arc, Mutex};
 
-/// The optional features a device is asked for where its adapter has them: GPU timestamps
-/// (`facet bench`), and subgroup operations (the variants that use them, such as
-/// `facet_render::trace::TraceVariant::postpone`).
-pub const WANTED_FEATURES: wgpu::Features =
-    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::SUBGROUP);
-
 /// What chose the adapter.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct GpuOptions {
@@ -132,7 +126,7 @@ impl Gpu {
     pub fn with_options(opts: &GpuOptions) -> Result<Self, GpuError> {
         let adapter = best_adapter(opts)?;
         let info = adapter.get_info();
-        let features = adapter.features() & WANTED_FEATURES;
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let mut limits = adapter.limits();
         if let Some(cap) = opts.max_storage_binding {
             limits.max_storage_buffer_binding_size =
@@ -163,7 +157,7 @@ impl Gpu {
             device,
             queue,
             info,
-            timestamps: features.contains(wgpu::Features::TIMESTAMP_QUERY),
+            timestamps: !features.is_empty(),
             lost,
         })
     }
@@ -189,13 +183,12 @@ impl Gpu {
         }
     }
 
-    /// The device descriptor [`Gpu::new`] asks an adapter for: its own limits, and timestamp
-    /// queries and subgroup operations where it has them. For code that creates the device
-    /// itself (eframe).
+    /// The device descriptor [`Gpu::new`] asks an adapter for: its own limits and timestamp
+    /// queries where it has them. For code that creates the device itself (eframe).
     pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         wgpu::DeviceDescriptor {
             label: Some("facet"),
-            required_features: adapter.features() & WANTED_FEATURES,
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: adapter.limits(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,

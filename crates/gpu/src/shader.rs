@@ -8,15 +8,6 @@
 //! it uses without the includer's order mattering (WGSL declarations may come in any order).
 //! Constants shared with Rust are WGSL `override`s, set through [`compute_pipeline`]'s
 //! `constants`, or closed sets generated into a committed include ([`tags`](mod@crate::tags)).
-//!
-//! A variant that needs other code than the default, not only other constants, swaps one
-//! include for another when its pipeline is built ([`IncludeSwap`], [`expand_with`]), so that
-//! the default's source stays as it is. An `enable` directive may stand in an include: the
-//! expansion moves every one to its top, where WGSL wants them, once each. naga 30 does not
-//! parse `enable subgroups;` (it gates subgroup operations by capability), so the expansion
-//! keeps that one as the comment [`SUBGROUPS_ENABLED`]; a source that enables subgroups
-//! validates with naga's subgroup capabilities, and its pipelines need a device with
-//! `wgpu::Features::SUBGROUP`.
 
 use crate::error::GpuError;
 use std::collections::{HashMap, HashSet};
@@ -41,122 +32,56 @@ pub fn pipeline_files() -> impl Iterator<Item = &'static str> {
         .filter(|n| !n.ends_with(".inc.wgsl"))
 }
 
-/// `(from, to)`: wherever `#include "from"` stands, `to` is included instead.
-pub type IncludeSwap = (&'static str, &'static str);
-
 /// `name` with its includes expanded.
 pub fn expand(name: &str) -> Result<String, GpuError> {
-    expand_with(name, &[])
+    expand_from(name, &raw_source)
 }
 
-/// `name` with its includes expanded, `swaps` applied; an error where `name` does not reach an
-/// include that a swap replaces.
-pub fn expand_with(name: &str, swaps: &[IncludeSwap]) -> Result<String, GpuError> {
-    expand_from(name, swaps, &raw_source)
-}
-
-/// [`expand_with`] over the files `source` returns (the embedded `shaders/` for [`expand`]).
+/// [`expand`] over the files `source` returns (the embedded `shaders/` for [`expand`]).
 fn expand_from<'a>(
     name: &str,
-    swaps: &[IncludeSwap],
     source: &dyn Fn(&str) -> Option<&'a str>,
 ) -> Result<String, GpuError> {
-    let mut body = String::new();
+    let mut out = String::new();
     let mut seen = HashSet::new();
-    let mut expansion = Expansion {
-        source,
-        swaps,
-        seen: &mut seen,
+    expand_into(name, source, &mut out, &mut seen, 0)?;
+    Ok(out)
+}
+
+fn expand_into<'a>(
+    name: &str,
+    source: &dyn Fn(&str) -> Option<&'a str>,
+    out: &mut String,
+    seen: &mut HashSet<String>,
+    depth: usize,
+) -> Result<(), GpuError> {
+    let err = |message: String| GpuError::Shader {
+        name: name.to_owned(),
+        message,
     };
-    expansion.expand_into(name, &mut body, 0)?;
-    if let Some((gone, _)) = swaps.iter().find(|(f, _)| !seen.contains(*f)) {
-        return Err(GpuError::Shader {
-            name: name.to_owned(),
-            message: format!("includes no {gone} for a variant to swap"),
-        });
+    if depth > 16 {
+        return Err(err("includes nest deeper than 16".into()));
     }
-    Ok(hoist_directives(body))
-}
-
-/// `body` with its directives first, each once (`enable subgroups;` as [`SUBGROUPS_ENABLED`]).
-fn hoist_directives(body: String) -> String {
-    let mut directives = Vec::new();
-    let mut rest = String::with_capacity(body.len());
-    for line in body.lines() {
-        if is_directive(line) {
-            let d = match line.trim() {
-                "enable subgroups;" => SUBGROUPS_ENABLED,
-                other => other,
-            };
-            if !directives.contains(&d) {
-                directives.push(d);
+    if !seen.insert(name.to_owned()) {
+        return Ok(());
+    }
+    let src = source(name).ok_or_else(|| err("no such file under shaders/".into()))?;
+    for line in src.lines() {
+        match line.trim().strip_prefix("#include") {
+            Some(rest) => {
+                let inc = rest.trim().trim_matches('"');
+                expand_into(inc, source, out, seen, depth + 1).map_err(|e| match e {
+                    GpuError::Shader { name: n, message } => err(format!("in {n}: {message}")),
+                    other => other,
+                })?;
             }
-        } else {
-            rest.push_str(line);
-            rest.push('\n');
-        }
-    }
-    if directives.is_empty() {
-        return body;
-    }
-    directives.join("\n") + "\n" + &rest
-}
-
-/// What an expansion keeps of `enable subgroups;`, at its top.
-pub const SUBGROUPS_ENABLED: &str = "// enable subgroups; (naga 30: by capability)";
-
-/// A WGSL global directive (`enable …;`, `requires …;`) on a line of its own.
-fn is_directive(line: &str) -> bool {
-    let l = line.trim();
-    (l.starts_with("enable ") || l.starts_with("requires ")) && l.ends_with(';')
-}
-
-/// The state of one expansion: where files come from, the swaps, the files reached.
-struct Expansion<'s, 'a> {
-    source: &'s dyn Fn(&str) -> Option<&'a str>,
-    swaps: &'s [IncludeSwap],
-    /// Every file reached, and every include a swap replaced, by its own name.
-    seen: &'s mut HashSet<String>,
-}
-
-impl Expansion<'_, '_> {
-    fn expand_into(&mut self, name: &str, out: &mut String, depth: usize) -> Result<(), GpuError> {
-        let err = |message: String| GpuError::Shader {
-            name: name.to_owned(),
-            message,
-        };
-        if depth > 16 {
-            return Err(err("includes nest deeper than 16".into()));
-        }
-        if !self.seen.insert(name.to_owned()) {
-            return Ok(());
-        }
-        let src = (self.source)(name).ok_or_else(|| err("no such file under shaders/".into()))?;
-        for line in src.lines() {
-            match line.trim().strip_prefix("#include") {
-                Some(rest) => {
-                    let inc = rest.trim().trim_matches('"');
-                    let swapped = self.swaps.iter().find(|(from, _)| *from == inc);
-                    let inc = match swapped {
-                        Some(&(from, to)) => {
-                            self.seen.insert(from.to_owned());
-                            to
-                        }
-                        None => inc,
-                    };
-                    self.expand_into(inc, out, depth + 1).map_err(|e| match e {
-                        GpuError::Shader { name: n, message } => err(format!("in {n}: {message}")),
-                        other => other,
-                    })?;
-                }
-                None => {
-                    out.push_str(line);
-                    out.push('\n');
-                }
+            None => {
+                out.push_str(line);
+                out.push('\n');
             }
         }
-        Ok(())
     }
+    Ok(())
 }
 
 /// The naga capabilities of a WebGPU-core device: what wgpu grants a device with no optional
@@ -180,39 +105,10 @@ pub fn validate(name: &str, source: &str) -> Result<naga::Module, GpuError> {
     };
     let module =
         naga::front::wgsl::parse_str(source).map_err(|e| fail(e.emit_to_string(source)))?;
-    let mut validator = if enables_subgroups(source) {
-        let mut v = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            WEBGPU_CORE | naga::valid::Capabilities::SUBGROUP,
-        );
-        v.subgroup_stages(naga::valid::ShaderStages::COMPUTE)
-            .subgroup_operations(SUBGROUP_OPERATIONS);
-        v
-    } else {
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), WEBGPU_CORE)
-    };
-    validator
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), WEBGPU_CORE)
         .validate(&module)
         .map_err(|e| fail(e.emit_to_string(source)))?;
     Ok(module)
-}
-
-/// The subgroup operations a device with `wgpu::Features::SUBGROUP` has (wgpu grants the
-/// feature only with all of them).
-const SUBGROUP_OPERATIONS: naga::valid::SubgroupOperationSet =
-    naga::valid::SubgroupOperationSet::BASIC
-        .union(naga::valid::SubgroupOperationSet::VOTE)
-        .union(naga::valid::SubgroupOperationSet::ARITHMETIC)
-        .union(naga::valid::SubgroupOperationSet::BALLOT)
-        .union(naga::valid::SubgroupOperationSet::SHUFFLE)
-        .union(naga::valid::SubgroupOperationSet::SHUFFLE_RELATIVE);
-
-/// Whether expanded WGSL `source` enables subgroup operations.
-pub fn enables_subgroups(source: &str) -> bool {
-    source
-        .lines()
-        .take_while(|l| is_directive(l) || *l == SUBGROUPS_ENABLED)
-        .any(|l| l == SUBGROUPS_ENABLED)
 }
 
 /// A compute pipeline for entry point `entry` of shader file `name`, with override constants.
@@ -234,26 +130,8 @@ pub fn compute_pipeline_with_layout(
     layout: Option<&wgpu::PipelineLayout>,
     constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, GpuError> {
-    compute_pipeline_variant(device, name, &[], entry, layout, constants)
-}
-
-/// [`compute_pipeline_with_layout`] of a variant that swaps includes ([`expand_with`]); an
-/// error, not wgpu's panic, where its source enables subgroups and `device` has none.
-pub fn compute_pipeline_variant(
-    device: &wgpu::Device,
-    name: &str,
-    swaps: &[IncludeSwap],
-    entry: &str,
-    layout: Option<&wgpu::PipelineLayout>,
-    constants: &[(&str, f64)],
-) -> Result<wgpu::ComputePipeline, GpuError> {
-    let source = expand_with(name, swaps)?;
+    let source = expand(name)?;
     validate(name, &source)?;
-    if enables_subgroups(&source) && !device.features().contains(wgpu::Features::SUBGROUP) {
-        return Err(GpuError::Validation(format!(
-            "{name} ({entry}) with {swaps:?} uses subgroup operations, which the device lacks"
-        )));
-    }
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -341,56 +219,9 @@ mod tests {
 
     /// Expands `name` over in-memory (name, text) files.
     fn expand_files(name: &str, files: &[(&str, &str)]) -> Result<String, GpuError> {
-        expand_swapped(name, &[], files)
-    }
-
-    /// [`expand_files`] with `swaps`.
-    fn expand_swapped(
-        name: &str,
-        swaps: &[IncludeSwap],
-        files: &[(&str, &str)],
-    ) -> Result<String, GpuError> {
-        expand_from(name, swaps, &|n: &str| {
+        expand_from(name, &|n: &str| {
             files.iter().find(|(f, _)| *f == n).map(|(_, s)| *s)
         })
-    }
-
-    /// The swapped include comes wherever the original stood, as often as it would have (once),
-    /// and the original is not read; `enable` directives, from any file, move to the top once.
-    #[test]
-    fn a_swap_replaces_an_include_and_directives_go_first() {
-        let files = [
-            (
-                "main.wgsl",
-                "#include \"a.inc.wgsl\"\n#include \"x.inc.wgsl\"\n#include \"x.inc.wgsl\"\nmain",
-            ),
-            (
-                "a.inc.wgsl",
-                "enable subgroups;\n#include \"x.inc.wgsl\"\na",
-            ),
-            ("x.inc.wgsl", "x"),
-            ("y.inc.wgsl", "enable subgroups;\ny"),
-        ];
-        let plain = expand_files("main.wgsl", &files).unwrap();
-        let top = SUBGROUPS_ENABLED;
-        assert_eq!(plain, format!("{top}\nx\na\nmain\n"));
-        let swapped = expand_swapped("main.wgsl", &[("x.inc.wgsl", "y.inc.wgsl")], &files).unwrap();
-        assert_eq!(swapped, format!("{top}\ny\na\nmain\n"));
-        assert!(enables_subgroups(&swapped));
-        assert!(!enables_subgroups("// enable subgroups;\nfn f() {}"));
-        assert!(!enables_subgroups(&format!("fn f() {{}}\n{top}")));
-        assert!(!enables_subgroups("enable f16;\nfn f() {}"));
-    }
-
-    /// A swap of an include the file never reaches is an error naming both: a variant that
-    /// would silently build the default.
-    #[test]
-    fn a_swap_of_an_include_not_reached_is_an_error() {
-        let files = [("main.wgsl", "main"), ("y.inc.wgsl", "y")];
-        let e = expand_swapped("main.wgsl", &[("x.inc.wgsl", "y.inc.wgsl")], &files).unwrap_err();
-        let (name, message) = shader_error(e);
-        assert_eq!(name, "main.wgsl");
-        assert!(message.contains("x.inc.wgsl"), "{message}");
     }
 
     fn shader_error(e: GpuError) -> (String, String) {

@@ -17,10 +17,9 @@ use crate::config::{ImageConfig, RenderConfig, SampleConfig};
 use crate::error::RenderError;
 use crate::gpu_types::GpuFrame;
 use crate::output::film::Image;
-use crate::queues::{COUNTERS, FETCH_COUNTER, GLINT_SORT_KEYS, Queue, SORT_COUNTERS};
+use crate::queues::Queue;
 use crate::resources::SceneResources;
 use crate::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};
-use crate::trace::{TraceSchedule, TraceVariant};
 use crate::wavefront::Wavefront;
 use facet_gpu::timer::GpuTimer;
 use facet_gpu::{Gpu, GpuError};
@@ -99,78 +98,18 @@ pub struct Integrator {
     n_queues: u32,
     /// Workgroup size of the stages dispatched over every slot.
     wg: u32,
-    /// The variants its stages were built in.
-    variants: StageVariants,
-}
-
-/// How the integrator's stages schedule their work: variants chosen when its pipelines are
-/// built, each rendering the default's image to the bit at another speed (`facet bench
-/// --variants` times them side by side).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct StageVariants {
-    /// How the extend stage hands rays to threads (its workgroup size; persistent threads).
-    pub extend: TraceVariant,
-    /// Group each glint stage's queue by footprint class before shading (a counting sort), so
-    /// that a warp walks footprints of alike size.
-    pub sort_glints: bool,
-    /// Walk each glint footprint's top levels breadth-first, four fixed slots a level, before
-    /// the depth-first walk (WGSL `GLINT_DESCENT`): the same counts, another loop shape.
-    pub glint_descent: bool,
-}
-
-impl StageVariants {
-    /// What every renderer uses.
-    pub const DEFAULT: StageVariants = StageVariants {
-        extend: TraceVariant::DEFAULT,
-        sort_glints: false,
-        glint_descent: false,
-    };
 }
 
 impl Integrator {
     /// The pipelines for the material classes of `scene`.
     pub fn new(device: &wgpu::Device, scene: &SceneResources) -> Result<Self, RenderError> {
-        Self::with_variants(device, scene, StageVariants::DEFAULT)
-    }
-
-    /// [`Integrator::new`] with its stages scheduled as `variants` says: the same image, at
-    /// another speed.
-    pub fn with_variants(
-        device: &wgpu::Device,
-        scene: &SceneResources,
-        variants: StageVariants,
-    ) -> Result<Self, RenderError> {
-        let extend = variants.extend;
-        extend.validate(device)?;
         let layouts = Layouts::new(device);
         let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
             Stage::new(device, &layouts, file, entry, queue, extra)
         };
-        let shade = shading_stages(device, &layouts, scene, variants)?;
+        let shade = shading_stages(device, &layouts, scene)?;
         let n_queues = Queue::count(scene.glints.len() as u32);
         let wg = STAGE_WORKGROUP;
-        let extend_wg = extend.constants();
-        let (extend_entry, extend_close) = match extend.schedule {
-            TraceSchedule::PerRay => ("extend", Vec::new()),
-            TraceSchedule::Persistent { groups } => (
-                "extend_persistent",
-                vec![
-                    ("MAX_GROUPS", groups as f64),
-                    ("ZERO_FIRST", FETCH_COUNTER as f64),
-                    ("ZERO_COUNT", 1.0),
-                ],
-            ),
-        };
-        // The glint stages' histograms start from 0 at every iteration.
-        let shade_close = [
-            ("ZERO_FIRST", SORT_COUNTERS as f64),
-            ("ZERO_COUNT", (COUNTERS - SORT_COUNTERS) as f64),
-        ];
-        let shade_close = if variants.sort_glints {
-            &shade_close[..]
-        } else {
-            &[]
-        };
         Ok(Integrator {
             logic: stage("render/logic.wgsl", "logic", None, &[])?,
             generate: stage(
@@ -179,45 +118,23 @@ impl Integrator {
                 Some(Queue::Generate),
                 &[],
             )?,
-            extend: Stage::swapping(
-                device,
-                &layouts,
-                "render/extend.wgsl",
-                extend.swaps(),
-                extend_entry,
-                Some(Queue::Extend),
-                &extend_wg,
-            )?,
+            extend: stage("render/extend.wgsl", "extend", Some(Queue::Extend), &[])?,
             connect: stage("render/connect.wgsl", "connect", Some(Queue::Shadow), &[])?,
-            close_gen: queue_args(device, &layouts, Queue::Generate.index(), 1, wg, &[])?,
-            close_extend: queue_args(
-                device,
-                &layouts,
-                Queue::Extend.index(),
-                1,
-                extend.workgroup,
-                &extend_close,
-            )?,
+            close_gen: queue_args(device, &layouts, Queue::Generate.index(), 1, wg)?,
+            close_extend: queue_args(device, &layouts, Queue::Extend.index(), 1, wg)?,
             close_shade: queue_args(
                 device,
                 &layouts,
                 Queue::Diffuse.index(),
                 n_queues - Queue::Diffuse.index(),
                 wg,
-                shade_close,
             )?,
-            close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg, &[])?,
+            close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg)?,
             shade,
             layouts,
             n_queues,
             wg,
-            variants,
         })
-    }
-
-    /// The variants its stages were built in.
-    pub fn variants(&self) -> StageVariants {
-        self.variants
     }
 
     /// Names of the stages built (shading stages once per class).
@@ -526,8 +443,7 @@ impl Integrator {
         each("close shade", &mut |p| close(p, &self.close_shade));
         for s in &self.shade {
             let name = match s.queue {
-                Some(Queue::Glint(k)) if s.name == "shade_glint" => format!("shade glint {k}"),
-                Some(Queue::Glint(k)) => format!("{} {k}", s.name.replace('_', " ")),
+                Some(Queue::Glint(k)) => format!("shade glint {k}"),
                 Some(q) => format!("shade {}", q.class_name()),
                 None => s.name.to_string(),
             };
@@ -538,14 +454,11 @@ impl Integrator {
     }
 }
 
-/// The shading stages of `scene`'s material classes, in queue order: one per class, and for a
-/// glint material with `variants.sort_glints` the three passes that group its queue by
-/// footprint class before the one that shades it.
+/// The shading stages of `scene`'s material classes, in queue order: one per class.
 fn shading_stages(
     device: &wgpu::Device,
     layouts: &Layouts,
     scene: &SceneResources,
-    variants: StageVariants,
 ) -> Result<Vec<Stage>, GpuError> {
     let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
         Stage::new(device, layouts, file, entry, queue, extra)
@@ -572,25 +485,15 @@ fn shading_stages(
                 Some(q),
                 &q_shade,
             )?),
-            Queue::Glint(k) => {
+            Queue::Glint(_) => {
                 let mut c = facet_glint::gpu::flake_constants();
                 c.push(q_shade[0]);
-                c.push(("Q_SORT", (SORT_COUNTERS + k * GLINT_SORT_KEYS) as f64));
-                c.push(("GLINT_SORT_KEYS", GLINT_SORT_KEYS as f64));
-                c.push(("GLINT_DESCENT", u32::from(variants.glint_descent) as f64));
-                let entries: &[&'static str] = if variants.sort_glints {
-                    &[
-                        "glint_histogram",
-                        "glint_offsets",
-                        "glint_scatter",
-                        "shade_glint_sorted",
-                    ]
-                } else {
-                    &["shade_glint"]
-                };
-                for &entry in entries {
-                    shade.push(stage("render/shade_glint.wgsl", entry, Some(q), &c)?);
-                }
+                shade.push(stage(
+                    "render/shade_glint.wgsl",
+                    "shade_glint",
+                    Some(q),
+                    &c,
+                )?);
             }
             _ => {}
         }

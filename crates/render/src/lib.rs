@@ -53,7 +53,7 @@ pub use error::RenderError;
 pub use facet_gpu::{Gpu, GpuError};
 /// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
 pub use glam;
-pub use integrator::{Integrator, RenderStats, StageClock, StageTime, StageVariants};
+pub use integrator::{Integrator, RenderStats, StageClock, StageTime};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
 pub use output::film::Image;

@@ -4,21 +4,6 @@
 /// The most glint materials one scene may have (one queue and one shading dispatch each).
 pub const MAX_GLINT_MATERIALS: u32 = 8;
 
-/// The counter after every queue's: a persistent extend stage takes its batches from it
-/// ([`crate::trace::TraceSchedule::Persistent`]; zeroed when the extend queue is closed).
-pub const FETCH_COUNTER: u32 = Queue::count(MAX_GLINT_MATERIALS);
-
-/// Footprint classes of the glint stage's grouping ([`crate::StageVariants::sort_glints`]):
-/// the path's last bounce, then octaves of the flakes under the footprint.
-pub const GLINT_SORT_KEYS: u32 = 16;
-
-/// The first counter of glint material 0's footprint histogram; material k's follow at
-/// k × [`GLINT_SORT_KEYS`] (zeroed when the shading queues are closed).
-pub const SORT_COUNTERS: u32 = FETCH_COUNTER + 1;
-
-/// How many counters a wavefront holds: every queue's, the fetch counter, the histograms.
-pub const COUNTERS: u32 = SORT_COUNTERS + MAX_GLINT_MATERIALS * GLINT_SORT_KEYS;
-
 /// A queue; its index is the WGSL queue number.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Queue {
@@ -75,13 +60,12 @@ impl Queue {
         8 + glints
     }
 
-    /// Override constants naming the fixed queues and [`FETCH_COUNTER`] in WGSL.
-    pub fn constants() -> [(&'static str, f64); 4] {
+    /// Override constants naming the fixed queues in WGSL.
+    pub fn constants() -> [(&'static str, f64); 3] {
         [
             ("Q_GEN", Queue::Generate.index() as f64),
             ("Q_EXTEND", Queue::Extend.index() as f64),
             ("Q_SHADOW", Queue::Shadow.index() as f64),
-            ("Q_FETCH", FETCH_COUNTER as f64),
         ]
     }
 }

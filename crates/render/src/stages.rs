@@ -5,11 +5,9 @@
 
 use crate::bindings::{Group, pipeline_groups};
 use crate::queues::Queue;
-use facet_gpu::shader::IncludeSwap;
 use facet_gpu::{GpuError, shader};
 
-/// Threads per workgroup of every stage (WGSL override `WG`), but the extend stage's, which
-/// its [`crate::trace::TraceVariant`] sets.
+/// Threads per workgroup of every stage (WGSL override `WG`).
 pub const STAGE_WORKGROUP: u32 = 64;
 
 /// Bind group layouts shared by every stage, one per [`Group`].
@@ -52,7 +50,6 @@ pub struct Stage {
 fn pipeline(
     device: &wgpu::Device,
     file: &str,
-    swaps: &[IncludeSwap],
     entry: &str,
     groups: &[&wgpu::BindGroupLayout],
     constants: &[(&str, f64)],
@@ -66,8 +63,7 @@ fn pipeline(
         bind_group_layouts: &groups,
         immediate_size: 0,
     });
-    let built =
-        shader::compute_pipeline_variant(device, file, swaps, entry, Some(&layout), constants);
+    let built = shader::compute_pipeline_with_layout(device, file, entry, Some(&layout), constants);
     if let Some(e) = pollster::block_on(scope.pop()) {
         return Err(GpuError::Validation(format!(
             "the adapter cannot build the render stage {entry}: {e}"
@@ -86,55 +82,37 @@ impl Stage {
         queue: Option<Queue>,
         extra_constants: &[(&str, f64)],
     ) -> Result<Stage, GpuError> {
-        Self::swapping(device, layouts, file, &[], entry, queue, extra_constants)
-    }
-
-    /// [`Stage::new`] with the includes a variant swaps.
-    pub fn swapping(
-        device: &wgpu::Device,
-        layouts: &Layouts,
-        file: &str,
-        swaps: &[IncludeSwap],
-        entry: &'static str,
-        queue: Option<Queue>,
-        extra_constants: &[(&str, f64)],
-    ) -> Result<Stage, GpuError> {
-        // `extra_constants` come last: a WG there replaces the default.
         let mut constants: Vec<(&str, f64)> = Queue::constants().to_vec();
         constants.push(("WG", STAGE_WORKGROUP as f64));
         constants.extend_from_slice(extra_constants);
         let groups = layouts.of_pipeline(file)?;
         Ok(Stage {
             name: entry,
-            pipeline: pipeline(device, file, swaps, entry, &groups, &constants)?,
+            pipeline: pipeline(device, file, entry, &groups, &constants)?,
             queue,
         })
     }
 }
 
 /// `queue_args.wgsl` for queues [first, first + count), consumed by stages of `stage_wg`
-/// threads a workgroup; `extra_constants` (`MAX_GROUPS`, `FETCH`) for a persistent consumer.
+/// threads a workgroup.
 pub fn queue_args(
     device: &wgpu::Device,
     layouts: &Layouts,
     first: u32,
     count: u32,
     stage_wg: u32,
-    extra_constants: &[(&str, f64)],
 ) -> Result<wgpu::ComputePipeline, GpuError> {
     let file = "render/queue_args.wgsl";
-    let mut constants = vec![
-        ("FIRST", first as f64),
-        ("COUNT", count as f64),
-        ("STAGE_WG", stage_wg as f64),
-    ];
-    constants.extend_from_slice(extra_constants);
     pipeline(
         device,
         file,
-        &[],
         "queue_args",
         &layouts.of_pipeline(file)?,
-        &constants,
+        &[
+            ("FIRST", first as f64),
+            ("COUNT", count as f64),
+            ("STAGE_WG", stage_wg as f64),
+        ],
     )
 }

@@ -12,7 +12,6 @@ use crate::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
 use crate::limits::{DeviceLimits, Planned, product};
 use crate::output::film::{Image, to_f32_saturated};
 use crate::output::tonemap::ToneMap;
-use crate::queues::{COUNTERS, FETCH_COUNTER};
 use crate::resources::SceneResources;
 use crate::stages::Layouts;
 use crate::tags::SlotState;
@@ -297,17 +296,12 @@ impl Buffers {
         let d = &gpu.device;
         let pixels = image.width as u64 * image.height as u64;
         let (w, nq) = (slots as u64, n_queues as u64);
-        debug_assert!(
-            n_queues <= FETCH_COUNTER,
-            "the fetch counter follows every queue"
-        );
         let film_sq_bytes = if moments { pixels * 16 } else { 16 };
         let buffers = gpu.scoped(|| Buffers {
             frame: buffer::uniform(d, "frame", &GpuFrame::default()),
             paths: buffer::storage_zeroed(d, "paths", PATH_REGIONS * w * 16),
             info: buffer::storage_zeroed(d, "path info", w * 16),
-            // Every queue's, then the persistent extend stage's and the glint histograms.
-            counters: buffer::storage_zeroed(d, "queue counters", COUNTERS as u64 * 4),
+            counters: buffer::storage_zeroed(d, "queue counters", nq * 4),
             sizes: buffer::storage_zeroed(d, "queue sizes", nq * 4),
             args: d.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("queue dispatch args"),

@@ -9,7 +9,7 @@
 
 use facet_render::bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh};
 use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, GpuRay, RayTracer, STACK_ENTRIES, TraceVariant};
+use facet_render::trace::{GpuHit, GpuRay, RayTracer};
 use glam::Vec3;
 
 fn scene_bvh(triangles: usize, config: BvhConfig) -> (procedural::Mesh, Bvh) {
@@ -261,8 +261,7 @@ fn gpu_matches_cpu(
     let cpu: Vec<_> = rays.iter().map(|r| cpu_closest(bvh, r)).collect();
     let cpu_s = start.elapsed().as_secs_f64();
     println!(
-        "{label}, {}: {} triangles, {} rays: GPU {:.2} Mrays/s ({}), CPU {:.2} Mrays/s",
-        tracer.variant().key(),
+        "{label}: {} triangles, {} rays: GPU {:.2} Mrays/s ({}), CPU {:.2} Mrays/s",
         bvh.triangles.len(),
         rays.len(),
         rays.len() as f64 / gpu_s * 1e-6,
@@ -363,58 +362,18 @@ fn gpu_traversal_matches_obvhs() {
     gpu_matches_cpu(&gpu, &tracer, &split, &rays, "very slow (pre-split)");
 }
 
-/// Every traversal variant the bench times gives obvhs's hits: the workgroup sizes, and
-/// persistent threads with as many workgroups as the bench launches (here more than the
-/// batches: one batch each) and with 3 and 1 (each loops over many batches); one of them split
-/// into dispatches of 4096 rays, so that the ray counter must start again at each. The stack
-/// partly in workgroup memory also with 1 and 2 entries there, so that most pushes go past them
-/// (the tree is 7 levels deep; a descent pushes at most once a level). Triangle tests postponed
-/// below 100 % of a subgroup: whenever a lane of it has none, so that triangle groups go onto
-/// the stack, its workgroup part too, and come back off it; closest hits may then take another
-/// of two triangles at the same t (a tie, which the comparison allows).
+/// A batch split into dispatches of 4096 rays gives obvhs's hits, and one encode over several
+/// dispatches in one encoder gives the same hits as the batches, one submission each.
 #[test]
-fn every_trace_variant_matches_obvhs() {
-    let Some(gpu) = facet_gpu::gpu_for_tests("every_trace_variant_matches_obvhs") else {
+fn a_batch_split_into_dispatches_matches_obvhs() {
+    let Some(gpu) = facet_gpu::gpu_for_tests("a_batch_split_into_dispatches_matches_obvhs") else {
         return;
     };
-    let d = &gpu.device;
+    let (d, q) = (&gpu.device, &gpu.queue);
     let (_, bvh) = scene_bvh(50_000, BvhConfig::medium());
     let rays = ray_set((96, 64), 12_000, 13);
-    let few = [
-        TraceVariant::persistent(32, 3),
-        TraceVariant::persistent(64, 1),
-        TraceVariant::per_ray(64).with_wg_stack(2),
-        TraceVariant::persistent(32, 3).with_wg_stack(1),
-        TraceVariant::per_ray(64).with_postpone(100),
-        TraceVariant::persistent(32, 3)
-            .with_wg_stack(1)
-            .with_postpone(100),
-    ];
-    let all: Vec<TraceVariant> = TraceVariant::ALL.into_iter().chain(few).collect();
-    let runnable: Vec<TraceVariant> = all
-        .iter()
-        .copied()
-        .filter(|v| v.validate(d).is_ok())
-        .collect();
-    if runnable.len() < all.len() {
-        // Only the postponing variants may be missing, on a device without subgroups.
-        assert!(!d.features().contains(wgpu::Features::SUBGROUP));
-        println!(
-            "no subgroups: {} variants not run",
-            all.len() - runnable.len()
-        );
-    }
-    for variant in runnable {
-        let tracer = RayTracer::with_variant(d, variant).unwrap();
-        gpu_matches_cpu(&gpu, &tracer, &bvh, &rays, "medium");
-    }
-    let split = RayTracer::with_variant(d, TraceVariant::persistent(32, 3))
-        .unwrap()
-        .with_rays_per_dispatch(4096);
+    let split = RayTracer::new(d).unwrap().with_rays_per_dispatch(4096);
     gpu_matches_cpu(&gpu, &split, &bvh, &rays, "medium, 4096 rays a dispatch");
-    // One encode over several dispatches, the counter cleared between them in one encoder: the
-    // same hits as the batches above, one submission each.
-    let q = &gpu.queue;
     let gpu_bvh = GpuBvh::upload(d, &bvh).unwrap();
     let ray_buf = facet_gpu::buffer::storage(d, "rays", &rays);
     let hit_buf = facet_gpu::buffer::storage_zeroed(d, "hits", (rays.len() * 16) as u64);
@@ -432,34 +391,6 @@ fn every_trace_variant_matches_obvhs() {
     let batched = split.trace_closest(d, q, &gpu_bvh, &rays).unwrap();
     let differ = once.iter().zip(&batched).filter(|(a, b)| a != b).count();
     assert_eq!(differ, 0, "of {} rays", rays.len());
-}
-
-/// A variant the device cannot run is refused with its name, not built.
-#[test]
-fn a_trace_variant_past_the_device_limit_is_refused() {
-    let Some(gpu) = facet_gpu::gpu_for_tests("a_trace_variant_past_the_device_limit_is_refused")
-    else {
-        return;
-    };
-    let too_wide =
-        TraceVariant::per_ray(gpu.device.limits().max_compute_invocations_per_workgroup + 1);
-    let e = RayTracer::with_variant(&gpu.device, too_wide)
-        .err()
-        .expect("refused");
-    assert!(e.to_string().contains(&too_wide.key()), "{e}");
-    let none = TraceVariant::persistent(32, 0);
-    assert!(RayTracer::with_variant(&gpu.device, none).is_err());
-    let deep = TraceVariant::per_ray(32).with_wg_stack(STACK_ENTRIES + 1);
-    assert!(RayTracer::with_variant(&gpu.device, deep).is_err());
-    let over = TraceVariant::per_ray(32).with_postpone(101);
-    assert!(RayTracer::with_variant(&gpu.device, over).is_err());
-    // The whole stack of every thread of the widest workgroup: past any device's shared memory.
-    let max = gpu.device.limits().max_compute_invocations_per_workgroup;
-    let big = TraceVariant::per_ray(max).with_wg_stack(STACK_ENTRIES);
-    let e = RayTracer::with_variant(&gpu.device, big)
-        .err()
-        .expect("refused");
-    assert!(e.to_string().contains("workgroup memory"), "{e}");
 }
 
 #[test]

@@ -11,10 +11,8 @@ use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
 use facet_render::camera::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, GlintParams, Material, Scene};
-use facet_render::trace::TraceVariant;
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
-    StageVariants,
 };
 use glam::{DVec3, Vec3};
 use std::sync::{Arc, OnceLock};
@@ -442,94 +440,6 @@ fn same_seed_same_image() {
     assert_eq!(a.pixels, b.pixels);
     assert_ne!(a.pixels, other.pixels);
     assert!(a.samples.iter().all(|&s| s == 4));
-}
-
-/// The extend stage's variants (workgroup sizes; persistent threads with as many workgroups as
-/// the bench launches, and with 2, each looping over the queue) render the default's image to the
-/// bit: a path's random numbers depend on its pixel and sample, never on its thread. Several
-/// tiles of many iterations each, so that the fetch counter must restart at every one.
-#[test]
-fn extend_variants_render_the_same_image() {
-    let Some(gpu) = gpu_for_tests("extend_variants_render_the_same_image") else {
-        return;
-    };
-    let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let scene = sphere_scene(facet_material(ModelChoice::Tabulated, None));
-    let mut c = config(2);
-    c.image.wavefront = 1000; // several tiles
-    let (reference, _, _) = render(&gpu, &scene, &env, ResourceConfig::standard(), c);
-    let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
-    let camera = CameraFrame::new(&scene.camera).unwrap();
-    let variants = TraceVariant::runnable(&gpu.device).into_iter().skip(1);
-    for v in variants.chain([TraceVariant::persistent(32, 2)]) {
-        let variants = StageVariants {
-            extend: v,
-            ..StageVariants::DEFAULT
-        };
-        let integrator = Integrator::with_variants(&gpu.device, &res, variants).unwrap();
-        assert_eq!(integrator.variants(), variants);
-        let (image, _) = integrator
-            .render(&gpu, &res, &camera, &c, &mut |_| {})
-            .unwrap();
-        assert!(image.pixels == reference.pixels, "{}", v.key());
-    }
-}
-
-/// The glint stages' queues grouped by footprint class (a counting sort before shading) render
-/// the unsorted image to the bit: two glint materials, each with its own histogram, a second
-/// sphere that the first reflects (larger footprints on later bounces), several tiles. The walks
-/// stay short: past llvmpipe's cap of 65 535 iterations of a loop, where a walk ends depends on
-/// the invocations run beside it, sorted or not (with a density of 10⁸ and a threshold of 10⁴ on
-/// the second sphere, 11 of its 4096 pixels differ). The same for the fixed-shape descent
-/// (`glint_descent`), alone and with the sorting.
-#[test]
-fn sorted_glints_render_the_same_image() {
-    let Some(gpu) = gpu_for_tests("sorted_glints_render_the_same_image") else {
-        return;
-    };
-    let env = Environment::Constant(Vec3::new(1.0, 0.8, 0.6));
-    let mut scene = sphere_scene(glint(1e6, 50.0));
-    scene.materials.push(glint(3e6, 50.0));
-    scene.add_uv_sphere(Vec3::new(0.9, 0.6, 0.5), 0.4, 64, 32, 1);
-    let mut c = config(2);
-    c.image.wavefront = 1000; // several tiles
-    let res = SceneResources::new(&gpu, &scene, Some(&env), ResourceConfig::standard()).unwrap();
-    let camera = CameraFrame::new(&scene.camera).unwrap();
-    let image = |variants: StageVariants| {
-        let integrator = Integrator::with_variants(&gpu.device, &res, variants).unwrap();
-        let (image, _) = integrator
-            .render(&gpu, &res, &camera, &c, &mut |_| {})
-            .unwrap();
-        (image, integrator.stage_names())
-    };
-    let (plain, _) = image(StageVariants::DEFAULT);
-    let (sorted, stages) = image(StageVariants {
-        sort_glints: true,
-        ..StageVariants::DEFAULT
-    });
-    let histograms = stages.iter().filter(|&&s| s == "glint_histogram").count();
-    assert_eq!(histograms, 2, "{stages:?}");
-    assert!(plain.pixels.iter().flatten().any(|&v| v > 0.0));
-    let descent = |sort_glints| {
-        image(StageVariants {
-            sort_glints,
-            glint_descent: true,
-            ..StageVariants::DEFAULT
-        })
-        .0
-    };
-    for (label, other) in [
-        ("sorted", sorted),
-        ("descent", descent(false)),
-        ("sorted, descent", descent(true)),
-    ] {
-        let differ = other
-            .pixels
-            .iter()
-            .zip(&plain.pixels)
-            .filter(|(a, b)| a != b);
-        assert_eq!(differ.count(), 0, "{label}: pixels differ");
-    }
 }
 
 /// A scene built in code with a NaN vertex or an index out of range is refused with a message,
