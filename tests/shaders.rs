@@ -235,11 +235,11 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
         layout_check!(ToneMapParams, "render/tonemap.wgsl", "Params", {
             pixels, scale, pad0, pad1,
         }),
-        layout_check!(GpuRay, "render/trace.wgsl", "Ray", { origin, tmin, dir, tmax }),
-        layout_check!(GpuHit, "render/trace.wgsl", "Hit", { t, prim, u, v }),
+        layout_check!(GpuRay, "render/trace_closest.wgsl", "Ray", { origin, tmin, dir, tmax }),
+        layout_check!(GpuHit, "render/trace_closest.wgsl", "Hit", { t, prim, u, v }),
         // obvhs's node is uploaded as it is: WGSL CwNode packs its u8 fields into u32 words;
         // e[0..3] and imask are the bytes of e_imask.
-        layout_check!(CwBvhNode, "render/trace.wgsl", "CwNode", {
+        layout_check!(CwBvhNode, "render/trace_closest.wgsl", "CwNode", {
                 p, [e, imask] => [e_imask], child_base_idx, primitive_base_idx, child_meta,
             child_min_x, child_max_x, child_min_y, child_max_y, child_min_z, child_max_z,
         }),

@@ -1,4 +1,4 @@
-//! Host driver of `shaders/render/trace.wgsl`: closest-hit and any-hit queries for a batch of
+//! Host driver of `shaders/render/trace_closest.wgsl` and `trace_any.wgsl`: closest-hit and any-hit queries for a batch of
 //! rays against a [`GpuBvh`], one thread per ray, through the traversal the extend stage runs
 //! (`bvh.inc.wgsl`). The CPU reference is [`Bvh::closest_hit`](crate::bvh::Bvh::closest_hit) /
 //! [`Bvh::occluded`](crate::bvh::Bvh::occluded).
@@ -8,7 +8,9 @@ use bytemuck::{Pod, Zeroable};
 use facet_gpu::timer::GpuTimer;
 use facet_gpu::{GpuError, buffer, dispatch, shader};
 
-const SHADER: &str = "render/trace.wgsl";
+/// The closest-hit pipeline's file, and the any-hit one's.
+const CLOSEST: &str = "render/trace_closest.wgsl";
+const ANY: &str = "render/trace_any.wgsl";
 
 /// One ray (WGSL `Ray`, 32 bytes). `dir` need not be unit length: t is in units of `dir`.
 #[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
@@ -76,7 +78,7 @@ pub enum TraceQuery {
     Any,
 }
 
-/// The two pipelines of `trace.wgsl`.
+/// The two pipelines, `trace_closest.wgsl` and `trace_any.wgsl`.
 pub struct RayTracer {
     closest: wgpu::ComputePipeline,
     any: wgpu::ComputePipeline,
@@ -89,11 +91,12 @@ pub struct RayTracer {
 impl RayTracer {
     /// Builds the traversal pipelines on `device`.
     pub fn new(device: &wgpu::Device) -> Result<Self, GpuError> {
-        let pipeline = |entry| shader::compute_pipeline(device, SHADER, entry, &[]);
+        let pipeline = |file, entry| shader::compute_pipeline(device, file, entry, &[]);
         Ok(RayTracer {
-            closest: pipeline("trace_closest_rays")?,
-            any: pipeline("trace_any_rays")?,
-            workgroup_size: shader::workgroup_size(SHADER, "trace_closest_rays")?,
+            closest: pipeline(CLOSEST, "trace_closest_rays")?,
+            any: pipeline(ANY, "trace_any_rays")?,
+            // Both files take the batch's WG.
+            workgroup_size: shader::workgroup_size(CLOSEST, "trace_closest_rays")?,
             chunk: Self::max_rays_per_dispatch(device),
         })
     }
