@@ -1,6 +1,6 @@
 //! The trace section: closest- and any-hit rays a second through `trace_closest.wgsl` and
-//! `trace_any.wgsl` against procedural scenes of the mode's sizes, camera and random rays, the median of the mode's runs after one
-//! warm-up. Each run is timed by the wall clock (submit to idle) and, where the adapter has
+//! `trace_any.wgsl` against procedural scenes of the mode's sizes, camera and random rays, the
+//! median of the mode's runs after one warm-up. Each run is timed by the wall clock (submit to idle) and, where the adapter has
 //! timestamp queries, by GPU timestamps around its passes; rays a second come from the GPU's
 //! time then.
 
