@@ -9,8 +9,8 @@
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
 use facet_gpu::Gpu;
-use facet_render::camera::CameraFrame;
-use facet_render::procedural;
+use facet_render::bvh::procedural;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{
     Camera, Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf,
 };

@@ -7,9 +7,9 @@
 //! `cargo bench --bench render_trace`; `FACET_TRACE_SCENES=1e4,1e5` picks the scene sizes.
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
+use facet_render::bvh::procedural::{self, Rng};
+use facet_render::bvh::query::{GpuHit, GpuRay, RayTracer};
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
-use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, GpuRay, RayTracer};
 use glam::Vec3;
 use std::time::{Duration, Instant};
 

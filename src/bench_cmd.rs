@@ -15,7 +15,7 @@ use facet_fit::gpu::GpuFitter;
 use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::Gpu;
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf};
 use facet_render::{ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources};
 use glam::Vec3;
@@ -587,7 +587,7 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     for _ in 0..frames {
         let cfg = SampleConfig {
             spp: batch,
-            spp_per_pass: facet_render::pacing::MAX_SPP_PER_FRAME,
+            spp_per_pass: facet_render::integrator::pacing::MAX_SPP_PER_FRAME,
             ..SampleConfig::preview()
         };
         let t = Instant::now();
@@ -599,7 +599,7 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         }
         ms_all.push(ms);
         spp_all.push(batch);
-        batch = facet_render::pacing::next_batch(batch, ms);
+        batch = facet_render::integrator::pacing::next_batch(batch, ms);
     }
     // Steady state: the second half of the frames.
     let half = frames as usize / 2;

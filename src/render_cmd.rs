@@ -6,8 +6,8 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use facet_fit::io::input::same_file;
 use facet_render::bvh::{BvhConfig, BvhPreset};
-use facet_render::camera::CameraFrame;
 use facet_render::output::shard::{PixelKind, ShardRecord};
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, EnvironmentMap, LoadOptions, Scene, load_gltf};
 use facet_render::{
     ImageConfig, Integrator, LightSelection, RenderConfig, ResourceConfig, SampleConfig,

@@ -175,11 +175,11 @@ fn shared_struct_checks() -> Vec<(&'static str, Vec<String>)> {
     use facet_fit::gpu::{GpuNode, GpuState};
     use facet_glint::cone_rule::Ring;
     use facet_glint::gpu::{DpfParams, GlintEvalParams, GlintEvalQuery, GlintField, GlintQuery};
-    use facet_render::gpu_types::{GpuFrame, GpuLight, GpuMaterial, GpuSceneInfo};
+    use facet_render::bvh::query::{GpuHit, GpuRay};
+    use facet_render::layout::gpu_types::{GpuFrame, GpuLight, GpuMaterial, GpuSceneInfo};
     use facet_render::obvhs::cwbvh::node::CwBvhNode;
     use facet_render::output::tonemap::ToneMapParams;
     use facet_render::resources::light_bvh::GpuLightNode;
-    use facet_render::trace::{GpuHit, GpuRay};
     vec![
         layout_check!(GpuNode, "fit/kernel.wgsl", "Node", {
             x, y, z, row_scale, col_weight, norm_weight, pad0, pad1,
@@ -367,6 +367,6 @@ fn glint_stack_is_sized_to_the_tree() {
 fn bvh_stack_is_the_hosts() {
     assert_eq!(
         wgsl_u32_const("render/bvh.inc.wgsl", "BVH_STACK_SIZE"),
-        facet_render::trace::STACK_ENTRIES
+        facet_render::bvh::query::STACK_ENTRIES
     );
 }

@@ -6,8 +6,8 @@
 
 use super::{Sizes, demo_scene, gold_ggx, gold_scene, measure_noise, median, square};
 use anyhow::Result;
-use facet_render::camera::CameraFrame;
 use facet_render::resources::light_bvh::{GpuLightNode, LightBounds, LightBvh};
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, LoadOptions, Scene, load_gltf};
 use facet_render::{
     Integrator, LightSelection, NdfSampling, RenderConfig, ResourceConfig, SampleConfig,

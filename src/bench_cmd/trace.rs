@@ -8,9 +8,9 @@ use super::{Sizes, median};
 use anyhow::Result;
 use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
+use facet_render::bvh::procedural::{self, Rng};
+use facet_render::bvh::query::{GpuHit, RayTracer, TraceBatch, TraceQuery};
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
-use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, RayTracer, TraceBatch, TraceQuery};
 use glam::Vec3;
 use serde_json::{Value, json};
 use std::time::Instant;
@@ -68,7 +68,7 @@ pub fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
 }
 
 /// Camera rays over the scene (a 1024-wide image) and random rays inside its box.
-fn ray_sets(n: u32) -> [(&'static str, Vec<facet_render::trace::GpuRay>); 2] {
+fn ray_sets(n: u32) -> [(&'static str, Vec<facet_render::bvh::query::GpuRay>); 2] {
     let camera = procedural::camera_rays(
         Vec3::new(-8.0, 6.0, 9.0),
         Vec3::new(2.0, 2.0, -3.0),

@@ -14,7 +14,7 @@ use anyhow::Result;
 use facet_fit::metric::look::SphereScene;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_gpu::Gpu;
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{
     Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, MeasuredMaterial,
     Measurement, Scene,

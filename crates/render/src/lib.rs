@@ -1,18 +1,22 @@
 //! # facet-render: a wavefront path tracer on wgpu
 //!
-//! glTF scenes ([`scene::load_gltf`]), an obvhs CWBVH traversed in WGSL ([`bvh`]), and a
-//! wavefront integrator ([`Integrator`]) whose stages — logic, generate, extend, shade per
-//! material class (glTF metallic-roughness, fitted analytic or tabulated microfacet, glints),
-//! connect — are separate compute passes over queues. The integrator holds the pipelines and the
-//! loop; a [`Wavefront`] holds the GPU state of one image (path state, queues, film) for reuse,
-//! and reads it back. [`Integrator::render_more`] accumulates samples in a wavefront's film on the
-//! GPU, [`Wavefront::tone_mapped`] reads back the PNG tone map and
-//! [`Integrator::profile_iteration`] times each stage. A render's settings come in two parts
-//! ([`config`]): the image, fixed for a wavefront, and the sampling. The closed sets shared with
-//! WGSL are in [`tags`].
+//! The crate's folders, in the order a render flows through them:
+//!
+//! | room | what it holds |
+//! |---|---|
+//! | [`scene`] | glTF scenes ([`scene::load_gltf`]): meshes, materials (measured ones included), lights, the camera and its frame |
+//! | [`bvh`] | the obvhs CWBVH, its GPU form, a batch ray query ([`RayTracer`]) |
+//! | [`resources`] | a scene on the GPU: BVH, material plan, tables, glint pyramids, textures, lights and their BVH |
+//! | [`layout`] | what the resources and the integrator agree on with the WGSL: the GPU records, the closed-set tags, the bind groups, the queues, the device limits |
+//! | [`integrator`] | the wavefront loop ([`Integrator`]) and its stages — logic, generate, extend, shade per material class, connect — as compute passes over queues; a [`Wavefront`] (the GPU state of one image); the render's settings ([`integrator::config`]) |
+//! | [`output`] | the film read back as PNG and EXR, the tone map, a shard's record, the merge of shards |
+//!
+//! [`Integrator::render_more`] accumulates samples in a wavefront's film on the GPU,
+//! [`Wavefront::tone_mapped`] reads back the PNG tone map and [`Integrator::profile_iteration`]
+//! times each stage.
 //!
 //! ```no_run
-//! use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, camera::CameraFrame};
+//! use facet_render::{Integrator, RenderConfig, ResourceConfig, SceneResources, scene::CameraFrame};
 //! let gpu = facet_gpu::Gpu::new()?;
 //! let scene = facet_render::scene::load_gltf("scene.gltf".as_ref(), &Default::default())?;
 //! let env = facet_render::scene::Environment::Constant(glam::Vec3::splat(1.0));
@@ -28,35 +32,27 @@
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod bindings;
+// The map, in the order a render flows through it.
 pub mod bvh;
-pub mod camera;
-pub mod config;
 mod error;
-pub mod gpu_types;
-mod integrator;
-pub(crate) mod limits;
+pub mod integrator;
+pub mod layout;
 pub mod output;
-pub mod pacing;
-pub mod procedural;
-pub(crate) mod queues;
 pub mod resources;
 pub mod scene;
-pub(crate) mod stages;
-pub mod tags;
-pub mod trace;
-pub mod wavefront;
 
+pub use bvh::query::{GpuHit, GpuRay, RayTracer};
 pub use bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh, Hit};
-pub use config::{ImageConfig, NdfSampling, RenderConfig, SampleConfig, Sequence, Strategy};
 pub use error::RenderError;
 pub use facet_gpu::{Gpu, GpuError};
 /// The vector library of the scene types ([`scene::Camera`], [`scene::Environment`], ...).
 pub use glam;
+pub use integrator::config::{
+    ImageConfig, NdfSampling, RenderConfig, SampleConfig, Sequence, Strategy,
+};
+pub use integrator::wavefront::Wavefront;
 pub use integrator::{Integrator, RenderStats, StageClock, StageTime};
 /// The BVH library, whose types [`Bvh`] exposes.
 pub use obvhs;
 pub use output::film::Image;
 pub use resources::{Built, LightSelection, ResourceConfig, SceneResources};
-pub use trace::{GpuHit, GpuRay, RayTracer};
-pub use wavefront::Wavefront;

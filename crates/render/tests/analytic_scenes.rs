@@ -22,7 +22,7 @@ use facet_fit::model::microfacet::{AnalyticNdf, NdfKind, correlation, g2};
 use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::rgl::RglBsdf;
 use facet_gpu::{Gpu, gpu_for_tests};
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{
     Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, MeasuredMaterial,
     Measurement, Scene, Texture,

@@ -1,10 +1,10 @@
-//! The integrator's bind groups by name (`facet_render::bindings`) against the WGSL: every
+//! The integrator's bind groups by name (`facet_render::layout::bindings`) against the WGSL: every
 //! pipeline file's `@group`/`@binding` globals, as naga reflects them, are exactly its groups'
 //! lists — the same names at the same binding numbers, holding the same kind of resource. No
 //! GPU needed.
 
 use facet_gpu::shader;
-use facet_render::bindings::{BindingKind, Group, PIPELINES, pipeline_groups};
+use facet_render::layout::bindings::{BindingKind, Group, PIPELINES, pipeline_groups};
 
 /// (group, binding, name, kind) of every global of `file` that has a binding, sorted.
 fn wgsl_bindings(file: &str) -> Vec<(u32, u32, String, BindingKind)> {

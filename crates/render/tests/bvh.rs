@@ -7,9 +7,9 @@
 //! flips about 1 ray in 10^5 at a box edge, a triangle edge or a tie in t between two triangles
 //! (design.md, "GPU notes"). Each mismatch is printed, with ties in t marked.
 
+use facet_render::bvh::procedural::{self, Rng};
+use facet_render::bvh::query::{GpuHit, GpuRay, RayTracer};
 use facet_render::bvh::{Bvh, BvhConfig, BvhPreset, GpuBvh};
-use facet_render::procedural::{self, Rng};
-use facet_render::trace::{GpuHit, GpuRay, RayTracer};
 use glam::Vec3;
 
 fn scene_bvh(triangles: usize, config: BvhConfig) -> (procedural::Mesh, Bvh) {

@@ -2,7 +2,7 @@
 //! them through the tone map of `facet_render::output::film` (v = 1 − exp(−2^exposure · L), sRGB, 8 bits).
 
 use facet_gpu::gpu_for_tests;
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Camera, Environment, Material, Scene};
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,

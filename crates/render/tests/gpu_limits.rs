@@ -3,7 +3,7 @@
 //! device is requested with a 1 MiB storage binding limit so that small inputs exceed it.
 
 use facet_gpu::{Gpu, GpuOptions};
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
 use facet_render::{
     ImageConfig, Integrator, RenderConfig, RenderError, ResourceConfig, SampleConfig,

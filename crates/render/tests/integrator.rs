@@ -9,7 +9,7 @@ use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::MicrofacetBrdf;
 use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::{Gpu, gpu_for_tests};
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, GlintParams, Material, Scene};
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,

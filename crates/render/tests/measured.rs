@@ -10,7 +10,7 @@ use facet_fit::model::merl_grid::{
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::{Brdf, Rgb};
 use facet_gpu::{Gpu, buffer, dispatch, gpu_for_tests, shader};
-use facet_render::procedural::Rng;
+use facet_render::bvh::procedural::Rng;
 use facet_render::resources::materials::merl_block;
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, PI};

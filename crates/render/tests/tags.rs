@@ -1,4 +1,4 @@
-//! The closed sets shared with WGSL are written once (facet_render::tags): the committed
+//! The closed sets shared with WGSL are written once (facet_render::layout::tags): the committed
 //! `shaders/render/tags.inc.wgsl` is exactly their generated text, naga reads back the values
 //! Rust has, and no other WGSL file defines a constant with one of their prefixes.
 //! `FACET_REGENERATE=1 cargo test -p facet-render --test tags` rewrites the file.
@@ -18,8 +18,8 @@ fn the_generated_wgsl_holds_the_rust_tags() {
     let problems = facet_gpu::tags::check_generated(
         shaders_dir(),
         FILE,
-        &facet_render::tags::wgsl(),
-        &facet_render::tags::all(),
+        &facet_render::layout::tags::wgsl(),
+        &facet_render::layout::tags::all(),
     );
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }

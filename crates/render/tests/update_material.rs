@@ -2,7 +2,7 @@
 //! built from scratch for the edited scene (same seed, same image).
 
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, Material, Scene};
 use facet_render::{
     ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,

@@ -10,7 +10,7 @@
 //! the UI's commands between batches, so a slider move restarts accumulation within one batch.
 
 use facet_gpu::Gpu;
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Camera, Environment, EnvironmentMap, Material, Scene};
 use facet_render::{
     ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources, Wavefront,
@@ -26,7 +26,7 @@ pub const SPHERE: usize = 1;
 pub const SPLIT: usize = 2;
 /// Accumulation stops here (the GPU rests until the next change).
 pub const MAX_SAMPLES: u32 = 1024;
-pub use facet_render::pacing::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
+pub use facet_render::integrator::pacing::{FRAME_MS, MAX_SPP_PER_FRAME, next_batch};
 
 /// An orbit camera around `target`.
 #[derive(Clone, Copy, Debug, PartialEq)]

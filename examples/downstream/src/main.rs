@@ -10,7 +10,7 @@ use facet_fit::fitting::{FitConfig, fit_material};
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_glint::dpf::{dpf, query_directions};
-use facet_render::camera::CameraFrame;
+use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, FacetMaterial, Material, shapes};
 use facet_render::{
     Gpu, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,

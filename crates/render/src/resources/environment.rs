@@ -4,11 +4,11 @@
 use super::lights::{LightSet, Probe};
 use super::tables::Tables;
 use crate::error::RenderError;
-use crate::gpu_types::{GpuLight, LightKind};
-use crate::limits::{DeviceLimits, Planned};
+use crate::layout::gpu_types::{GpuLight, LightKind};
+use crate::layout::limits::{DeviceLimits, Planned};
+use crate::layout::tags::EnvKind;
 use crate::scene::environment::{luminance, uv_to_direction};
 use crate::scene::{Environment, EnvironmentMap};
-use crate::tags::EnvKind;
 use glam::Vec2;
 use std::f32::consts::PI;
 

@@ -4,7 +4,7 @@
 
 use super::{GlintResources, ResourceConfig};
 use crate::error::RenderError;
-use crate::limits::{DeviceLimits, Planned, product};
+use crate::layout::limits::{DeviceLimits, Planned, product};
 use crate::scene::GlintParams;
 use facet_brdf::model::microfacet::Ndf;
 use facet_glint::dpf::{DpfPyramid, LEVELS_DEG};

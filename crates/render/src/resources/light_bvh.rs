@@ -12,7 +12,7 @@
 //! Units: φ bounds the irradiance numerator — a point or spot light's intensity I (E = I cos/d²),
 //! an emissive triangle's Le·A (E ≤ Le A cos/d²) — so that lights of different kinds compare.
 
-use crate::gpu_types::NONE;
+use crate::layout::gpu_types::NONE;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use std::f32::consts::PI;

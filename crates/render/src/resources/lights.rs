@@ -15,8 +15,8 @@
 use super::light_bvh::{LightBounds, LightBvh};
 use super::tables::Tables;
 use crate::bvh::Bvh;
-use crate::camera::CameraFrame;
-use crate::gpu_types::{GpuLight, GpuMaterial, LightKind, NONE};
+use crate::layout::gpu_types::{GpuLight, GpuMaterial, LightKind, NONE};
+use crate::scene::camera_frame::CameraFrame;
 use crate::scene::{Light, Scene};
 use glam::Vec3;
 use std::f32::consts::PI;

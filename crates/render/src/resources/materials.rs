@@ -3,8 +3,8 @@
 
 use super::tables::Tables;
 use crate::error::RenderError;
-use crate::gpu_types::{GpuMaterial, MaterialKind, NONE};
-use crate::queues::Queue;
+use crate::layout::gpu_types::{GpuMaterial, MaterialKind, NONE};
+use crate::layout::queues::Queue;
 use crate::scene::{GlintParams, Material, MeasuredMaterial, Measurement};
 use facet_brdf::model::coat::CoatLayer;
 use facet_brdf::model::material::FittedMaterial;

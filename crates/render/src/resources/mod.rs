@@ -18,9 +18,9 @@ pub use materials::{FRESNEL_NODES, MaterialSlot};
 
 use crate::bvh::{Bvh, BvhConfig, GpuBvh};
 use crate::error::RenderError;
-use crate::gpu_types::{GpuLight, GpuMaterial, GpuSceneInfo};
-use crate::limits::{DeviceLimits, Planned, product};
-use crate::queues::Queue;
+use crate::layout::gpu_types::{GpuLight, GpuMaterial, GpuSceneInfo};
+use crate::layout::limits::{DeviceLimits, Planned, product};
+use crate::layout::queues::Queue;
 use crate::scene::{Environment, GlintParams, Measurement, Scene};
 use facet_brdf::model::microfacet::Ndf;
 use facet_glint::dpf::DpfConfig;
@@ -194,7 +194,7 @@ impl SceneResources {
         let mut light_set = LightSet::new(scene, &bvh, &materials, radius);
         built.emissive_triangles = light_set.emissive_triangles();
         let env = environment::place(environment, &mut tables, &mut light_set, &limits, radius)?;
-        built.environment_map = env.kind == crate::tags::EnvKind::Map;
+        built.environment_map = env.kind == crate::layout::tags::EnvKind::Map;
         let PlacedLights {
             lights,
             triangle_light,
@@ -521,7 +521,7 @@ fn check_buffers(
 
 impl GlintResources {
     /// Its bind group's resources, named as `shade_glint.wgsl` names them
-    /// ([`Group::Glint`](crate::bindings::Group::Glint)).
+    /// ([`Group::Glint`](crate::layout::bindings::Group::Glint)).
     pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 5] {
         [
             ("field", self.field.as_entire_binding()),
@@ -535,7 +535,7 @@ impl GlintResources {
 
 impl SceneResources {
     /// Its bind group's resources, named as `scene.inc.wgsl` names them
-    /// ([`Group::Scene`](crate::bindings::Group::Scene)).
+    /// ([`Group::Scene`](crate::layout::bindings::Group::Scene)).
     pub fn bindings(&self) -> [(&'static str, wgpu::BindingResource<'_>); 11] {
         [
             ("bvh_nodes", self.bvh.nodes.as_entire_binding()),
@@ -650,10 +650,10 @@ pub fn validate(scene: &Scene) -> Result<(), RenderError> {
         .iter()
         .filter(|m| m.facet.as_ref().is_some_and(|f| f.glint.is_some()))
         .count();
-    if glints > crate::queues::MAX_GLINT_MATERIALS as usize {
+    if glints > crate::layout::queues::MAX_GLINT_MATERIALS as usize {
         return bad(format!(
             "{glints} glint materials; at most {} are supported",
-            crate::queues::MAX_GLINT_MATERIALS
+            crate::layout::queues::MAX_GLINT_MATERIALS
         ));
     }
     Ok(())

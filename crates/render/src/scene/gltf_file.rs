@@ -595,7 +595,7 @@ fn choose_camera(
         let up = world.transform_vector3(Vec3::Y);
         // Gram–Schmidt: up ⟂ forward.
         let up = forward.and_then(|f| (up - f * f.dot(up)).try_normalize());
-        // The pinhole of [`crate::camera::CameraFrame`] needs yfov in [1e-4, π − 1e-3].
+        // The pinhole of [`crate::scene::camera_frame::CameraFrame`] needs yfov in [1e-4, π − 1e-3].
         if !(yfov > 1e-4 && yfov < std::f32::consts::PI - 1e-3) {
             return Err(RenderError::input(
                 path,

@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 use std::sync::Arc;
 
+pub mod camera_frame;
 pub mod data_uri;
 pub mod environment;
 pub(crate) mod gltf_buffers;
@@ -20,6 +21,7 @@ pub mod mesh;
 pub mod shapes;
 pub mod uri;
 
+pub use camera_frame::CameraFrame;
 pub use environment::{Environment, EnvironmentMap};
 pub use gltf_file::{LoadOptions, load_gltf, load_gltf_bytes};
 pub use measured::{MeasuredMaterial, Measurement};

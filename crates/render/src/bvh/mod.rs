@@ -13,6 +13,11 @@
 //! assert!((hit.t - 1.0).abs() < 1e-6);
 //! ```
 
+/// Procedural geometry and rays for the tests and the benchmarks (feature `bench-scenes`).
+#[cfg(feature = "bench-scenes")]
+pub mod procedural;
+pub mod query;
+
 use facet_gpu::{GpuError, buffer};
 use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;

@@ -1,10 +1,10 @@
 //! The integrator's stage pipelines (one WGSL file each under `shaders/render/`) and their
-//! bind group layouts, built from the named lists of [`crate::bindings`]. Group 0: frame, path
+//! bind group layouts, built from the named lists of [`crate::layout::bindings`]. Group 0: frame, path
 //! state, queues, film (`frame.inc.wgsl`); group 1: the scene (`scene.inc.wgsl`); group 2: one
 //! glint material's field, parameters and DPF levels.
 
-use crate::bindings::{Group, pipeline_groups};
-use crate::queues::Queue;
+use crate::layout::bindings::{Group, pipeline_groups};
+use crate::layout::queues::Queue;
 use facet_gpu::{GpuError, shader};
 
 /// Threads per workgroup of every stage (WGSL override `WG`).
@@ -33,7 +33,7 @@ impl Layouts {
     fn of_pipeline(&self, file: &str) -> Result<Vec<&wgpu::BindGroupLayout>, GpuError> {
         let groups = pipeline_groups(file).ok_or_else(|| {
             GpuError::Validation(format!(
-                "{file} is not an integrator pipeline (facet_render::bindings::PIPELINES)"
+                "{file} is not an integrator pipeline (facet_render::layout::bindings::PIPELINES)"
             ))
         })?;
         Ok(groups.iter().map(|g| self.of(*g)).collect())

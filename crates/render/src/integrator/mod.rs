@@ -12,15 +12,20 @@
 //! runs over — path state, queues, film and their bind groups — is a [`Wavefront`], which knows
 //! nothing of the loop.
 
-use crate::camera::CameraFrame;
-use crate::config::{ImageConfig, RenderConfig, SampleConfig};
+pub mod config;
+pub mod pacing;
+pub(crate) mod stages;
+pub mod wavefront;
+
 use crate::error::RenderError;
-use crate::gpu_types::GpuFrame;
+use crate::integrator::config::{ImageConfig, RenderConfig, SampleConfig};
+use crate::integrator::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};
+use crate::integrator::wavefront::Wavefront;
+use crate::layout::gpu_types::GpuFrame;
+use crate::layout::queues::Queue;
 use crate::output::film::Image;
-use crate::queues::Queue;
 use crate::resources::SceneResources;
-use crate::stages::{Layouts, STAGE_WORKGROUP, Stage, queue_args};
-use crate::wavefront::Wavefront;
+use crate::scene::camera_frame::CameraFrame;
 use facet_gpu::timer::GpuTimer;
 use facet_gpu::{Gpu, GpuError};
 use std::time::Instant;

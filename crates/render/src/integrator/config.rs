@@ -4,7 +4,7 @@
 //! [`Integrator::render_more`](crate::Integrator::render_more) does). A wavefront cannot be
 //! asked to render another size than its own: the size is never passed again.
 
-pub use crate::tags::{NdfSampling, Sequence, Strategy};
+pub use crate::layout::tags::{NdfSampling, Sequence, Strategy};
 
 /// The image of a [`Wavefront`](crate::Wavefront): fixed when it is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -3,13 +3,13 @@
 
 use bytemuck::{Pod, Zeroable};
 
-pub use crate::tags::{LightKind, MaterialKind};
+pub use crate::layout::tags::{LightKind, MaterialKind};
 
 /// Texture index meaning "none" (WGSL `NONE`).
 pub const NONE: u32 = u32::MAX;
 
-/// Regions of the path-state buffer ([`Region`](crate::tags::Region)), one vec4 per slot each.
-pub const PATH_REGIONS: u64 = crate::tags::Region::ALL.len() as u64;
+/// Regions of the path-state buffer ([`Region`](crate::layout::tags::Region)), one vec4 per slot each.
+pub const PATH_REGIONS: u64 = crate::layout::tags::Region::ALL.len() as u64;
 
 /// WGSL `SceneInfo` (`shaders/render/frame.inc.wgsl`): what the frame uniform carries of the
 /// scene — its sizes, the light-selection CDF and the environment — made once by
@@ -24,7 +24,7 @@ pub struct GpuSceneInfo {
     pub n_lights: u32,
     /// Word offset of the light-selection CDF in the scene tables.
     pub light_cdf: u32,
-    /// [`EnvKind`](crate::tags::EnvKind) as `u32`.
+    /// [`EnvKind`](crate::layout::tags::EnvKind) as `u32`.
     pub env_kind: u32,
     /// The environment map's size (1 × 1 without a map).
     pub env_width: u32,
@@ -58,13 +58,13 @@ pub struct GpuFrame {
     pub seed: u32,
     pub rr_depth: u32,
     pub ray_epsilon: f32,
-    /// [`Strategy`](crate::tags::Strategy) as `u32`.
+    /// [`Strategy`](crate::layout::tags::Strategy) as `u32`.
     pub strategy: u32,
-    /// [`NdfSampling`](crate::tags::NdfSampling) as `u32`.
+    /// [`NdfSampling`](crate::layout::tags::NdfSampling) as `u32`.
     pub ndf_sampling: u32,
     /// 1: the film's squares are accumulated too (`Integrator::wavefront_with_variance`).
     pub moments: u32,
-    /// [`Sequence`](crate::tags::Sequence) as `u32`.
+    /// [`Sequence`](crate::layout::tags::Sequence) as `u32`.
     pub sequence: u32,
     pub pad1: u32,
     pub pad2: u32,

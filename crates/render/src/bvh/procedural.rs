@@ -2,7 +2,7 @@
 //! displaced icospheres and loose random triangles (depth complexity, thin and large triangles,
 //! all orientations), plus pinhole camera rays and random rays. Deterministic from a seed.
 
-use crate::trace::GpuRay;
+use crate::bvh::query::GpuRay;
 use glam::Vec3;
 use std::collections::HashMap;
 

@@ -5,16 +5,16 @@
 //! film accumulates, continuing each pixel's sample indices, so 4 calls of 2 spp give the
 //! pixels of one 8 spp render with the same seed.
 
-use crate::bindings::{Group, bind_group};
-use crate::config::ImageConfig;
 use crate::error::RenderError;
-use crate::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
-use crate::limits::{DeviceLimits, Planned, product};
+use crate::integrator::config::ImageConfig;
+use crate::integrator::stages::Layouts;
+use crate::layout::bindings::{Group, bind_group};
+use crate::layout::gpu_types::{GpuFrame, GpuSceneInfo, PATH_REGIONS};
+use crate::layout::limits::{DeviceLimits, Planned, product};
+use crate::layout::tags::SlotState;
 use crate::output::film::{Image, to_f32_saturated};
 use crate::output::tonemap::ToneMap;
 use crate::resources::SceneResources;
-use crate::stages::Layouts;
-use crate::tags::SlotState;
 use facet_gpu::{Gpu, buffer};
 
 /// Paths in flight and film for one image, bound to one scene's resources.

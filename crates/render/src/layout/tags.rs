@@ -174,8 +174,8 @@ pub fn all() -> Vec<TagSet> {
 /// The committed `shaders/render/tags.inc.wgsl`, generated.
 pub fn wgsl() -> String {
     tags::wgsl(
-        "facet_render::tags",
-        "crates/render/src/tags.rs",
+        "facet_render::layout::tags",
+        "crates/render/src/layout/tags.rs",
         "facet-render",
         &all(),
     )
