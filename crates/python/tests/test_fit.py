@@ -1,0 +1,78 @@
+"""`fit` against `facet fit` on the same input: the same record but for the timings."""
+
+import json
+import re
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import facet_brdf
+from conftest import GOLD, PLASTIC, program
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def cli_record(source, out):
+    facet = program("FACET_BIN")
+    subprocess.run([facet, "fit", str(source), "--out", str(out)], check=True, capture_output=True)
+    (json_file,) = out.glob("*.json")
+    return json.loads(json_file.read_text())
+
+
+def without_timings(record):
+    return {k: v for k, v in record.items() if k != "timings_ms"}
+
+
+@pytest.mark.parametrize("which", ["analytic-gold", "analytic-plastic", "merl-file"])
+def test_record_equals_facet_fit(which, files, tmp_path):
+    source = {"analytic-gold": GOLD, "analytic-plastic": PLASTIC, "merl-file": files["merl"]}[which]
+    cli = cli_record(source, tmp_path / "out")
+    ours = facet_brdf.fit(source).record
+    assert set(ours["timings_ms"]) == set(cli["timings_ms"])
+    assert without_timings(ours) == without_timings(cli)
+
+
+def test_fit_of_a_brdf_and_its_models(files, tmp_path):
+    brdf = facet_brdf.load(files["merl"])
+    fit = facet_brdf.fit(brdf, coat="off")
+    assert fit.record["source"] == str(files["merl"])
+    assert fit.record["name"] == "plastic"
+    for model in ["tabulated", "ggx", "beckmann"]:
+        m = fit.model(model)
+        assert m.name == f"plastic-{model}"
+        f = m.eval([[0.3, 0.0, 0.95]], [[-0.3, 0.0, 0.95]])
+        assert (f > 0).all()
+    with pytest.raises(facet_brdf.FacetError, match="coat"):
+        fit.model("ggx", coated=True)
+    with pytest.raises(facet_brdf.FacetError, match="tabulated, ggx, beckmann"):
+        fit.model("phong")
+    # Saved, the record reads back as the same fit.
+    path = tmp_path / "plastic.json"
+    fit.save(path)
+    assert json.loads(path.read_text()) == fit.record
+    assert path.read_text() == fit.to_json()
+    again = facet_brdf.load(path)
+    wi = np.array([[0.2, 0.1, 0.97]])
+    np.testing.assert_array_equal(again.eval(wi, wi), fit.model("tabulated").eval(wi, wi))
+
+
+def test_ndf_is_the_tables_csv(files, tmp_path):
+    facet = program("FACET_BIN")
+    out = tmp_path / "out"
+    subprocess.run([facet, "fit", GOLD, "--out", str(out)], check=True, capture_output=True)
+    (csv,) = out.glob("*.tables.csv")
+    table = np.loadtxt(csv, delimiter=",", skiprows=1)
+    d = facet_brdf.fit(GOLD).ndf(np.radians(table[:, 0]))
+    # The CSV prints D with {:e}: its shortest round-tripping digits.
+    np.testing.assert_array_equal(d, table[:, 1])
+    theta = np.radians([[10.0, 20.0], [30.0, 40.0]])
+    assert facet_brdf.fit(GOLD, coat="off").ndf(theta).shape == (2, 2)
+
+
+def test_version_is_the_workspace_version():
+    cargo = (ROOT / "Cargo.toml").read_text()
+    section = cargo.split("[workspace.package]")[1]
+    version = re.search(r'^version = "([^"]+)"', section, re.M).group(1)
+    assert facet_brdf.__version__ == version
