@@ -25,13 +25,33 @@ def without_timings(record):
     return {k: v for k, v in record.items() if k != "timings_ms"}
 
 
+def differences(a, b, path="", rtol=1e-9):
+    """Where two records differ: structure, strings and integers exactly, floats beyond
+    `rtol`. `facet fit` itself sums over the MERL grid with rayon's fold/reduce, whose order
+    follows work stealing, so two runs of it may differ at round-off (seen once in about ten
+    runs on a loaded 2-core machine, on a MERL file with a coat search)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        if set(a) != set(b):
+            return [f"{path}: keys {sorted(set(a) ^ set(b))}"]
+        return [d for k in a for d in differences(a[k], b[k], f"{path}/{k}", rtol)]
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{path}: lengths {len(a)}, {len(b)}"]
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in differences(x, y, f"{path}[{i}]", rtol)]
+    if isinstance(a, float) and isinstance(b, float):
+        return [] if abs(a - b) <= rtol * max(abs(a), abs(b)) else [f"{path}: {a!r} != {b!r}"]
+    return [] if a == b and type(a) is type(b) else [f"{path}: {a!r} != {b!r}"]
+
+
 @pytest.mark.parametrize("which", ["analytic-gold", "analytic-plastic", "merl-file"])
 def test_record_equals_facet_fit(which, files, tmp_path):
     source = {"analytic-gold": GOLD, "analytic-plastic": PLASTIC, "merl-file": files["merl"]}[which]
     cli = cli_record(source, tmp_path / "out")
     ours = facet_brdf.fit(source).record
     assert set(ours["timings_ms"]) == set(cli["timings_ms"])
-    assert without_timings(ours) == without_timings(cli)
+    assert differences(without_timings(ours), without_timings(cli)) == []
+    # Most runs agree to the last digit.
+    print(f"{which}: records bit-identical: {without_timings(ours) == without_timings(cli)}")
 
 
 def test_fit_of_a_brdf_and_its_models(files, tmp_path):
