@@ -347,11 +347,13 @@ impl PyFit {
 
     fn __repr__(&self) -> String {
         let r = &self.fit.record;
+        let py = |v: Option<f64>| v.map_or("None".to_owned(), |v| format!("{v:.6}"));
         format!(
-            "facet_brdf.Fit({:?}, tabulated error {:?}, ggx α {:?})",
+            "facet_brdf.Fit({:?}, tabulated_error={}, ggx_alpha={}, coat={})",
             r.name,
-            r.tabulated.error,
-            r.ggx.as_ref().map(|p| p.alpha_x)
+            py(r.tabulated.error),
+            py(r.ggx.as_ref().map(|p| p.alpha_x)),
+            if r.coat.is_some() { "True" } else { "False" }
         )
     }
 }
