@@ -5,6 +5,8 @@ when its pool starts:
     RAYON_NUM_THREADS=1 python crates/python/bench/eval_throughput.py MERL.binary OUT_DIR
     RAYON_NUM_THREADS=2 python crates/python/bench/eval_throughput.py MERL.binary OUT_DIR mitsuba
 
+(`mitsuba+llvm` also times Mitsuba's llvm_ad_rgb variant, vectorised.)
+
 The MERL file goes through NumPy (`from_merl(load(file).to_merl())`); the .bsdf is the same
 material written as `facet convert` writes it (into OUT_DIR, once).
 """
@@ -62,11 +64,11 @@ def main():
             f"facet_brdf {name}, {threads} thread(s): {N / t / 1e6:.2f} M pairs/s "
             f"({t:.3f} s wall, {cpu:.3f} s CPU)"
         )
-    if len(sys.argv) > 3 and sys.argv[3] == "mitsuba":
-        mitsuba(bsdf_file, wi, wo, rgl)
+    if len(sys.argv) > 3 and sys.argv[3] in ("mitsuba", "mitsuba+llvm"):
+        mitsuba(bsdf_file, wi, wo, rgl, llvm=sys.argv[3] == "mitsuba+llvm")
 
 
-def mitsuba(bsdf_file, wi, wo, rgl):
+def mitsuba(bsdf_file, wi, wo, rgl, llvm):
     import drjit as dr
     import mitsuba as mi
 
@@ -90,6 +92,10 @@ def mitsuba(bsdf_file, wi, wo, rgl):
     big = ours.max(axis=1) > 1e-3
     rel = np.abs(out - ours).max(axis=1)[big] / ours.max(axis=1)[big]
     print(f"  f cos θo against facet_brdf: median relative difference {np.median(rel):.2e}")
+    if not llvm:
+        return
+    # On 2026-12-07 this aborted the process (LLVM ERROR: Cannot select fminimum) with the
+    # system's libLLVM: hence a separate argument.
     try:
         mi.set_variant("llvm_ad_rgb")
     except Exception as e:  # no LLVM on this machine
