@@ -16,6 +16,8 @@ def kinds(files):
     return {
         "analytic": GOLD,
         "analytic-plastic": PLASTIC,
+        # Anisotropic and rotated: a swapped axis or component shows.
+        "analytic-aniso": "analytic:beckmann?alpha_x=0.1&alpha_y=0.4&rotation=30&f0=0.9,0.5,0.2",
         "nbrdf": PROXY,
         "merl": str(files["merl"]),
         "rgl": str(files["bsdf"]),
@@ -24,7 +26,8 @@ def kinds(files):
 
 
 @pytest.mark.parametrize(
-    "kind", ["analytic", "analytic-plastic", "nbrdf", "merl", "rgl", "fit-json"]
+    "kind",
+    ["analytic", "analytic-plastic", "analytic-aniso", "nbrdf", "merl", "rgl", "fit-json"],
 )
 def test_eval_equals_rust_on_random_pairs(kind, files, tmp_path):
     source = kinds(files)[kind]
