@@ -14,9 +14,11 @@ from conftest import GOLD, PLASTIC, program
 ROOT = Path(__file__).resolve().parents[3]
 
 
-def cli_record(source, out):
+def cli_record(source, out, args=()):
     facet = program("FACET_BIN")
-    subprocess.run([facet, "fit", str(source), "--out", str(out)], check=True, capture_output=True)
+    subprocess.run(
+        [facet, "fit", str(source), *args, "--out", str(out)], check=True, capture_output=True
+    )
     (json_file,) = out.glob("*.json")
     return json.loads(json_file.read_text())
 
@@ -43,11 +45,27 @@ def differences(a, b, path="", rtol=1e-9):
     return [] if a == b and type(a) is type(b) else [f"{path}: {a!r} != {b!r}"]
 
 
-@pytest.mark.parametrize("which", ["analytic-gold", "analytic-plastic", "merl-file"])
+# (source, fit's keywords, the same options on facet fit's command line)
+CASES = {
+    "analytic-gold": (GOLD, {}, []),
+    "analytic-plastic": (PLASTIC, {}, []),
+    "merl-file": ("merl", {}, []),
+    "options": (
+        PLASTIC,
+        dict(coat="off", model="ggx", resolution=64, metric="log", fresnel="schlick"),
+        ["--coat", "off", "--model", "ggx", "--resolution", "64", "--metric", "log",
+         "--fresnel", "schlick"],
+    ),
+    "single-lobe": (GOLD, dict(no_diffuse=True, iterations=8), ["--no-diffuse", "--iterations", "8"]),
+}
+
+
+@pytest.mark.parametrize("which", list(CASES))
 def test_record_equals_facet_fit(which, files, tmp_path):
-    source = {"analytic-gold": GOLD, "analytic-plastic": PLASTIC, "merl-file": files["merl"]}[which]
-    cli = cli_record(source, tmp_path / "out")
-    ours = facet_brdf.fit(source).record
+    source, kwargs, args = CASES[which]
+    source = files["merl"] if source == "merl" else source
+    cli = cli_record(source, tmp_path / "out", args)
+    ours = facet_brdf.fit(source, **kwargs).record
     assert set(ours["timings_ms"]) == set(cli["timings_ms"])
     assert differences(without_timings(ours), without_timings(cli)) == []
     # Most runs agree to the last digit.
