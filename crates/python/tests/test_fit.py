@@ -114,3 +114,28 @@ def test_version_is_the_workspace_version():
     section = cargo.split("[workspace.package]")[1]
     version = re.search(r'^version = "([^"]+)"', section, re.M).group(1)
     assert facet_brdf.__version__ == version
+
+
+def test_a_coated_fit(tmp_path):
+    """A proxy whose fit keeps a clear coat: its coated models, and its Mitsuba export, a
+    `measured` BSDF on a table written into table_dir."""
+    fit = facet_brdf.fit("nbrdf:gold-metallic-paint")
+    assert fit.record.get("coat") is not None
+    wi = np.array([[0.3, 0.0, 0.954], [0.0, 0.5, 0.866]])
+    wo = np.array([[-0.3, 0.1, 0.949], [0.2, -0.4, 0.894]])
+    coated = fit.model("ggx", coated=True)
+    assert coated.source.endswith(":coated")
+    assert np.isfinite(coated.eval(wi, wo)).all()
+    with pytest.raises(facet_brdf.FacetError, match="table_dir"):
+        fit.to_mitsuba(coat=True)
+    d = fit.to_mitsuba(coat=True, table_dir=tmp_path)
+    assert d["type"] == "measured"
+    assert Path(d["filename"]).parent == tmp_path and Path(d["filename"]).is_file()
+    # The table is a .bsdf this package reads too.
+    assert np.isfinite(facet_brdf.load(d["filename"]).eval(wi, wo)).all()
+    try:
+        import mitsuba as mi
+    except ImportError:
+        return
+    mi.set_variant("scalar_rgb")
+    mi.load_dict(d)
