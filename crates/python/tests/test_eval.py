@@ -1,11 +1,13 @@
 """`Brdf.eval` against Rust's `Brdf::eval` (the eval_pairs example) for every kind of source,
 and the MERL table through NumPy and back."""
 
+import subprocess
+
 import numpy as np
 import pytest
 
 import facet_brdf
-from conftest import GOLD, PLASTIC, PROXY, random_pairs, reference_eval
+from conftest import GOLD, PLASTIC, PROXY, program, random_pairs, reference_eval
 
 N = 10_000
 # The MERL scales (1, 1.15, 1.66) / 1500: a file's values times these are f_r.
@@ -106,3 +108,12 @@ def test_saved_formats_read_back(files, tmp_path):
     assert copy.read_bytes() == files["merl"].read_bytes()
     with pytest.raises(facet_brdf.FacetError, match="extension"):
         merl.save(tmp_path / "x.exr")
+
+
+@pytest.mark.parametrize("ext", ["binary", "bsdf"])
+def test_save_writes_what_facet_convert_writes(ext, tmp_path):
+    facet = program("FACET_BIN")
+    ours, theirs = tmp_path / f"ours.{ext}", tmp_path / f"theirs.{ext}"
+    facet_brdf.load(PLASTIC).save(ours)
+    subprocess.run([facet, "convert", PLASTIC, str(theirs)], check=True, capture_output=True)
+    assert ours.read_bytes() == theirs.read_bytes()
