@@ -279,6 +279,16 @@ impl ViewerApp {
         }
     }
 
+    /// Shows the model `s` asked for on the command line (`--shown`), or keeps it for the
+    /// input's fit, which comes later from a background job.
+    pub fn ask_shown(&mut self, s: Shown) {
+        if self.material.available(s) {
+            self.material.shown = s;
+        } else {
+            self.wanted = Some(s);
+        }
+    }
+
     /// The neural proxies' names (the network file is read once).
     pub fn proxies(&mut self) -> &Result<Vec<String>, String> {
         let path = self.nbrdf.clone();

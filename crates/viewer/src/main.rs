@@ -157,11 +157,8 @@ fn run_with(
                 app.open(spec);
             }
             app.split = args.split;
-            match args.shown {
-                Some(s) if app.material.available(s) => app.material.shown = s,
-                // The input's fit (and measurement) comes later, from a background job.
-                Some(s) => app.wanted = Some(s),
-                None => {}
+            if let Some(s) = args.shown {
+                app.ask_shown(s);
             }
             match (&cc.wgpu_render_state, no_gpu) {
                 (Some(rs), _) => {
