@@ -31,7 +31,8 @@ struct Args {
     #[arg(long, value_name = "SPEC")]
     material: Option<String>,
     /// The model shown first: measured (the measurement itself, for a measured INPUT),
-    /// tabulated, ggx, beckmann or glint (default: GGX where the material has one).
+    /// tabulated, ggx, beckmann or glint (default: GGX where the material has one); for an
+    /// INPUT fitted in the background, once its fit arrives.
     #[arg(long, value_name = "MODEL", value_parser = parse_shown)]
     shown: Option<Shown>,
     /// Split the sphere: the measurement on its left half, the edited model on its right (a
