@@ -4,7 +4,7 @@ mod digest;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
-use facet_fit::io::input::same_file;
+use facet_fit::io::input::{self, same_file};
 use facet_render::bvh::{BvhConfig, BvhPreset};
 use facet_render::output::shard::{PixelKind, ShardRecord};
 use facet_render::scene::camera_frame::CameraFrame;
@@ -203,19 +203,11 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         nbrdf: args.nbrdf.clone(),
     };
     let mut scene = load_gltf(&args.scene, &options)?;
-    // Every file the scene read (its buffers, textures and fits), the scene, the
-    // environment and the proxy file `nbrdf:` resolves in: no output may replace one of them,
-    // and the shards' digest reads them all.
-    let names_proxy = |m: &facet_render::scene::Material| {
-        (m.measured.as_ref()).is_some_and(|mm| mm.source.starts_with("nbrdf:"))
-    };
-    let nbrdf = (scene.materials.iter().any(names_proxy))
-        .then(|| facet_fit::sources::nbrdf::NbrdfLibrary::override_path(args.nbrdf.as_deref()))
-        .flatten();
+    // Every file the scene read (the scene, its buffers, textures, fits and measurements, the
+    // proxy file `nbrdf:` resolves in) and the environment: no output may replace one of them.
     let inputs: Vec<&Path> = std::iter::once(args.scene.as_path())
         .chain(args.env.as_deref())
-        .chain(scene.inputs.iter().map(PathBuf::as_path))
-        .chain(nbrdf.as_deref())
+        .chain(scene.inputs.iter().map(|r| r.path.as_path()))
         .collect();
     let (png, exr) = outputs(&args.out);
     // The folder is made (or refused) now, not after the render.
@@ -238,9 +230,13 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
+    // The shards' digest is made of the bytes the loaders read, hashed as they read them.
+    let mut read = scene.inputs.clone();
     let environment = match (&args.env, &args.env_color) {
         (Some(path), _) => {
-            let (map, warnings) = EnvironmentMap::load(path)?;
+            let (map, env_read) = input::recording(|| EnvironmentMap::load(path));
+            let (map, warnings) = map?;
+            read.extend(env_read);
             for w in warnings {
                 eprintln!("warning: {w}");
             }
@@ -271,7 +267,7 @@ pub fn prepare(args: &RenderArgs) -> Result<Job> {
         light_selection: args.light_selection.selection(),
         ..ResourceConfig::standard()
     };
-    let digest = digest::digest(args, &inputs)?;
+    let digest = digest::digest(args, &read);
     fit_measured(&mut scene)?;
     Ok(Job {
         scene,

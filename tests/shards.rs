@@ -215,3 +215,91 @@ fn parts_that_do_not_belong_together_are_refused() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[path = "../crates/render/tests/common/mod.rs"]
+mod render_common;
+
+/// A triangle whose base colour texture `tex.png` is beside the glTF and whose normal map
+/// `nope.png` is missing, seen by a camera at z = 2.
+fn textured_triangle(dir: &Path) -> PathBuf {
+    let mut g = render_common::GltfBuilder::default();
+    let (p, n, i) = g.triangle();
+    g.images.push(serde_json::json!({"uri": "tex.png"}));
+    g.images.push(serde_json::json!({"uri": "nope.png"}));
+    g.textures.push(serde_json::json!({"source": 0}));
+    g.textures.push(serde_json::json!({"source": 1}));
+    let m = g.material(serde_json::json!({
+        "name": "painted",
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+        "normalTexture": {"index": 1}
+    }));
+    let mesh = g.mesh(
+        "tri",
+        serde_json::json!({"POSITION": p, "NORMAL": n}),
+        Some(i),
+        Some(m),
+    );
+    g.cameras.push(
+        serde_json::json!({"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.01}}),
+    );
+    let tri = g.node(serde_json::json!({"mesh": mesh}));
+    let cam = g.node(serde_json::json!({"camera": 0, "translation": [0.3, 0.3, 2.0]}));
+    let scene = dir.join("tri.gltf");
+    g.write(&[tri, cam], &scene);
+    write_png(&dir.join("tex.png"), [200, 40, 40]);
+    scene
+}
+
+fn write_png(path: &Path, rgb: [u8; 3]) {
+    image::RgbImage::from_pixel(2, 2, image::Rgb(rgb))
+        .save(path)
+        .unwrap();
+}
+
+/// A scene whose texture is missing renders a shard (with the warning, the factor alone): the
+/// digest is made of the bytes the load read, not of the files read again. It is the same for
+/// the same files, and changes when a file's bytes change or the missing texture appears.
+#[test]
+fn a_scene_with_a_missing_texture_renders_a_shard() {
+    if facet_gpu::gpu_for_tests("a_scene_with_a_missing_texture_renders_a_shard").is_none() {
+        return;
+    }
+    let dir = common::scratch("shards_missing_texture");
+    let scene = textured_triangle(&dir);
+    let shard = |out: &str| {
+        let args = [
+            "render",
+            scene.to_str().unwrap(),
+            "--env-color",
+            "1",
+            "--width",
+            "16",
+            "--height",
+            "16",
+            "--max-depth",
+            "1",
+            "--samples",
+            "0..2",
+            "--out",
+            out,
+        ];
+        let (ok, stdout, err) = common::facet_in(&dir, &args);
+        assert!(ok, "{args:?}: {stdout}\n{err}");
+        (read(dir.join(out).with_extension("exr")).1.digest, err)
+    };
+    let (first, err) = shard("a/r.png");
+    assert!(
+        err.contains("nope.png") && err.contains("using the factor alone"),
+        "{err}"
+    );
+    let (again, _) = shard("b/r.png");
+    assert_eq!(again, first, "the same files, the same digest");
+    write_png(&dir.join("tex.png"), [40, 200, 40]);
+    let (recoloured, _) = shard("c/r.png");
+    assert_ne!(recoloured, first, "tex.png's bytes changed");
+    std::fs::copy(dir.join("tex.png"), dir.join("nope.png")).unwrap();
+    let (found, err) = shard("d/r.png");
+    assert!(!err.contains("nope.png"), "{err}");
+    assert_ne!(found, recoloured, "the missing texture is there now");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -271,6 +271,69 @@ fn png_data_uri(w: u32, h: u32) -> String {
     )
 }
 
+/// SHA-256 of a file's bytes.
+fn sha256_of(path: &Path) -> [u8; 32] {
+    use sha2::Digest;
+    sha2::Sha256::digest(std::fs::read(path).unwrap()).into()
+}
+
+/// The scene lists the files its load read, each once with the SHA-256 of its bytes: the
+/// glTF first, its buffer file, an image file that two textures share, the fit; a missing
+/// image is listed without a digest (and costs only its texture). A glTF given as bytes is
+/// not among them.
+#[test]
+fn inputs_are_the_files_read_with_their_digests() {
+    let dir = temp_dir("inputs");
+    let mut g = GltfBuilder::default();
+    let (p, _, i) = g.triangle();
+    g.images.push(json!({"uri": "tex.png"}));
+    g.images.push(json!({"uri": "nope.png"}));
+    g.textures.push(json!({"source": 0}));
+    g.textures.push(json!({"source": 1}));
+    let m = g.material(json!({
+        "name": "metal",
+        "pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+            "metallicRoughnessTexture": {"index": 0}},
+        "normalTexture": {"index": 1},
+        "extras": {"facet": {"fit": "m.json"}}
+    }));
+    let mesh = g.mesh("tri", json!({"POSITION": p}), Some(i), Some(m));
+    let root = g.node(json!({"mesh": mesh}));
+    let mut doc = g.finish(&[root]);
+    doc["buffers"][0]["uri"] = json!("mesh.bin");
+    std::fs::write(dir.join("mesh.bin"), &g.bin).unwrap();
+    let img = image::RgbaImage::from_pixel(2, 2, image::Rgba([10, 20, 30, 255]));
+    img.save(dir.join("tex.png")).unwrap();
+    std::fs::copy(small_fit(), dir.join("m.json")).unwrap();
+    let path = dir.join("inputs.gltf");
+    std::fs::write(&path, serde_json::to_string(&doc).unwrap()).unwrap();
+
+    let s = load(&path);
+    assert_eq!(s.textures.len(), 2, "tex.png as sRGB and as linear");
+    assert!(s.warnings.iter().any(|w| w.contains("nope.png")));
+    let listed: Vec<(PathBuf, Option<[u8; 32]>)> = s
+        .inputs
+        .iter()
+        .map(|r| (r.path.clone(), r.sha256))
+        .collect();
+    assert_eq!(listed[0], (path.clone(), Some(sha256_of(&path))));
+    let mut rest = listed[1..].to_vec();
+    rest.sort();
+    let mut want: Vec<(PathBuf, Option<[u8; 32]>)> = ["mesh.bin", "tex.png", "m.json"]
+        .iter()
+        .map(|f| (dir.join(f), Some(sha256_of(&dir.join(f)))))
+        .chain([(dir.join("nope.png"), None)])
+        .collect();
+    want.sort();
+    assert_eq!(rest, want);
+
+    let bytes = std::fs::read(&path).unwrap();
+    let given =
+        facet_render::scene::load_gltf_bytes(&path, &bytes, &LoadOptions::default()).unwrap();
+    assert_eq!(given.inputs.len(), 4, "{:?}", given.inputs);
+    assert!(given.inputs.iter().all(|r| r.path != path));
+}
+
 #[test]
 fn materials_textures_and_emissive_strength() {
     let dir = temp_dir("materials");
@@ -653,7 +716,15 @@ fn measured_extras_and_overrides_name_a_measurement() {
         std::sync::Arc::ptr_eq(&a.data, &b.data),
         "one table for both"
     );
-    assert!(s.inputs.contains(&dir.join("m.binary")), "{:?}", s.inputs);
+    // Streamed into its table (not through `input::read`), and still digested as read.
+    let merl = dir.join("m.binary");
+    assert!(
+        s.inputs
+            .iter()
+            .any(|r| r.path == merl && r.sha256 == Some(sha256_of(&merl))),
+        "{:?}",
+        s.inputs
+    );
     // The embedded proxies need no file.
     let path = facet_scene(
         &dir,

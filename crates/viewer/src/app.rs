@@ -89,7 +89,8 @@ pub struct ViewerApp {
     pub sent_split: Option<usize>,
     /// The glTF scene in the preview (the split applies to the sphere only).
     pub gltf: Option<PathBuf>,
-    /// The model asked for on the command line, shown once the input's fit arrives.
+    /// The model asked for (`--shown`, or picked while a fit runs), shown once the fit in
+    /// progress arrives where it has that model.
     pub wanted: Option<Shown>,
 }
 
@@ -279,6 +280,25 @@ impl ViewerApp {
         }
     }
 
+    /// Shows the model `s` asked for (`--shown`): now, where the material shown has it, and,
+    /// while a fit runs in the background (an INPUT being fitted), once the fit arrives, which
+    /// would otherwise open on its default (GGX).
+    pub fn ask_shown(&mut self, s: Shown) {
+        if self.material.available(s) {
+            self.material.shown = s;
+        }
+        if self.fit_job.is_some() {
+            self.wanted = Some(s);
+        } else if !self.material.available(s) {
+            self.status = format!(
+                "{} asked for, which {} has not; {} shown",
+                s.label(),
+                self.material.source,
+                self.material.shown.label()
+            );
+        }
+    }
+
     /// The neural proxies' names (the network file is read once).
     pub fn proxies(&mut self) -> &Result<Vec<String>, String> {
         let path = self.nbrdf.clone();
@@ -308,10 +328,18 @@ impl ViewerApp {
                     Some(m) => EditedMaterial::with_measurement(fit, label.clone(), m),
                     None => EditedMaterial::new(fit, label.clone()),
                 });
-                if let Some(s) = self.wanted.take().filter(|&s| self.material.available(s)) {
-                    self.material.shown = s;
-                }
                 self.status = format!("fitted {label} in {secs:.1} s");
+                match self.wanted.take() {
+                    Some(s) if self.material.available(s) => self.material.shown = s,
+                    Some(s) => {
+                        self.status += &format!(
+                            " ({} asked for, which it has not; {} shown)",
+                            s.label(),
+                            self.material.shown.label()
+                        )
+                    }
+                    None => {}
+                }
                 false
             }
             Ok(Err(e)) => {

@@ -31,7 +31,8 @@ struct Args {
     #[arg(long, value_name = "SPEC")]
     material: Option<String>,
     /// The model shown first: measured (the measurement itself, for a measured INPUT),
-    /// tabulated, ggx, beckmann or glint (default: GGX where the material has one).
+    /// tabulated, ggx, beckmann or glint (default: GGX where the material has one); for an
+    /// INPUT fitted in the background, once its fit arrives.
     #[arg(long, value_name = "MODEL", value_parser = parse_shown)]
     shown: Option<Shown>,
     /// Split the sphere: the measurement on its left half, the edited model on its right (a
@@ -157,11 +158,8 @@ fn run_with(
                 app.open(spec);
             }
             app.split = args.split;
-            match args.shown {
-                Some(s) if app.material.available(s) => app.material.shown = s,
-                // The input's fit (and measurement) comes later, from a background job.
-                Some(s) => app.wanted = Some(s),
-                None => {}
+            if let Some(s) = args.shown {
+                app.ask_shown(s);
             }
             match (&cc.wgpu_render_state, no_gpu) {
                 (Some(rs), _) => {

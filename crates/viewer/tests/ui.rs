@@ -258,3 +258,73 @@ fn diffuse_albedo_edits_reach_the_renderer_and_reset_to_the_fit() {
         assert_eq!(h.state().material.diffuse(), Some(fitted), "{shown:?}");
     }
 }
+
+/// Runs the UI until the fit in progress has arrived.
+fn wait_for_fit(h: &mut Harness<'static, ViewerApp>) {
+    let t = std::time::Instant::now();
+    while h.state().fit_job.is_some() {
+        assert!(t.elapsed().as_secs() < 300, "the fit did not finish");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    h.run_steps(2);
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+}
+
+/// `facet-viewer INPUT --shown MODEL` on an input fitted in the background: the model asked
+/// for is the one shown once the fit has arrived (not GGX, the default of a new fit), and its
+/// radio button is the one selected.
+#[test]
+fn the_model_asked_for_is_shown_when_the_fit_arrives() {
+    use egui_kittest::kittest::NodeT;
+    for shown in [Shown::Tabulated, Shown::Beckmann] {
+        let mut h = harness();
+        // As `main` does: open INPUT, then --shown.
+        h.state_mut().open("analytic:ggx?alpha=0.3&conductor=gold");
+        h.state_mut().ask_shown(shown);
+        assert!(h.state().fit_job.is_some(), "the fit runs on a thread");
+        wait_for_fit(&mut h);
+        let app = h.state();
+        assert_eq!(app.material.source, "analytic:ggx?alpha=0.3&conductor=gold");
+        assert_eq!(app.material.shown, shown, "--shown {}", shown.label());
+        assert_eq!(app.sent_key.as_ref(), Some(&app.material.key()));
+        let radio = h.get_by_role_and_label(Role::RadioButton, shown.label());
+        assert_eq!(
+            radio.accesskit_node().toggled(),
+            Some(egui::accesskit::Toggled::True),
+            "{} selected",
+            shown.label()
+        );
+    }
+}
+
+/// A model picked while a fit runs is the one shown when it arrives; one the fit has not is
+/// said on the status line.
+#[test]
+fn a_model_picked_while_the_fit_runs_stays_picked() {
+    let mut h = harness();
+    h.state_mut().open("analytic:ggx?alpha=0.3&conductor=gold");
+    h.run_steps(1);
+    assert!(h.state().fit_job.is_some(), "the fit runs on a thread");
+    // By its id (the fit's status line above may change height meanwhile).
+    h.get_by_role_and_label(Role::RadioButton, Shown::Beckmann.label())
+        .click_accesskit();
+    h.run_steps(1);
+    assert_eq!(h.state().material.shown, Shown::Beckmann);
+    wait_for_fit(&mut h);
+    assert_eq!(h.state().material.shown, Shown::Beckmann);
+
+    // A fit JSON opens at once: a model it lacks is said, and the default stays.
+    let mut h = harness();
+    let fit =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/demo/default_fit.json");
+    h.state_mut().open(&fit.display().to_string());
+    h.state_mut().ask_shown(Shown::Measured);
+    let app = h.state();
+    assert!(app.wanted.is_none() && app.material.shown != Shown::Measured);
+    assert!(
+        app.status.contains("measured data asked for"),
+        "{}",
+        app.status
+    );
+}

@@ -4,7 +4,14 @@
 //! is opened (a FIFO would block the reader, a device never end), and the opened handle is
 //! checked again. Every read is bounded by a cap the caller names ([`Cap`]): a file larger than
 //! its kind can be is refused by its size, before a byte is read.
+//!
+//! What a load read can be recorded ([`recording`]): each file with the SHA-256 of the very
+//! bytes the reader got, hashed as they are read, so that whoever identifies the load by its
+//! files (a render shard's digest) sees what the loader saw and never reads a file again.
 
+use sha2::{Digest, Sha256};
+use std::cell::RefCell;
+use std::collections::HashSet;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -153,8 +160,20 @@ pub fn open(path: &Path, cap: Cap) -> Result<(std::fs::File, u64), InputError> {
     Ok((file, len))
 }
 
-/// The whole of a regular file of at most `cap` bytes.
+/// The whole of a regular file of at most `cap` bytes. Seen by [`recording`]: with the bytes'
+/// SHA-256, or without one when the file could not be read.
 pub fn read(path: &Path, cap: Cap) -> Result<Vec<u8>, InputError> {
+    let bytes = read_unrecorded(path, cap);
+    if is_recording() {
+        push(FileRead {
+            path: path.to_owned(),
+            sha256: bytes.as_ref().ok().map(|b| sha256(&[b])),
+        });
+    }
+    bytes
+}
+
+fn read_unrecorded(path: &Path, cap: Cap) -> Result<Vec<u8>, InputError> {
     let (file, len) = open(path, cap)?;
     let mut bytes = Vec::with_capacity(len as usize);
     // `take` keeps a file that grows while being read inside the cap.
@@ -185,6 +204,92 @@ pub fn read_to_string(path: &Path, cap: Cap) -> Result<String, InputError> {
             ),
         )
     })
+}
+
+/// A file read while [`recording`]: the path as the reader named it and the SHA-256 of the
+/// bytes it got.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct FileRead {
+    /// The file.
+    pub path: PathBuf,
+    /// SHA-256 of the bytes read; `None` for a file that could not be read (missing, not a
+    /// regular file, over its cap), which the loader either failed on or went on without (a
+    /// glTF's missing texture: a warning, and the factor alone).
+    pub sha256: Option<[u8; 32]>,
+}
+
+/// The reads seen so far by the innermost [`recording`] of a thread, each (path, bytes) once.
+#[derive(Default)]
+struct Recorder {
+    reads: Vec<FileRead>,
+    seen: HashSet<FileRead>,
+}
+
+thread_local! {
+    static RECORDER: RefCell<Option<Recorder>> = const { RefCell::new(None) };
+}
+
+fn is_recording() -> bool {
+    RECORDER.with(|r| r.borrow().is_some())
+}
+
+fn push(read: FileRead) {
+    RECORDER.with(|r| {
+        if let Some(rec) = r.borrow_mut().as_mut()
+            && rec.seen.insert(read.clone())
+        {
+            rec.reads.push(read);
+        }
+    });
+}
+
+fn sha256(parts: &[&[u8]]) -> [u8; 32] {
+    let mut h = Sha256::new();
+    for p in parts {
+        h.update(p);
+    }
+    h.finalize().into()
+}
+
+/// Runs `f` and returns, with its result, the files read on this thread meanwhile through
+/// [`read`] and [`read_to_string`] (and by readers that stream or map a file and say so with
+/// [`note_read`]), in the order first read: each file once per content (a file read twice
+/// with the same bytes is one entry), a file that could not be read with no digest. A
+/// recording inside another is seen by both. Reads on other threads are not seen: a loader
+/// that reads files in parallel would have to record them itself.
+pub fn recording<T>(f: impl FnOnce() -> T) -> (T, Vec<FileRead>) {
+    /// Puts the enclosing recording (if any) back, also when `f` panics.
+    struct Enclosing(Option<Option<Recorder>>);
+    impl Drop for Enclosing {
+        fn drop(&mut self) {
+            if let Some(outer) = self.0.take() {
+                RECORDER.with(|r| *r.borrow_mut() = outer);
+            }
+        }
+    }
+    let outer = RECORDER.with(|r| r.borrow_mut().replace(Recorder::default()));
+    let mut enclosing = Enclosing(Some(outer));
+    let value = f();
+    let outer = enclosing.0.take().expect("taken once");
+    let reads = RECORDER
+        .with(|r| std::mem::replace(&mut *r.borrow_mut(), outer))
+        .map(|rec| rec.reads)
+        .unwrap_or_default();
+    for read in &reads {
+        push(read.clone());
+    }
+    (value, reads)
+}
+
+/// Tells [`recording`] that `path` was read without [`read`] (streamed into a table, or
+/// mapped): its bytes are `parts`, one after the other. Hashes them only while recording.
+pub fn note_read(path: &Path, parts: &[&[u8]]) {
+    if is_recording() {
+        push(FileRead {
+            path: path.to_owned(),
+            sha256: Some(sha256(parts)),
+        });
+    }
 }
 
 /// `path` made absolute and free of symbolic links, for comparing inputs with outputs; a path
@@ -230,6 +335,55 @@ pub fn safe_file_stem(name: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every read seen, with the SHA-256 of the bytes read; a file read twice with the same
+    /// bytes is one entry, with other bytes two; a missing file has no digest; an inner
+    /// recording is seen by the outer one too; nothing is seen outside a recording, and a panic
+    /// inside one ends it.
+    #[test]
+    fn recording_sees_each_read_with_its_digest() {
+        let dir = std::env::temp_dir().join(format!("facet-input-rec-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b, gone) = (dir.join("a"), dir.join("b"), dir.join("gone"));
+        std::fs::write(&a, b"first").unwrap();
+        std::fs::write(&b, b"bee").unwrap();
+        let cap = Cap::new("test file", 1 << 10);
+        let digest = |bytes: &[u8]| Some(<[u8; 32]>::from(Sha256::digest(bytes)));
+        let ((), outer) = recording(|| {
+            read(&a, cap).unwrap();
+            read(&a, cap).unwrap();
+            assert!(read(&gone, cap).is_err());
+            let ((), inner) = recording(|| {
+                read_to_string(&b, cap).unwrap();
+            });
+            assert_eq!(inner.len(), 1);
+            std::fs::write(&a, b"second").unwrap();
+            read(&a, cap).unwrap();
+            note_read(&dir.join("streamed"), &[b"str", b"eamed"]);
+        });
+        let seen: Vec<(PathBuf, Option<[u8; 32]>)> =
+            outer.into_iter().map(|r| (r.path, r.sha256)).collect();
+        assert_eq!(
+            seen,
+            vec![
+                (a.clone(), digest(b"first")),
+                (gone.clone(), None),
+                (b.clone(), digest(b"bee")),
+                (a.clone(), digest(b"second")),
+                (dir.join("streamed"), digest(b"streamed")),
+            ]
+        );
+        read(&a, cap).unwrap();
+        assert!(!is_recording());
+        let caught = std::panic::catch_unwind(|| {
+            recording(|| {
+                read(&a, cap).unwrap();
+                panic!("a loader's bug");
+            })
+        });
+        assert!(caught.is_err() && !is_recording());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn stems_are_safe() {

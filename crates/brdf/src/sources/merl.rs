@@ -99,6 +99,9 @@ impl MerlTable {
         {
             return Ok(None); // the general path names the sample
         }
+        // Read without `input::read`: said to a recording here, with the bytes it holds.
+        let values: &[u8] = bytemuck::cast_slice(raw.values());
+        crate::io::input::note_read(path, &[&header, values]);
         Ok(Some(MerlTable { raw }))
     }
 

@@ -26,19 +26,12 @@ struct Loaded {
 #[derive(Clone, Debug, Default)]
 pub struct Buffers {
     loaded: Vec<Loaded>,
-    /// The files read, in order.
-    files: Vec<PathBuf>,
 }
 
 impl Buffers {
     /// Buffer `i`'s bytes, exactly its byteLength.
     pub fn get(&self, i: usize) -> Option<&[u8]> {
         self.loaded.get(i).map(|l| &l.bytes[..l.len])
-    }
-
-    /// The files the buffers were read from.
-    pub fn files(&self) -> &[PathBuf] {
-        &self.files
     }
 
     /// Buffer `i`'s byteLength.
@@ -105,7 +98,6 @@ impl Buffers {
                 bytes,
             });
         }
-        let files = files.into_keys().collect();
-        Ok(Buffers { loaded, files })
+        Ok(Buffers { loaded })
     }
 }

@@ -65,12 +65,15 @@ pub const DEFAULT_YFOV: f32 = std::f32::consts::FRAC_PI_4;
 /// The file is read through [`facet_brdf::io::input`] (a regular file of at most
 /// [`Cap::GLTF`](facet_brdf::io::input::Cap::GLTF) bytes), then [`load_gltf_bytes`].
 pub fn load_gltf(path: &Path, options: &LoadOptions) -> Result<Scene, RenderError> {
-    let bytes = input::read(path, Cap::GLTF)?;
-    load_gltf_bytes(path, &bytes, options)
+    let (bytes, own) = input::recording(|| input::read(path, Cap::GLTF));
+    let mut scene = load_gltf_bytes(path, &bytes?, options)?;
+    scene.inputs.splice(0..0, own);
+    Ok(scene)
 }
 
 /// [`load_gltf`] of a glTF JSON or `.glb` already in memory: `path` names it in messages and
-/// is where relative URIs (buffers, images, fits) are resolved from.
+/// is where relative URIs (buffers, images, fits) are resolved from. [`Scene::inputs`] lists
+/// the files it read, as [`input::recording`] saw them (not `path`: its bytes were given).
 ///
 /// Hostile input is an error naming the file and what is wrong with it (see
 /// [`super::gltf_check`]); should the `gltf` crate still panic, the panic is caught and becomes
@@ -82,7 +85,11 @@ pub fn load_gltf_bytes(
     bytes: &[u8],
     options: &LoadOptions,
 ) -> Result<Scene, RenderError> {
-    guard(path, "the glTF", || load_document(path, bytes, options))
+    let (scene, read) =
+        input::recording(|| guard(path, "the glTF", || load_document(path, bytes, options)));
+    let mut scene = scene?;
+    scene.inputs = read;
+    Ok(scene)
 }
 
 /// Runs `f`, turning a panic inside it into a [`RenderError::Input`] naming `path`:
@@ -158,12 +165,6 @@ fn load_document(path: &Path, bytes: &[u8], options: &LoadOptions) -> Result<Sce
     let mut loader = MaterialLoader::new(path, &buffers, &options.materials);
     loader.nbrdf = options.nbrdf.as_deref();
     scene.materials = loader.load_all(&document, &mut scene.textures, &mut scene.warnings)?;
-    scene.inputs = buffers
-        .files()
-        .iter()
-        .chain(loader.files())
-        .cloned()
-        .collect();
 
     let placed = walk_nodes(path, &document, &mut scene.warnings)?;
     let mut default_material = None;

@@ -205,16 +205,6 @@ impl<'a> MaterialLoader<'a> {
         }
     }
 
-    /// Every file read (or tried) so far: image files, fits and measurements.
-    pub fn files(&self) -> impl Iterator<Item = &PathBuf> {
-        let images = self.images.keys().filter_map(|k| match k {
-            ImageKey::File(f) => Some(f),
-            ImageKey::Image(_) => None,
-        });
-        let measured = self.measurements.values().filter_map(|m| m.path.as_ref());
-        images.chain(self.fits.keys()).chain(measured)
-    }
-
     /// All materials of `doc`, textures appended to `textures`, warnings to `warnings`.
     pub fn load_all(
         &mut self,

@@ -4,6 +4,7 @@
 //! material per triangle, textures as RGBA8, punctual lights, one camera. glTF is Y-up and
 //! right-handed; so is the scene.
 
+pub use facet_brdf::io::input::FileRead;
 use facet_brdf::model::material::ModelChoice;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::PathBuf;
@@ -52,9 +53,12 @@ pub struct Scene {
     pub camera: Camera,
     /// Messages about things skipped or defaulted (a missing texture, a dropped triangle).
     pub warnings: Vec<String>,
-    /// Every file read besides the scene file itself (buffers, textures, fits named by
-    /// materials), so that no output of a run replaces one of them.
-    pub inputs: Vec<PathBuf>,
+    /// Every file the load read, with the SHA-256 of the bytes it read, in the order first
+    /// read: the glTF itself (when [`load_gltf`] read it), its buffers, images, fits,
+    /// measurements and the neural proxies' file. A file it could not read and went on
+    /// without (a missing texture) is here without a digest. What a render shard's digest is
+    /// made of, and what no output of a run may replace.
+    pub inputs: Vec<FileRead>,
 }
 
 /// A pinhole camera.

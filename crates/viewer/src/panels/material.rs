@@ -24,6 +24,10 @@ fn contents(app: &mut ViewerApp, ui: &mut egui::Ui) {
             ui.radio_value(&mut m.shown, s, s.label());
         });
     }
+    // Picked while a fit runs: the choice holds for the fit when it arrives, too.
+    if m.shown != before.shown && app.fit_job.is_some() {
+        app.wanted = Some(m.shown);
+    }
     let can_split = m.available(Shown::Measured) && app.gltf.is_none();
     ui.add_enabled_ui(can_split, |ui| {
         ui.checkbox(
