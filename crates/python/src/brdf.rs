@@ -3,14 +3,17 @@
 
 use crate::arrays::directions;
 use crate::error::facet_err;
-use crate::merl::table_array;
+use crate::merl::{SHAPE, file_bytes, table_array};
 use facet_fit::Brdf;
 use facet_fit::export::rgl::{BsdfResolution, write_rgl};
+use facet_fit::model::merl_grid::MerlTable;
+use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::sources::rgl::RglBsdf;
 use facet_fit::sources::{InputSpec, Residence};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyArray4};
+use numpy::{PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -172,4 +175,30 @@ pub fn open(py: Python<'_>, source: &str, nbrdf: Option<PathBuf>) -> PyResult<Py
 #[pyo3(signature = (source, nbrdf = None))]
 pub fn load(py: Python<'_>, source: PathBuf, nbrdf: Option<PathBuf>) -> PyResult<PyBrdf> {
     open(py, &source.to_string_lossy(), nbrdf)
+}
+
+/// A MERL measurement from an array shaped like `Brdf.to_merl`'s: (3, 90, 90, 180) f_r values
+/// (channel, θh, θd, φd bins; f_r, not the file's stored values), negative where a sample is
+/// missing. It is evaluated as a MERL file is (interpolated between bins). Raises FacetError
+/// for another shape, a NaN, an infinite or too large value, or a table the fitter cannot use
+/// (no backscattering sample, fewer than 92 valid samples).
+#[pyfunction]
+#[pyo3(signature = (array, name = "from_merl"))]
+pub fn from_merl(py: Python<'_>, array: &Bound<'_, PyAny>, name: &str) -> PyResult<PyBrdf> {
+    let arr = crate::arrays::contiguous_f64(array)?;
+    if arr.shape() != SHAPE {
+        return Err(facet_err(format!(
+            "from_merl: an array of shape (3, 90, 90, 180) is needed, not {:?}",
+            arr.shape()
+        )));
+    }
+    let ro = arr.readonly();
+    let bytes = file_bytes(ro.as_slice()?);
+    let label = format!("<array {name}>");
+    let src = py.allow_threads(|| {
+        let table = MerlTable::parse(Path::new(&label), &bytes).map_err(facet_err)?;
+        MerlBrdf::from_table(name, table)
+            .map_err(|problem| facet_err(format!("{label}: {problem}")))
+    })?;
+    Ok(PyBrdf::new(Arc::new(src), "from_merl"))
 }

@@ -34,7 +34,7 @@ fn native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<brdf::PyBrdf>()?;
     m.add_class::<fit::PyFit>()?;
     m.add_function(wrap_pyfunction!(brdf::load, m)?)?;
-    m.add_function(wrap_pyfunction!(merl::from_merl, m)?)?;
+    m.add_function(wrap_pyfunction!(brdf::from_merl, m)?)?;
     m.add_function(wrap_pyfunction!(fit::fit, m)?)?;
     Ok(())
 }
