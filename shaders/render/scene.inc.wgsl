@@ -8,48 +8,23 @@
 #include "render/light_tree.inc.wgsl"
 #include "render/none.inc.wgsl"
 
-// Rust: facet_render::gpu_types::GpuMaterial.
+// Rust: facet_render::materials::GpuMaterial. The header every class reads, then the class
+// block, whose fields its class defines (render/materials/blocks.inc.wgsl decodes them).
 struct Material {
-    base_color: vec4<f32>,
-    // rgb emitted radiance, w the specular weight of a glTF material (KHR_materials_specular)
-    emissive: vec4<f32>,
-    // rgb Lambertian albedo of a fitted material
-    diffuse: vec4<f32>,
-    kind: u32,
-    ndf_kind: u32,
-    alpha_x: f32,
-    alpha_y: f32,
-    rotation: f32,
-    metallic: f32,
-    roughness: f32,
-    normal_scale: f32,
-    tex_base: u32,
-    tex_mr: u32,
-    tex_normal: u32,
+    // emitted radiance (rgb) and its texture (NONE: none)
+    emissive: vec3<f32>,
     tex_emissive: u32,
-    fresnel_offset: u32,
-    fresnel_count: u32,
-    tab_offset: u32,
+    // the tangent-space normal map (NONE: none) and its xy scale
+    tex_normal: u32,
+    normal_scale: f32,
+    // the shading queue its hits go to
     queue: u32,
-    // a measured material's table: its MERL grid or its RGL block in `tables`
-    measured_offset: u32,
-    // a coated material's coat block in `tables` (NONE: no coat), render/coat.inc.wgsl
-    coat_block: u32,
-    coat_weight: f32,
-    coat_alpha: f32,
-    coat_eta: f32,
-    // KHR_materials_clearcoat's textures (NONE: none) and normal scale (glTF stage: coat_weight
-    // the factor, coat_alpha the roughness)
-    tex_clearcoat: u32,
-    tex_clearcoat_roughness: u32,
-    tex_clearcoat_normal: u32,
-    clearcoat_normal_scale: f32,
-    pad0: u32,
-    pad1: u32,
-    pad2: u32,
+    // a fit's coat layer: its block in `tables` (NONE: no coat), render/materials/coat.inc.wgsl
+    coat: u32,
+    block: array<u32, 16>,
 }
 
-// Rust: facet_render::gpu_types::GpuLight.
+// Rust: facet_render::layout::gpu_types::GpuLight.
 struct Light {
     kind: u32,
     // the triangle of a LIGHT_TRIANGLE
@@ -84,6 +59,8 @@ struct Light {
 @group(1) @binding(9) var<storage, read> triangle_light: array<u32>;
 // The light BVH (one unused node without one: frame.scene.light_tree_nodes == 0).
 @group(1) @binding(10) var<storage, read> light_tree: array<LightNode>;
+
+#include "render/materials/blocks.inc.wgsl"
 
 fn vertex(region: u32, i: u32) -> vec4<f32> {
     return vertices[region * frame.scene.n_vertices + i];
@@ -239,24 +216,11 @@ fn offset_origin(s: Surface, w: vec3<f32>) -> vec3<f32> {
 
 fn emitted(s: Surface) -> vec3<f32> {
     let m = materials[s.material];
-    var le = m.emissive.xyz;
+    var le = m.emissive;
     if (m.tex_emissive != NONE) {
         le *= texture_sample(m.tex_emissive, s.uv).xyz;
     }
     return select(vec3<f32>(0.0), le, s.front);
-}
-
-// ---- Fresnel tables (θd nodes evenly spaced over [0, π/2], inclusive) ----------------------
-
-fn fresnel_table(m: Material, cos_d: f32) -> vec3<f32> {
-    let n = m.fresnel_count;
-    let theta_d = acos(clamp(cos_d, 0.0, 1.0));
-    let x = clamp(theta_d / (0.5 * PI) * f32(n - 1u), 0.0, f32(n - 1u));
-    let j = min(u32(x), n - 2u);
-    let o = m.fresnel_offset + 3u * j;
-    let a = vec3<f32>(tables[o], tables[o + 1u], tables[o + 2u]);
-    let b = vec3<f32>(tables[o + 3u], tables[o + 4u], tables[o + 5u]);
-    return mix(a, b, x - f32(j));
 }
 
 // ---- environment ---------------------------------------------------------------------------
@@ -469,7 +433,7 @@ fn sample_light(p: vec3<f32>, sel: vec3<f32>, n: vec3<f32>, u0_in: f32, u: vec2<
         ls.pdf = triangle_solid_angle_pdf(pmf, p, q, nq, area);
         let m = materials[tri.w];
         // One-sided emitters: only the front (counter-clockwise) side emits.
-        var le = m.emissive.xyz;
+        var le = m.emissive;
         if (m.tex_emissive != NONE) {
             let uv = (1.0 - su) * vertex(3u, tri.x).xy + su * (1.0 - u.y) * vertex(3u, tri.y).xy + su * u.y * vertex(3u, tri.z).xy;
             le *= texture_sample(m.tex_emissive, uv).xyz;

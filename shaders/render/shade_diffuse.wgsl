@@ -1,4 +1,4 @@
-// Shading stage of glTF metallic-roughness materials (glTF 2.0, Appendix B, with the specular
+// Shading stage of glTF metallic-roughness materials (facet_render::materials::gltf) (glTF 2.0, Appendix B, with the specular
 // weight of KHR_materials_specular): GGX α = roughness², F0 = mix(0.04 · specular, base, metallic),
 //   f = (1 − metallic)(1 − specular · F) base/π + F D G2 / (4 cos θi cos θo).
 // Specular weight 0 and metallic 0 is a pure Lambertian surface.
@@ -31,8 +31,8 @@ struct Bsdf {
 }
 
 fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
-    let m = materials[s.material];
-    var base = m.base_color.xyz;
+    let m = gltf_block(s.material, 0u);
+    var base = m.base_color;
     var metallic = m.metallic;
     var roughness = m.roughness;
     if (m.tex_base != NONE) {
@@ -47,19 +47,19 @@ fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
     var b: Bsdf;
     b.base = base;
     b.metallic = clamp(metallic, 0.0, 1.0);
-    b.specular = m.emissive.w;
+    b.specular = m.specular;
     b.ndf = AnalyticNdf(0u, alpha, alpha, 0.0);
     b.p_spec = b.metallic + (1.0 - b.metallic) * 0.5 * min(b.specular, 1.0);
     b.cc = 0.0;
-    if (m.coat_weight > 0.0) {
+    if (m.clearcoat > 0.0) {
         clearcoat_setup(&b, s, m);
     }
     return b;
 }
 
-fn clearcoat_setup(b: ptr<function, Bsdf>, s: Surface, m: Material) {
-    var cc = m.coat_weight;
-    var roughness = m.coat_alpha;
+fn clearcoat_setup(b: ptr<function, Bsdf>, s: Surface, m: GltfBlock) {
+    var cc = m.clearcoat;
+    var roughness = m.clearcoat_roughness;
     if (m.tex_clearcoat != NONE) {
         cc *= texture_sample(m.tex_clearcoat, s.uv).x;
     }

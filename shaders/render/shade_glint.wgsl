@@ -7,7 +7,7 @@
 // the count taken over the ray cone's footprint mapped into UV (an ellipse), replaced by its mean
 // N a P once that exceeds the threshold. Sampling: the smooth lobe's visible normals, mixed with
 // the cosine lobe by albedo where the fit has a diffuse term (as shade_microfacet.wgsl).
-// Under a fit's coat (render/coat.inc.wgsl) the flakes are the base's: the same counts, lit and
+// Under a fit's coat (render/materials/coat.inc.wgsl) the flakes are the base's: the same counts, lit and
 // seen along the directions refracted into the coat and attenuated by its transmission.
 
 #include "render/frame.inc.wgsl"
@@ -16,7 +16,8 @@
 #include "render/bvh.inc.wgsl"
 #include "render/scene.inc.wgsl"
 #include "render/shade.inc.wgsl"
-#include "render/tabulated.inc.wgsl"
+#include "render/materials/lobe.inc.wgsl"
+#include "render/materials/tabulated.inc.wgsl"
 #include "glint/tea.inc.wgsl"
 
 override Q_SHADE: u32;
@@ -32,10 +33,11 @@ override Q_SHADE: u32;
 #include "glint/chains2.inc.wgsl"
 #include "glint/lit.inc.wgsl"
 #include "glint/glint_brdf.inc.wgsl"
-#include "render/coat.inc.wgsl"
+#include "render/materials/coat.inc.wgsl"
 
 struct Bsdf {
     material: u32,
+    lobe: LobeBlock,
     ndf: AnalyticNdf,
     // The fit's tabulated NDF, when params.ndf_kind is NDF_KIND_TABULATED.
     tab: TabNdf,
@@ -71,24 +73,25 @@ fn clamp_axis(v: vec2<f32>) -> vec2<f32> {
 }
 
 fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
-    let m = materials[s.material];
+    let l = lobe_block(s.material, 0u);
     var b: Bsdf;
     b.material = s.material;
-    b.ndf = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
+    b.lobe = l;
+    b.ndf = AnalyticNdf(l.ndf_kind, l.alpha_x, l.alpha_y, l.rotation);
     if (params.ndf_kind == NDF_KIND_TABULATED) {
-        b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
+        b.tab = tab_ndf_at(l.table, l.alpha_x, l.alpha_y, l.rotation);
     }
     b.center = s.uv;
     // One of the blended direction cells per sample, chosen by its weight: the image converges
     // to the blended counts, and the walk follows one chain per query instead of up to four.
     b.cell_u = path_rand(slot, 6u);
-    b.diffuse = m.diffuse.xyz;
+    b.diffuse = l.diffuse;
     // Lobe choice by albedo, as for the smooth microfacet class.
-    let spec = luminance(fresnel_table(m, 1.0));
+    let spec = luminance(fresnel_table(l, 1.0));
     let diff = luminance(b.diffuse);
     b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
     b.albedo = spec + diff;
-    b.coat = coat_of(m);
+    b.coat = coat_at(materials[s.material].coat);
     // The cone's circle of radius w/2 around the ray, projected onto the tangent plane: an
     // ellipse with semi-axes r (across the ray) and r / |cos θ| (along it).
     let d = path_get(R_DIR, slot).xyz;
@@ -121,13 +124,12 @@ fn base_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -
     glint_tab = b.tab;
     glint_cell_u = b.cell_u;
     let k = glint_factor_pair(wi_light, wi_bsdf, wo, b.center, b.a, b.b);
-    let m = materials[b.material];
     var f: array<vec3<f32>, 2>;
     if (k.x > 0.0) {
-        f[0] = fresnel_table(m, dot(wi_light, normalize(wi_light + wo))) * k.x;
+        f[0] = fresnel_table(b.lobe, dot(wi_light, normalize(wi_light + wo))) * k.x;
     }
     if (k.y > 0.0) {
-        f[1] = fresnel_table(m, dot(wi_bsdf, normalize(wi_bsdf + wo))) * k.y;
+        f[1] = fresnel_table(b.lobe, dot(wi_bsdf, normalize(wi_bsdf + wo))) * k.y;
     }
     if (wo.z > 0.0) {
         f[0] += select(vec3<f32>(0.0), b.diffuse / PI, wi_light.z > 0.0);
@@ -180,10 +182,10 @@ fn base_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
 }
 
 fn bsdf_roughness(b: Bsdf) -> f32 {
-    // m.roughness: the fit's effective α (GGX) for a table, √(αx αy) for an analytic NDF.
+    // The fit's effective α (GGX) for a table, √(αx αy) for an analytic NDF.
     var r = sqrt(b.ndf.alpha_x * b.ndf.alpha_y);
     if (params.ndf_kind == NDF_KIND_TABULATED) {
-        r = materials[b.material].roughness;
+        r = b.lobe.cone_alpha;
     }
     return mix(1.0, r, b.p_spec);
 }

@@ -1,21 +1,23 @@
-// Shading stage of fitted microfacet materials (facet_fit::microfacet::MicrofacetBrdf):
+// Shading stage of the fitted classes without glints (facet_render::materials::{analytic,
+// tabulated, merl}), a fit's microfacet model (render/materials/lobe.inc.wgsl):
 //   f = F(θd) D(h) G2(ωi, ωo) / (4 cos θi cos θo) + ρd / π,
 // F the fit's Fresnel table, D and Λ analytic (GGX / Beckmann, TABULATED = 0) or the fit's
 // tables (TABULATED = 1), the correlated G2. Sampling, with probability p_spec: the normals
 // visible from ωo (by frame.ndf_sampling: analytic in closed form, tabulated by the table's
 // visible slices); else the cosine lobe when the fit has a diffuse term.
-// MEASURED = 1 (with TABULATED = 1): f is a measured MERL-grid table (render/merl.inc.wgsl),
+// MEASURED = 1 (with TABULATED = 1): f is a measured MERL-grid table (render/materials/merl.inc.wgsl),
 // sampled as its fit's tabulated model is. A fit that kept a coat is this model under its coat
-// (render/coat.inc.wgsl).
+// (render/materials/coat.inc.wgsl).
 
 #include "render/frame.inc.wgsl"
 #include "common/microfacet.inc.wgsl"
 #include "render/bvh.inc.wgsl"
 #include "render/scene.inc.wgsl"
 #include "render/shade.inc.wgsl"
-#include "render/tabulated.inc.wgsl"
-#include "render/merl.inc.wgsl"
-#include "render/coat.inc.wgsl"
+#include "render/materials/lobe.inc.wgsl"
+#include "render/materials/tabulated.inc.wgsl"
+#include "render/materials/merl.inc.wgsl"
+#include "render/materials/coat.inc.wgsl"
 
 override Q_SHADE: u32;
 override TABULATED: bool;
@@ -23,6 +25,7 @@ override MEASURED: bool;
 
 struct Bsdf {
     material: u32,
+    lobe: LobeBlock,
     analytic: AnalyticNdf,
     tab: TabNdf,
     diffuse: vec3<f32>,
@@ -33,20 +36,21 @@ struct Bsdf {
 }
 
 fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
-    let m = materials[s.material];
+    let l = lobe_block(s.material, 0u);
     var b: Bsdf;
     b.material = s.material;
-    b.analytic = AnalyticNdf(m.ndf_kind, m.alpha_x, m.alpha_y, m.rotation);
+    b.lobe = l;
+    b.analytic = AnalyticNdf(l.ndf_kind, l.alpha_x, l.alpha_y, l.rotation);
     if (TABULATED) {
-        b.tab = tab_ndf_at(m.tab_offset, m.alpha_x, m.alpha_y, m.rotation);
+        b.tab = tab_ndf_at(l.table, l.alpha_x, l.alpha_y, l.rotation);
     }
-    b.diffuse = m.diffuse.xyz;
+    b.diffuse = l.diffuse;
     // Lobe choice by albedo: the specular lobe's is at most ~F(0); compare with ρd.
-    let spec = luminance(fresnel_table(m, 1.0));
+    let spec = luminance(fresnel_table(l, 1.0));
     let diff = luminance(b.diffuse);
     b.p_spec = select(1.0, spec / (spec + diff), diff > 0.0);
     b.albedo = spec + diff;
-    b.coat = coat_of(m);
+    b.coat = coat_at(materials[s.material].coat);
     if (frame.ndf_sampling == NDF_SAMPLING_COSINE) {
         b.p_spec = 0.0;
     }
@@ -93,10 +97,10 @@ fn base_eval(b: Bsdf, wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     if (MEASURED) {
-        return merl_eval(materials[b.material].measured_offset, wi, wo);
+        return merl_eval(merl_block(b.material, LOBE_BLOCK_WORDS).table, wi, wo);
     }
     let h = normalize(wi + wo);
-    let f = fresnel_table(materials[b.material], dot(wi, h));
+    let f = fresnel_table(b.lobe, dot(wi, h));
     let g = g2_correlated(mf_lambda(b, wi), mf_lambda(b, wo), wi, wo);
     return f * mf_d(b, h) * g / (4.0 * wi.z * wo.z) + b.diffuse / PI;
 }
@@ -131,9 +135,8 @@ fn base_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
 }
 
 fn bsdf_roughness(b: Bsdf) -> f32 {
-    let m = materials[b.material];
-    // m.roughness: the fit's effective α (GGX), the stretch included.
-    return mix(1.0, m.roughness, b.p_spec);
+    // The fit's effective α (GGX), the stretch included.
+    return mix(1.0, b.lobe.cone_alpha, b.p_spec);
 }
 
 @compute @workgroup_size(WG)

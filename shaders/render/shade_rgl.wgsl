@@ -1,5 +1,5 @@
-// Shading stage of measured RGL `.bsdf` materials: f, its sampling and its pdf from the file's
-// own warps (render/rgl.inc.wgsl, the twin of facet_fit::sources::rgl::RglBsdf), as Mitsuba 3's
+// Shading stage of measured RGL `.bsdf` materials (facet_render::materials::rgl): f, its sampling and its pdf from the file's
+// own warps (render/materials/rgl.inc.wgsl, the twin of facet_fit::sources::rgl::RglBsdf), as Mitsuba 3's
 // `measured` plugin evaluates and samples them. The view direction ωo is the file's parameter
 // direction (Mitsuba's si.wi); the light or sampled direction ωi is the one it tabulates.
 
@@ -7,17 +7,19 @@
 #include "render/bvh.inc.wgsl"
 #include "render/scene.inc.wgsl"
 #include "render/shade.inc.wgsl"
-#include "render/rgl.inc.wgsl"
+#include "render/materials/rgl.inc.wgsl"
 
 override Q_SHADE: u32;
 
 struct Bsdf {
-    material: u32,
     table: RglTable,
+    // the GGX α the ray cone widens by
+    cone_alpha: f32,
 }
 
 fn bsdf_setup(s: Surface, slot: u32) -> Bsdf {
-    return Bsdf(s.material, rgl_at(materials[s.material].measured_offset));
+    let r = rgl_block(s.material, 0u);
+    return Bsdf(rgl_at(r.table), r.cone_alpha);
 }
 
 fn bsdf_eval2(b: Bsdf, wi_light: vec3<f32>, wi_bsdf: vec3<f32>, wo: vec3<f32>) -> array<vec3<f32>, 2> {
@@ -33,7 +35,7 @@ fn bsdf_sample_wi(b: Bsdf, wo: vec3<f32>, u: vec3<f32>) -> vec3<f32> {
 }
 
 fn bsdf_roughness(b: Bsdf) -> f32 {
-    return materials[b.material].roughness;
+    return b.cone_alpha;
 }
 
 @compute @workgroup_size(WG)

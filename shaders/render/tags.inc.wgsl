@@ -5,8 +5,9 @@
 const MAT_GLTF: u32 = 0u; // a glTF metallic-roughness material
 const MAT_ANALYTIC: u32 = 1u; // a fit's GGX or Beckmann model
 const MAT_TABULATED: u32 = 2u; // a fit's tabulated NDF
-const MAT_GLINT: u32 = 3u; // a glint material
-const MAT_MEASURED: u32 = 4u; // a measurement: a MERL-grid table or an RGL `.bsdf`
+const MAT_MERL: u32 = 3u; // a MERL-grid measurement, sampled by its fit's tabulated model
+const MAT_RGL: u32 = 4u; // an RGL `.bsdf` measurement
+const MAT_GLINT: u32 = 5u; // a fit's model as glints
 
 // facet_render::layout::tags::LightKind
 const LIGHT_POINT: u32 = 0u; // KHR_lights_punctual point light

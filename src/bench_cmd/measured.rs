@@ -11,7 +11,7 @@ use facet_fit::model::material::ModelChoice;
 use facet_fit::sources::rgl::RglBsdf;
 use facet_fit::sources::{InputSpec, nbrdf::NbrdfLibrary};
 use facet_fit::{FitConfig, fit_material};
-use facet_render::resources::materials::measured_block;
+use facet_render::materials::measured_block;
 use facet_render::scene::{FacetMaterial, Material, MeasuredMaterial, Measurement};
 use serde_json::{Value, json};
 use std::sync::Arc;

@@ -6,6 +6,7 @@
 //! |---|---|
 //! | [`scene`] | glTF scenes ([`scene::load_gltf`]): meshes, materials (measured ones included), lights, the camera and its frame |
 //! | [`bvh`] | the obvhs CWBVH, its GPU form, a batch ray query ([`RayTracer`]) |
+//! | [`materials`] | the material classes, one file each: a class's block of the GPU record, its plan, its queue and shading stage |
 //! | [`resources`] | a scene on the GPU: BVH, material plan, tables, glint pyramids, textures, lights and their BVH |
 //! | [`layout`] | what the resources and the integrator agree on with the WGSL: the GPU records, the closed-set tags, the bind groups, the queues, the device limits |
 //! | [`integrator`] | the wavefront loop ([`Integrator`]) and its stages — logic, generate, extend, shade per material class, connect — as compute passes over queues; a [`Wavefront`] (the GPU state of one image); the render's settings ([`integrator::config`]) |
@@ -37,6 +38,7 @@ pub mod bvh;
 mod error;
 pub mod integrator;
 pub mod layout;
+pub mod materials;
 pub mod output;
 pub mod resources;
 pub mod scene;

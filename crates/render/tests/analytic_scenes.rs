@@ -1141,7 +1141,7 @@ fn materials_sharing_a_measurement_upload_it_once() {
     };
     let (one, many) = (upload(1), upload(200));
     assert_eq!((one.1, one.2, many.1, many.2), (1, 1, 1, 1));
-    let fresnel = 4 * 3 * facet_render::resources::materials::FRESNEL_NODES as u64;
+    let fresnel = 4 * 3 * facet_render::materials::FRESNEL_NODES as u64;
     println!(
         "tables: {} bytes for 1 material, {} for 200 ({} a material more)",
         one.0,

@@ -1,4 +1,4 @@
-//! The coat's sampling in WGSL (shaders/render/coat.inc.wgsl, through coat_probe.wgsl, over a
+//! The coat's sampling in WGSL (shaders/render/materials/coat.inc.wgsl, through coat_probe.wgsl, over a
 //! GGX + Lambertian base): its histogram against the CPU's pdf of the same mixture (χ²), and
 //! its pdf against the CPU's, for a sharp and a rough coat, from normal to grazing views. The
 //! CPU's pdf is written here from the mixture's definition: the coat's visible normals with
@@ -13,7 +13,7 @@ use facet_fit::model::coat::{Coat, CoatLayer};
 use facet_fit::model::microfacet::{AnalyticNdf, NdfKind};
 use facet_fit::numerics::chi2;
 use facet_gpu::{buffer, gpu_for_tests, shader};
-use facet_render::resources::materials::coat_block;
+use facet_render::materials::coat::coat_block;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -54,13 +54,6 @@ fn coat_sampling_matches_its_pdf() {
     for coat in [Coat::new(1.5, 0.05, 1.0), Coat::new(1.5, 0.3, 0.5)] {
         let layer = CoatLayer::new(coat).unwrap();
         let tables = buffer::storage(&gpu.device, "coat", &coat_block(&layer));
-        let material: [u32; 4] = [
-            0,
-            (coat.weight as f32).to_bits(),
-            (coat.alpha as f32).to_bits(),
-            (coat.eta as f32).to_bits(),
-        ];
-        let mb = buffer::uniform(&gpu.device, "material", &material);
         let (alpha, p_spec, albedo) = BASE;
         let bb = buffer::uniform(
             &gpu.device,
@@ -85,7 +78,6 @@ fn coat_sampling_matches_its_pdf() {
                 "coat sample",
                 &[
                     tables.as_entire_binding(),
-                    mb.as_entire_binding(),
                     bb.as_entire_binding(),
                     ib.as_entire_binding(),
                 ],

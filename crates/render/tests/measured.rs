@@ -1,5 +1,5 @@
 //! Measured materials on the GPU against their CPU twins: the MERL-grid lookup of
-//! `shaders/render/merl.inc.wgsl` against `MerlTable::lookup_interpolated` on the same filled
+//! `shaders/render/materials/merl.inc.wgsl` against `MerlTable::lookup_interpolated` on the same filled
 //! table, at 10⁵ random direction pairs, grazing ones included.
 
 use facet_fit::model::analytic::parse_analytic;
@@ -11,7 +11,7 @@ use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_fit::{Brdf, Rgb};
 use facet_gpu::{Gpu, buffer, dispatch, gpu_for_tests, shader};
 use facet_render::bvh::procedural::Rng;
-use facet_render::resources::materials::merl_block;
+use facet_render::materials::merl::merl_block;
 use glam::DVec3;
 use std::f64::consts::{FRAC_PI_2, PI};
 

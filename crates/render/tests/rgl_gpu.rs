@@ -1,4 +1,4 @@
-//! RGL `.bsdf` materials in WGSL (shaders/render/rgl.inc.wgsl through the probe
+//! RGL `.bsdf` materials in WGSL (shaders/render/materials/rgl.inc.wgsl through the probe
 //! shaders/tests/render/rgl_probe.wgsl) against the CPU reader (facet_fit::sources::rgl::RglBsdf):
 //! `rgl_eval` and `rgl_pdf` at 10⁵ direction pairs, `rgl_sample` at 2·10⁴ (ωi, u), on files
 //! Facet writes from analytic GGX: isotropic, anisotropic, and anisotropic cut to a half and a
@@ -10,7 +10,7 @@ use facet_fit::numerics::chi2::uniforms;
 use facet_fit::sources::rgl::RglBsdf;
 use facet_gpu::{Gpu, buffer, dispatch, shader};
 use facet_oracles::fixtures::rgl_test_files;
-use facet_render::resources::rgl_table::rgl_block;
+use facet_render::materials::rgl::rgl_block;
 use glam::{DVec3, Vec3};
 
 fn files() -> Vec<(&'static str, RglBsdf)> {

@@ -1,4 +1,4 @@
-//! The tabulated NDF's visible-normal sampling in WGSL (shaders/render/tabulated.inc.wgsl): its
+//! The tabulated NDF's visible-normal sampling in WGSL (shaders/render/materials/tabulated.inc.wgsl): its
 //! histogram against the CPU twin's pdf (χ²) and its pdf against the CPU's, for the demo fit's
 //! extracted table (plain, and stretched and rotated) and an anisotropic table, from normal to
 //! grazing views.
@@ -12,7 +12,7 @@ use facet_fit::model::microfacet::{AnalyticNdf, NdfKind};
 use facet_fit::model::tabulated::{NdfTables, Stretch, TabulatedNdf, phi_node, u_node_theta};
 use facet_fit::numerics::chi2;
 use facet_gpu::{buffer, shader};
-use facet_render::resources::materials::tabulated_block;
+use facet_render::materials::tabulated::tabulated_block;
 use glam::DVec3;
 use std::path::Path;
 

@@ -23,3 +23,28 @@ fn the_generated_wgsl_holds_the_rust_tags() {
     );
     assert!(problems.is_empty(), "{}", problems.join("\n"));
 }
+
+/// The class blocks' WGSL (`facet_render::materials::record`) is generated too: the committed
+/// `shaders/render/materials/blocks.inc.wgsl` is exactly the text the Rust blocks give, and
+/// each block fits the record's class block.
+#[test]
+fn the_generated_wgsl_holds_the_class_blocks() {
+    use facet_render::materials::record::BLOCK_WORDS;
+    let path = shaders_dir().join("render/materials/blocks.inc.wgsl");
+    let generated = facet_render::materials::wgsl();
+    if std::env::var_os("FACET_REGENERATE").is_some() {
+        std::fs::write(&path, &generated).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        committed == generated,
+        "{} is not the generated text; rerun with FACET_REGENERATE=1",
+        path.display()
+    );
+    for block in facet_render::materials::class_blocks() {
+        assert!(block.words() <= BLOCK_WORDS, "{} overflows", block.wgsl);
+    }
+    // The MERL class places its block after its lobe's.
+    let merl = facet_render::materials::merl::MERL_AT + 1;
+    assert!(merl <= BLOCK_WORDS);
+}

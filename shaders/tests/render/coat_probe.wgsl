@@ -1,17 +1,9 @@
-// bsdf_sample_wi and bsdf_pdf of render/coat.inc.wgsl over a GGX + Lambertian base (sampled as
+// bsdf_sample_wi and bsdf_pdf of render/materials/coat.inc.wgsl over a GGX + Lambertian base (sampled as
 // shade_microfacet.wgsl samples an analytic fit: visible normals with probability p_spec, else
 // the cosine lobe), read back by crates/render/tests/coat_sampling.rs for a χ² test against
 // the CPU's pdf.
 
 const WG: u32 = 64u;
-
-// The fields of the scene's Material that coat_of reads.
-struct Material {
-    coat_block: u32,
-    coat_weight: f32,
-    coat_alpha: f32,
-    coat_eta: f32,
-}
 
 // The base: GGX α, p_spec, its albedo estimate.
 struct Base {
@@ -21,17 +13,16 @@ struct Base {
     pad: f32,
 }
 
-// The coat block (render/coat.inc.wgsl) at 0.
+// The coat block (render/materials/coat.inc.wgsl) at 0.
 @group(0) @binding(0) var<storage, read> tables: array<f32>;
-@group(0) @binding(1) var<uniform> material: Material;
-@group(0) @binding(2) var<uniform> base: Base;
+@group(0) @binding(1) var<uniform> base: Base;
 // (ωo.xyz, u0) and (u1, u2, -, -) per query.
-@group(0) @binding(3) var<storage, read> inputs: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> inputs: array<vec4<f32>>;
 // (ωi.xyz, pdf of ωi).
-@group(0) @binding(4) var<storage, read_write> samples: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> samples: array<vec4<f32>>;
 
 #include "common/microfacet.inc.wgsl"
-#include "render/coat.inc.wgsl"
+#include "render/materials/coat.inc.wgsl"
 
 struct Bsdf {
     ndf: AnalyticNdf,
@@ -83,7 +74,7 @@ fn coat_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workg
     }
     let a = inputs[2u * i];
     let c = inputs[2u * i + 1u];
-    let b = Bsdf(AnalyticNdf(NDF_KIND_GGX, base.alpha, base.alpha, 0.0), base.p_spec, base.albedo, coat_of(material));
+    let b = Bsdf(AnalyticNdf(NDF_KIND_GGX, base.alpha, base.alpha, 0.0), base.p_spec, base.albedo, coat_at(0u));
     let wi = bsdf_sample_wi(b, a.xyz, vec3<f32>(a.w, c.x, c.y));
     samples[i] = vec4<f32>(wi, bsdf_pdf(b, wi, a.xyz));
 }

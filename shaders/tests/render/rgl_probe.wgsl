@@ -1,4 +1,4 @@
-// RglBsdf's eval, pdf and sample on the GPU (shaders/render/rgl.inc.wgsl) at given directions,
+// RglBsdf's eval, pdf and sample on the GPU (shaders/render/materials/rgl.inc.wgsl) at given directions,
 // read back by crates/render/tests/rgl_gpu.rs and compared with the CPU's
 // (facet_fit::sources::rgl::RglBsdf::{eval, pdf, sample}).
 
@@ -11,7 +11,7 @@ const WG: u32 = 64u;
 // Per probe, two vec4: (f(ωi, ωo).rgb, pdf(ωi, ωo)) and (the ωo sampled for ωi from u, -).
 @group(0) @binding(2) var<storage, read_write> results: array<vec4<f32>>;
 
-#include "render/rgl.inc.wgsl"
+#include "render/materials/rgl.inc.wgsl"
 
 @compute @workgroup_size(WG)
 fn rgl_probe(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {

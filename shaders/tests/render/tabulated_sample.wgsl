@@ -13,7 +13,7 @@ const WG: u32 = 64u;
 // (h.xyz, pdf of h).
 @group(0) @binding(3) var<storage, read_write> samples: array<vec4<f32>>;
 
-#include "render/tabulated.inc.wgsl"
+#include "render/materials/tabulated.inc.wgsl"
 
 @compute @workgroup_size(WG)
 fn tabulated_sample(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {

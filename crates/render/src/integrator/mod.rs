@@ -68,25 +68,6 @@ pub enum StageClock {
     Wall,
 }
 
-/// The override constants of the microfacet stage serving `q`: its queue, whether its NDF is
-/// tabulated, whether f is a measured MERL table (sampled by its fit's tabulated NDF), and the
-/// MERL grid's sizes.
-fn microfacet_constants(q: Queue) -> [(&'static str, f64); 6] {
-    use facet_brdf::model::merl_grid::{PHI_D_RES, THETA_D_RES, THETA_H_RES};
-    let flag = |b: bool| b as u32 as f64;
-    [
-        ("Q_SHADE", q.index() as f64),
-        (
-            "TABULATED",
-            flag(matches!(q, Queue::Tabulated | Queue::Merl)),
-        ),
-        ("MEASURED", flag(q == Queue::Merl)),
-        ("MERL_THETA_H", THETA_H_RES as f64),
-        ("MERL_THETA_D", THETA_D_RES as f64),
-        ("MERL_PHI_D", PHI_D_RES as f64),
-    ]
-}
-
 /// The stage pipelines for one scene: only the shading stages of the classes it uses.
 pub struct Integrator {
     layouts: Layouts,
@@ -130,8 +111,8 @@ impl Integrator {
             close_shade: queue_args(
                 device,
                 &layouts,
-                Queue::Diffuse.index(),
-                n_queues - Queue::Diffuse.index(),
+                Queue::first_shade(),
+                n_queues - Queue::first_shade(),
                 wg,
             )?,
             close_shadow: queue_args(device, &layouts, Queue::Shadow.index(), 1, wg)?,
@@ -449,7 +430,7 @@ impl Integrator {
         for s in &self.shade {
             let name = match s.queue {
                 Some(Queue::Glint(k)) => format!("shade glint {k}"),
-                Some(q) => format!("shade {}", q.class_name()),
+                Some(q) => format!("shade {}", q.class().map_or("none", |k| k.name())),
                 None => s.name.to_string(),
             };
             each(&name, &mut |p| run(p, s));
@@ -459,49 +440,20 @@ impl Integrator {
     }
 }
 
-/// The shading stages of `scene`'s material classes, in queue order: one per class.
+/// The shading stages of `scene`'s material classes, in queue order: one per class, one per
+/// glint material.
 fn shading_stages(
     device: &wgpu::Device,
     layouts: &Layouts,
     scene: &SceneResources,
 ) -> Result<Vec<Stage>, GpuError> {
-    let stage = |file: &str, entry: &'static str, queue, extra: &[(&str, f64)]| {
-        Stage::new(device, layouts, file, entry, queue, extra)
-    };
     let mut shade = Vec::new();
     for &q in &scene.queues_used {
-        let q_shade = [("Q_SHADE", q.index() as f64)];
-        match q {
-            Queue::Diffuse => shade.push(stage(
-                "render/shade_diffuse.wgsl",
-                "shade_diffuse",
-                Some(q),
-                &q_shade,
-            )?),
-            Queue::Analytic | Queue::Tabulated | Queue::Merl => shade.push(stage(
-                "render/shade_microfacet.wgsl",
-                "shade_microfacet",
-                Some(q),
-                &microfacet_constants(q),
-            )?),
-            Queue::Rgl => shade.push(stage(
-                "render/shade_rgl.wgsl",
-                "shade_rgl",
-                Some(q),
-                &q_shade,
-            )?),
-            Queue::Glint(_) => {
-                let mut c = facet_glint::gpu::flake_constants();
-                c.push(q_shade[0]);
-                shade.push(stage(
-                    "render/shade_glint.wgsl",
-                    "shade_glint",
-                    Some(q),
-                    &c,
-                )?);
-            }
-            _ => {}
-        }
+        let Some(class) = q.class() else { continue };
+        let spec = class.stage();
+        let mut constants = spec.constants;
+        constants.push(("Q_SHADE", q.index() as f64));
+        shade.push(Stage::new(device, layouts, spec.file, spec.entry, Some(q), &constants)?);
     }
     Ok(shade)
 }

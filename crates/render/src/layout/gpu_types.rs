@@ -76,54 +76,6 @@ pub struct GpuFrame {
     pub cam_right: [f32; 4],
 }
 
-/// WGSL `Material` (`shaders/render/scene.inc.wgsl`).
-#[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct GpuMaterial {
-    pub base_color: [f32; 4],
-    /// rgb emitted radiance, w the specular weight of a glTF material.
-    pub emissive: [f32; 4],
-    /// rgb Lambertian albedo of a fitted material.
-    pub diffuse: [f32; 4],
-    pub kind: u32,
-    /// 0 GGX, 1 Beckmann.
-    pub ndf_kind: u32,
-    pub alpha_x: f32,
-    pub alpha_y: f32,
-    pub rotation: f32,
-    pub metallic: f32,
-    /// glTF roughness; for fitted materials the effective GGX α the ray cone widens by.
-    pub roughness: f32,
-    pub normal_scale: f32,
-    pub tex_base: u32,
-    pub tex_mr: u32,
-    pub tex_normal: u32,
-    pub tex_emissive: u32,
-    pub fresnel_offset: u32,
-    pub fresnel_count: u32,
-    pub tab_offset: u32,
-    /// The shading queue its hits go to.
-    pub queue: u32,
-    /// A measured material's table (its MERL grid or its RGL block) in the scene tables.
-    pub measured_offset: u32,
-    /// A coated material's coat block in the scene tables (NONE: no coat): its lobe's albedo
-    /// table (shaders/render/coat.inc.wgsl).
-    pub coat_block: u32,
-    pub coat_weight: f32,
-    pub coat_alpha: f32,
-    pub coat_eta: f32,
-    /// KHR_materials_clearcoat's textures (NONE: none) and normal scale; the glTF stage reads
-    /// its factor and roughness from coat_weight and coat_alpha.
-    pub tex_clearcoat: u32,
-    pub tex_clearcoat_roughness: u32,
-    pub tex_clearcoat_normal: u32,
-    pub clearcoat_normal_scale: f32,
-    pub pad0: u32,
-    pub pad1: u32,
-    pub pad2: u32,
-}
-
 /// WGSL `Light`.
 #[allow(missing_docs)] // fields: those of the WGSL struct it mirrors, by name and in order
 #[repr(C)]

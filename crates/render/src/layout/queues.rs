@@ -1,6 +1,8 @@
 //! The integrator's work queues: slot lists filled by one stage with atomic counters and
 //! consumed by the next through indirect dispatch (`shaders/render/queue_args.wgsl`).
 
+use super::tags::MaterialKind;
+
 /// The most glint materials one scene may have (one queue and one shading dispatch each).
 pub const MAX_GLINT_MATERIALS: u32 = 8;
 
@@ -13,19 +15,14 @@ pub enum Queue {
     Extend,
     /// Shadow rays (shading → connect).
     Shadow,
-    /// Hits on glTF metallic-roughness materials.
-    Diffuse,
-    /// Hits on fitted materials with a GGX / Beckmann NDF.
-    Analytic,
-    /// Hits on fitted materials with their tabulated NDF.
-    Tabulated,
-    /// Hits on measured MERL-grid tables.
-    Merl,
-    /// Hits on measured RGL `.bsdf` files.
-    Rgl,
+    /// Hits on the materials of a class (not glints, which have a queue per material).
+    Shade(MaterialKind),
     /// Hits on glint material k.
     Glint(u32),
 }
+
+/// The first shading queue's index.
+const FIRST_SHADE: u32 = 3;
 
 impl Queue {
     pub const fn index(self) -> u32 {
@@ -33,31 +30,28 @@ impl Queue {
             Queue::Generate => 0,
             Queue::Extend => 1,
             Queue::Shadow => 2,
-            Queue::Diffuse => 3,
-            Queue::Analytic => 4,
-            Queue::Tabulated => 5,
-            Queue::Merl => 6,
-            Queue::Rgl => 7,
-            Queue::Glint(k) => 8 + k,
+            Queue::Shade(k) => FIRST_SHADE + k as u32,
+            Queue::Glint(k) => FIRST_SHADE + MaterialKind::Glint as u32 + k,
         }
     }
 
     /// The material class a shading queue serves.
-    pub const fn class_name(self) -> &'static str {
+    pub const fn class(self) -> Option<MaterialKind> {
         match self {
-            Queue::Diffuse => "diffuse",
-            Queue::Analytic => "analytic",
-            Queue::Tabulated => "tabulated",
-            Queue::Merl => "measured MERL",
-            Queue::Rgl => "measured RGL",
-            Queue::Glint(_) => "glint",
-            _ => "none",
+            Queue::Shade(k) => Some(k),
+            Queue::Glint(_) => Some(MaterialKind::Glint),
+            _ => None,
         }
+    }
+
+    /// The first shading queue.
+    pub const fn first_shade() -> u32 {
+        FIRST_SHADE
     }
 
     /// Number of queues for a scene with `glints` glint materials.
     pub const fn count(glints: u32) -> u32 {
-        8 + glints
+        FIRST_SHADE + MaterialKind::Glint as u32 + glints
     }
 
     /// Override constants naming the fixed queues in WGSL.

@@ -10,7 +10,8 @@ use facet_gpu::tags;
 pub use facet_gpu::tags::TagSet;
 
 tags!(
-    /// Material kinds (`Material.kind`).
+    /// The material classes (`crate::materials`, one file each), in the order of their
+    /// shading queues; glints last, whose materials have a queue each.
     MaterialKind, "MAT_" {
         /// a glTF metallic-roughness material
         Gltf = 0 => "GLTF",
@@ -18,10 +19,12 @@ tags!(
         Analytic = 1 => "ANALYTIC",
         /// a fit's tabulated NDF
         Tabulated = 2 => "TABULATED",
-        /// a glint material
-        Glint = 3 => "GLINT",
-        /// a measurement: a MERL-grid table or an RGL `.bsdf`
-        Measured = 4 => "MEASURED",
+        /// a MERL-grid measurement, sampled by its fit's tabulated model
+        Merl = 3 => "MERL",
+        /// an RGL `.bsdf` measurement
+        Rgl = 4 => "RGL",
+        /// a fit's model as glints
+        Glint = 5 => "GLINT",
     }
 );
 

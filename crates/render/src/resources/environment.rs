@@ -2,7 +2,7 @@
 //! sampling CDFs in the tables, and its entry among the lights.
 
 use super::lights::{LightSet, Probe};
-use super::tables::Tables;
+use crate::layout::tables::Tables;
 use crate::error::RenderError;
 use crate::layout::gpu_types::{GpuLight, LightKind};
 use crate::layout::limits::{DeviceLimits, Planned};

@@ -9,16 +9,14 @@ mod environment;
 mod glints;
 pub mod light_bvh;
 mod lights;
-pub mod materials;
-pub mod rgl_table;
-mod tables;
 mod textures;
 
-pub use materials::{FRESNEL_NODES, MaterialSlot};
+pub use crate::materials::{FRESNEL_NODES, MaterialSlot};
 
 use crate::bvh::{Bvh, BvhConfig, GpuBvh};
 use crate::error::RenderError;
-use crate::layout::gpu_types::{GpuLight, GpuMaterial, GpuSceneInfo};
+use crate::layout::gpu_types::{GpuLight, GpuSceneInfo};
+use crate::materials::GpuMaterial;
 use crate::layout::limits::{DeviceLimits, Planned, product};
 use crate::layout::queues::Queue;
 use crate::scene::{Environment, GlintParams, Measurement, Scene};
@@ -30,7 +28,8 @@ use light_bvh::GpuLightNode;
 pub use lights::LightSelection;
 use lights::LightSet;
 use std::sync::Arc;
-use tables::Tables;
+use crate::layout::tables::Tables;
+use crate::materials;
 
 /// The record of what was built for a scene.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -387,7 +386,7 @@ fn plan_materials(
     // Each measurement's table, and each fit's tabulated NDF, once, however many materials
     // render it.
     let mut measured_at: Vec<(*const Measurement, u32)> = Vec::new();
-    let mut ndfs_at = materials::PlacedNdfs::new();
+    let mut ndfs_at = materials::tabulated::PlacedNdfs::new();
     for (mi, m) in scene.materials.iter().enumerate() {
         let mut plan = materials::plan(m)?;
         let what = match (&m.measured, &m.facet) {
@@ -409,7 +408,7 @@ fn plan_materials(
                     at
                 }
             };
-            plan.slot.set_measured_offset(offset);
+            plan.set_measured_offset(offset);
         }
         if let Some((ndf, spec)) = plan.glint {
             plan.slot.set_queue(Queue::Glint(glint_specs.len() as u32));
@@ -431,7 +430,7 @@ fn queues_used(slots: &[MaterialSlot], used: &[bool], built: &mut Built) -> Vec<
         .collect();
     queues.sort_by_key(|q| q.index());
     queues.dedup();
-    built.classes = queues.iter().map(|q| q.class_name()).collect();
+    built.classes = queues.iter().filter_map(|q| q.class()).map(|k| k.name()).collect();
     built.classes.dedup();
     queues
 }
@@ -577,7 +576,7 @@ impl SceneResources {
         let fres = plan.fresnel.expect("checked by fits_in_place_of");
         queue.write_buffer(
             &self.tables,
-            4 * g.fresnel_offset as u64,
+            4 * materials::lobe::of(g).fresnel as u64,
             bytemuck::cast_slice(&fres),
         );
         queue.write_buffer(

@@ -1,5 +1,9 @@
-//! An RGL `.bsdf` ([`RglBsdf`]) as one block of f32 words in the scene's `tables` buffer, the
-//! layout `shaders/render/rgl.inc.wgsl` reads: every warp of the file (Dupuy & Jakob 2018's
+//! The measured RGL class: an RGL `.bsdf` evaluated and sampled from its own warps as Mitsuba 3's
+//! `measured` plugin does, shaded by `shaders/render/shade_rgl.wgsl`
+//! (`shaders/render/materials/rgl.inc.wgsl`). Its class block is [`RglBlock`].
+//!
+//! The file ([`RglBsdf`]) is one block of f32 words in the scene's `tables` buffer, the
+//! layout `materials/rgl.inc.wgsl` reads: every warp of the file (Dupuy & Jakob 2018's
 //! `Marginal2D`, [`Warp2D`]) with its sizes, its data and, for the two distributions, its
 //! marginal and conditional CDFs, as the CPU reader holds them (normalised, in f64) rounded
 //! to f32.
@@ -18,9 +22,49 @@
 //! (slices are consecutive). An interpolant's marginal and conditional offsets are 0, and a
 //! warp without parameters (`ndf`, `sigma`) has both strides 0.
 
+use super::lobe::UNKNOWN_CONE_ALPHA;
+use super::record::GpuMaterial;
+use super::{MaterialPlan, MaterialSlot, ShadeStage};
+use crate::class_block;
+use crate::layout::gpu_types::MaterialKind;
+use crate::layout::queues::Queue;
 use facet_brdf::Brdf;
 use facet_brdf::sources::rgl::RglBsdf;
 use facet_brdf::sources::rgl::warp2d::Warp2D;
+
+class_block!(
+    /// An RGL `.bsdf` file.
+    RglBlock => "RglBlock" {
+        /// its block in the scene tables
+        table: u32,
+        /// the GGX α the ray cone widens by (the file states none)
+        cone_alpha: f32,
+    }
+);
+
+/// The plan of an RGL file; its table's offset is set when it is placed
+/// ([`MaterialPlan::place_tables`]).
+pub fn plan<'a>(mut gpu: GpuMaterial) -> MaterialPlan<'a> {
+    let block = RglBlock {
+        table: 0,
+        cone_alpha: UNKNOWN_CONE_ALPHA,
+    };
+    gpu.put(0, &block);
+    let kind = MaterialKind::Rgl;
+    MaterialPlan::new(MaterialSlot::new(gpu, kind, None, Queue::Shade(kind)))
+}
+
+/// Points an RGL record at its table.
+pub fn set_table(gpu: &mut GpuMaterial, table: u32) {
+    let mut block: RglBlock = gpu.get(0);
+    block.table = table;
+    gpu.put(0, &block);
+}
+
+/// Its stage.
+pub fn stage() -> ShadeStage {
+    ShadeStage::new("render/shade_rgl.wgsl", "shade_rgl", Vec::new())
+}
 
 /// Words of the block's header.
 pub const RGL_HEADER_WORDS: usize = 8;

@@ -1,16 +1,16 @@
-// Include-only. A clear coat over a shading stage's base BSDF (Rust twin:
-// facet_fit::model::coat::Coated):
+// Include-only. A fit's clear coat, a layer over a fitted class's base BSDF (Rust:
+// facet_render::materials::coat; twin: facet_brdf::model::coat::Coated):
 //   f = w F(η, ωi·h) D_c(h) G2_c / (4 cos θi cos θo) + T(θi) T(θo) f_base(ωi', ωo') / η²,
 // D_c GGX of the coat's α, ωi' and ωo' refracted into the coat (sin θ' = sin θ / η), T = 1 − w E_c(θ)
-// with E_c the coat lobe's directional albedo, tabulated in the material's coat block:
-// [n, E_c at cos θ = (k + ½)/n for k < n].
+// with E_c the coat lobe's directional albedo, tabulated in the coat's block in `tables`, which the
+// material's header names (Material.coat): [n, w, α, η, E_c at cos θ = (k + ½)/n for k < n].
 // Sampling: the coat's lobe (its normals, as lobe_sample_h) with probability
 //   p = w E_c(θo) / (w E_c(θo) + T(θo) max(base_albedo(b), 0.02)),
 // else the base's sampling from ωo', folded into the cone that leaves the coat (coat_fold: a
 // direction past the critical angle would be lost) and refracted out;
 // pdf = p pdf_coat + (1 − p) q(ωi') cos θi / (η² cos θi'), with q the folded base density,
 // q(ω') = pdf_base(ω') + pdf_base(unfold(ω')) cos θ' / (k cos θ_unfolded).
-// The includer's Bsdf has a field `coat: Coat` (coat_of), and the includer defines
+// The includer's Bsdf has a field `coat: Coat` (coat_at), and the includer defines
 //   base_eval2(b, wi_light, wi_bsdf, wo), base_pdf(b, wi, wo), base_sample_wi(b, wo, u),
 //   base_albedo(b) (an estimate of the base's albedo, for p),
 // from which this file defines bsdf_eval2, bsdf_pdf and bsdf_sample_wi for shade.inc.wgsl. A
@@ -26,8 +26,13 @@ struct Coat {
     ndf: AnalyticNdf,
 }
 
-fn coat_of(m: Material) -> Coat {
-    return Coat(m.coat_block, m.coat_weight, m.coat_eta, AnalyticNdf(NDF_KIND_GGX, m.coat_alpha, m.coat_alpha, 0.0));
+// The coat whose block is at `o` in `tables` (NONE: none).
+fn coat_at(o: u32) -> Coat {
+    if (o == NONE) {
+        return Coat(NONE, 0.0, 1.0, AnalyticNdf(NDF_KIND_GGX, 1.0, 1.0, 0.0));
+    }
+    let alpha = tables[o + 2u];
+    return Coat(o, tables[o + 1u], tables[o + 3u], AnalyticNdf(NDF_KIND_GGX, alpha, alpha, 0.0));
 }
 
 // Into the coat: sin θ' = sin θ / η; a direction below the surface stays below it.
@@ -81,7 +86,7 @@ fn coat_lobe_albedo(c: Coat, cos_theta: f32) -> f32 {
     let x = max(clamp(cos_theta, 0.0, 1.0) * f32(n) - 0.5, 0.0);
     let k = min(u32(x), n - 2u);
     let t = min(x - f32(k), 1.0);
-    return mix(tables[c.block + 1u + k], tables[c.block + 2u + k], t);
+    return mix(tables[c.block + 4u + k], tables[c.block + 5u + k], t);
 }
 
 // T(θ) = 1 − w E_c(θ).
