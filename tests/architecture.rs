@@ -1,5 +1,5 @@
 //! What `docs/architecture.md` says about the layout, checked where a test can check it:
-//! facet-brdf's and facet-fit's folders import only the folders above them (their unit tests
+//! facet-brdf's, facet-fit's and facet-render's folders import only the folders above them (their unit tests
 //! aside), and every WGSL file
 //! that is not an include is one pipeline with one `@compute` entry point. (That the renderer
 //! does not depend on the fitter is Cargo's to enforce; `tests/packaging.rs` checks the tree.)
@@ -80,6 +80,19 @@ fn each_layer_imports_only_the_layers_above_it() {
     assert!(up.is_empty(), "facet-brdf imports upward: {up:?}");
     let up = upward_imports("crates/fit", &fit);
     assert!(up.is_empty(), "facet-fit imports upward: {up:?}");
+    // facet-render's rooms: the material classes below the resources that upload them; the
+    // integrator reads the film back through output/.
+    let render = [
+        "scene",
+        "bvh",
+        "layout",
+        "materials",
+        "resources",
+        "output",
+        "integrator",
+    ];
+    let up = upward_imports("crates/render", &render);
+    assert!(up.is_empty(), "facet-render imports upward: {up:?}");
     // The check has the power to fail: the same scan finds the export's use of the fitting when
     // the order is reversed.
     let reversed: Vec<&str> = fit.iter().rev().copied().collect();

@@ -1,5 +1,5 @@
 // Include-only. Group 0 of every integrator stage: the frame, the path state in
-// structure-of-arrays form, the queues and the film (Rust twin: facet_render::gpu_types).
+// structure-of-arrays form, the queues and the film (Rust twin: facet_render::layout::gpu_types).
 //
 // Path state: `paths` holds one vec4 region per field, W = frame.wavefront slots each:
 // region r of slot s is paths[r * W + s]. `info` is per slot (flags, next sample, depth, -).
@@ -15,7 +15,7 @@ override Q_SHADOW: u32;
 // Path-state regions R_*, slot states SLOT_* (info.x), strategies STRATEGY_*.
 #include "render/tags.inc.wgsl"
 
-// Rust: facet_render::gpu_types::GpuSceneInfo. The scene's part of the frame, the same in
+// Rust: facet_render::layout::gpu_types::GpuSceneInfo. The scene's part of the frame, the same in
 // every frame of a scene.
 struct SceneInfo {
     n_vertices: u32,
@@ -36,7 +36,7 @@ struct SceneInfo {
     env_color: vec4<f32>,
 }
 
-// Rust: facet_render::gpu_types::GpuFrame.
+// Rust: facet_render::layout::gpu_types::GpuFrame.
 struct Frame {
     width: u32,
     height: u32,

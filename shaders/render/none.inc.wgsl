@@ -1,4 +1,4 @@
-// Include-only. The index that means "none" (Rust: facet_render::gpu_types::NONE): no texture,
+// Include-only. The index that means "none" (Rust: facet_render::layout::gpu_types::NONE): no texture,
 // no light, no parent.
 
 const NONE: u32 = 0xffffffffu;

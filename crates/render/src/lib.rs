@@ -6,9 +6,9 @@
 //! |---|---|
 //! | [`scene`] | glTF scenes ([`scene::load_gltf`]): meshes, materials (measured ones included), lights, the camera and its frame |
 //! | [`bvh`] | the obvhs CWBVH, its GPU form, a batch ray query ([`RayTracer`]) |
+//! | [`layout`] | what the resources and the integrator agree on with the WGSL: the GPU records, the closed-set tags, the bind groups, the queues, the device limits |
 //! | [`materials`] | the material classes, one file each: a class's block of the GPU record, its plan, its queue and shading stage |
 //! | [`resources`] | a scene on the GPU: BVH, material plan, tables, glint pyramids, textures, lights and their BVH |
-//! | [`layout`] | what the resources and the integrator agree on with the WGSL: the GPU records, the closed-set tags, the bind groups, the queues, the device limits |
 //! | [`integrator`] | the wavefront loop ([`Integrator`]) and its stages — logic, generate, extend, shade per material class, connect — as compute passes over queues; a [`Wavefront`] (the GPU state of one image); the render's settings ([`integrator::config`]) |
 //! | [`output`] | the film read back as PNG and EXR, the tone map, a shard's record, the merge of shards |
 //!

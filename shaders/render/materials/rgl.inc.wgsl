@@ -3,13 +3,13 @@
 // (eval, pdf, sample), which reads as Mitsuba 3's `measured` plugin; its warps are the twins of
 // facet_fit::sources::rgl::warp2d::Warp2D (eval, invert, sample). Everything in the local
 // shading frame (z the normal); `wi` is the parameter direction (Mitsuba's si.wi, the camera
-// side). Block at `offset` in `tables` as facet_render::resources::rgl_table::rgl_block lays it
+// side). Block at `offset` in `tables` as facet_render::materials::rgl::rgl_block lays it
 // out: 8 header words and 7 warp records of 8 words, all u32 bit patterns, then the arrays;
 // offsets in the block are relative to its start. The includer declares `tables`.
 
 #include "common/math.inc.wgsl"
 
-// The warp records, in rgl_table::RGL_WARPS order.
+// The warp records, in facet_render::materials::rgl::RGL_WARPS order.
 const RGL_NDF: u32 = 0u;
 const RGL_SIGMA: u32 = 1u;
 const RGL_VNDF: u32 = 2u;

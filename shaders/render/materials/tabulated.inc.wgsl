@@ -2,7 +2,7 @@
 // facet_fit::tabulated::TabulatedNdf: D₀ on nu nodes u = sqrt(θ / (π/2)) × nphi azimuths,
 // G1₀ on ng nodes evenly in θ, sampling cells (nu − 1) × nphi with their CDF and pdf (D cos θ),
 // and the visible-normal slices of facet_fit::visible_tables (n_theta_v × n_phi_v slices of
-// rows × columns cells, each with its CDF and pdf). Block in `tables` at `tab_offset`:
+// rows × columns cells, each with its CDF and pdf). Block in `tables` at the lobe's `table`:
 // [nu, nphi, ng, n_theta_v, n_phi_v, rows, columns, -] then d, g1, cdf, cell_pdf, vis_cdf,
 // vis_pdf. The includer declares `tables`.
 

@@ -4,7 +4,7 @@
 
 const WG: u32 = 64u;
 
-// The tabulated block as facet_render::resources::materials::tabulated_block lays it out.
+// The tabulated block as facet_render::materials::tabulated::tabulated_block lays it out.
 @group(0) @binding(0) var<storage, read> tables: array<f32>;
 // (αx, αy, rotation, -).
 @group(0) @binding(1) var<uniform> stretch: vec4<f32>;

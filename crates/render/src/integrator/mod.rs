@@ -453,7 +453,14 @@ fn shading_stages(
         let spec = class.stage();
         let mut constants = spec.constants;
         constants.push(("Q_SHADE", q.index() as f64));
-        shade.push(Stage::new(device, layouts, spec.file, spec.entry, Some(q), &constants)?);
+        shade.push(Stage::new(
+            device,
+            layouts,
+            spec.file,
+            spec.entry,
+            Some(q),
+            &constants,
+        )?);
     }
     Ok(shade)
 }

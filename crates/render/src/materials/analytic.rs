@@ -10,7 +10,11 @@ use facet_brdf::model::material::FittedMaterial;
 use facet_brdf::model::microfacet::MicrofacetBrdf;
 
 /// The plan of analytic model `brdf` of `fit`.
-pub fn plan<'a>(gpu: GpuMaterial, brdf: &'a MicrofacetBrdf, fit: &FittedMaterial) -> MaterialPlan<'a> {
+pub fn plan<'a>(
+    gpu: GpuMaterial,
+    brdf: &'a MicrofacetBrdf,
+    fit: &FittedMaterial,
+) -> MaterialPlan<'a> {
     lobe::plan(gpu, brdf, fit, MaterialKind::Analytic)
 }
 

@@ -8,8 +8,13 @@ use facet_brdf::model::coat::CoatLayer;
 pub fn coat_block(layer: &CoatLayer) -> Vec<f32> {
     let nodes = layer.albedo_nodes();
     let c = &layer.coat;
-    [nodes.len() as f32, c.weight as f32, c.alpha as f32, c.eta as f32]
-        .into_iter()
-        .chain(nodes.iter().map(|&e| e as f32))
-        .collect()
+    [
+        nodes.len() as f32,
+        c.weight as f32,
+        c.alpha as f32,
+        c.eta as f32,
+    ]
+    .into_iter()
+    .chain(nodes.iter().map(|&e| e as f32))
+    .collect()
 }

@@ -53,7 +53,11 @@ pub struct ShadeStage {
 
 impl ShadeStage {
     /// A stage of `file`'s `entry` with `constants`.
-    pub fn new(file: &'static str, entry: &'static str, constants: Vec<(&'static str, f64)>) -> Self {
+    pub fn new(
+        file: &'static str,
+        entry: &'static str,
+        constants: Vec<(&'static str, f64)>,
+    ) -> Self {
         ShadeStage {
             file,
             entry,
@@ -116,7 +120,12 @@ pub struct MaterialSlot {
 
 impl MaterialSlot {
     /// `gpu` with its queue written from `queue`.
-    pub(crate) fn new(gpu: GpuMaterial, kind: MaterialKind, ndf: Option<NdfKind>, queue: Queue) -> Self {
+    pub(crate) fn new(
+        gpu: GpuMaterial,
+        kind: MaterialKind,
+        ndf: Option<NdfKind>,
+        queue: Queue,
+    ) -> Self {
         let mut slot = MaterialSlot {
             gpu,
             kind,
@@ -227,7 +236,10 @@ impl MaterialPlan<'_> {
         placed: &mut tabulated::PlacedNdfs,
     ) -> bool {
         // Per material: an update in place rewrites it.
-        let fresnel = self.fresnel.as_ref().map(|f| tables.push(source, f.iter().copied()));
+        let fresnel = self
+            .fresnel
+            .as_ref()
+            .map(|f| tables.push(source, f.iter().copied()));
         let mut appended = false;
         let table = self.tabulated.map(|tab| {
             let key = std::ptr::from_ref(tab);

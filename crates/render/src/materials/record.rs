@@ -50,7 +50,11 @@ impl GpuMaterial {
     /// after the other: the MERL class its table after its sampling lobe).
     pub fn put<B: ClassBlock>(&mut self, at: usize, block: &B) {
         let words: &[u32] = bytemuck::cast_slice(std::slice::from_ref(block));
-        debug_assert!(at + words.len() <= BLOCK_WORDS, "{} overflows the block", B::LAYOUT.wgsl);
+        debug_assert!(
+            at + words.len() <= BLOCK_WORDS,
+            "{} overflows the block",
+            B::LAYOUT.wgsl
+        );
         self.block[at..at + words.len()].copy_from_slice(words);
     }
 
@@ -208,7 +212,12 @@ pub fn block_wgsl(layout: &BlockLayout) -> String {
         args.push(match ty {
             FieldType::F32 => float(k),
             FieldType::U32 => word(k),
-            FieldType::Vec3 => format!("vec3<f32>({}, {}, {})", float(k), float(k + 1), float(k + 2)),
+            FieldType::Vec3 => format!(
+                "vec3<f32>({}, {}, {})",
+                float(k),
+                float(k + 1),
+                float(k + 2)
+            ),
         });
         k += ty.words();
     }
@@ -266,7 +275,10 @@ mod tests {
         assert_eq!(m.block[3], 1.5f32.to_bits());
         assert_eq!(m.block[7], 7);
         let w = block_wgsl(&Probe::LAYOUT);
-        assert!(w.contains("fn probe_block(m: u32, at: u32) -> ProbeBlock"), "{w}");
+        assert!(
+            w.contains("fn probe_block(m: u32, at: u32) -> ProbeBlock"),
+            "{w}"
+        );
         assert!(w.contains("materials[m].block[at + 4u],"), "{w}");
         assert!(w.contains("const PROBE_BLOCK_WORDS: u32 = 5u;"), "{w}");
     }

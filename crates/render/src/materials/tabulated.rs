@@ -11,7 +11,11 @@ use facet_brdf::model::microfacet::MicrofacetBrdf;
 use facet_brdf::model::tabulated::TabulatedNdf;
 
 /// The plan of tabulated model `brdf` of `fit`.
-pub fn plan<'a>(gpu: GpuMaterial, brdf: &'a MicrofacetBrdf, fit: &FittedMaterial) -> MaterialPlan<'a> {
+pub fn plan<'a>(
+    gpu: GpuMaterial,
+    brdf: &'a MicrofacetBrdf,
+    fit: &FittedMaterial,
+) -> MaterialPlan<'a> {
     lobe::plan(gpu, brdf, fit, MaterialKind::Tabulated)
 }
 

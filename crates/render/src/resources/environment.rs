@@ -2,10 +2,10 @@
 //! sampling CDFs in the tables, and its entry among the lights.
 
 use super::lights::{LightSet, Probe};
-use crate::layout::tables::Tables;
 use crate::error::RenderError;
 use crate::layout::gpu_types::{GpuLight, LightKind};
 use crate::layout::limits::{DeviceLimits, Planned};
+use crate::layout::tables::Tables;
 use crate::layout::tags::EnvKind;
 use crate::scene::environment::{luminance, uv_to_direction};
 use crate::scene::{Environment, EnvironmentMap};

@@ -13,9 +13,9 @@
 //! against).
 
 use super::light_bvh::{LightBounds, LightBvh};
-use crate::layout::tables::Tables;
 use crate::bvh::Bvh;
 use crate::layout::gpu_types::{GpuLight, LightKind, NONE};
+use crate::layout::tables::Tables;
 use crate::materials::GpuMaterial;
 use crate::scene::camera_frame::CameraFrame;
 use crate::scene::{Light, Scene};

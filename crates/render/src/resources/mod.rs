@@ -16,9 +16,11 @@ pub use crate::materials::{FRESNEL_NODES, MaterialSlot};
 use crate::bvh::{Bvh, BvhConfig, GpuBvh};
 use crate::error::RenderError;
 use crate::layout::gpu_types::{GpuLight, GpuSceneInfo};
-use crate::materials::GpuMaterial;
 use crate::layout::limits::{DeviceLimits, Planned, product};
 use crate::layout::queues::Queue;
+use crate::layout::tables::Tables;
+use crate::materials;
+use crate::materials::GpuMaterial;
 use crate::scene::{Environment, GlintParams, Measurement, Scene};
 use facet_brdf::model::microfacet::Ndf;
 use facet_glint::dpf::DpfConfig;
@@ -28,8 +30,6 @@ use light_bvh::GpuLightNode;
 pub use lights::LightSelection;
 use lights::LightSet;
 use std::sync::Arc;
-use crate::layout::tables::Tables;
-use crate::materials;
 
 /// The record of what was built for a scene.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -430,7 +430,11 @@ fn queues_used(slots: &[MaterialSlot], used: &[bool], built: &mut Built) -> Vec<
         .collect();
     queues.sort_by_key(|q| q.index());
     queues.dedup();
-    built.classes = queues.iter().filter_map(|q| q.class()).map(|k| k.name()).collect();
+    built.classes = queues
+        .iter()
+        .filter_map(|q| q.class())
+        .map(|k| k.name())
+        .collect();
     built.classes.dedup();
     queues
 }
