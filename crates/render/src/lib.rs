@@ -33,7 +33,7 @@
 // `!(x > 0.0)` is how the validators reject NaN along with non-positive values.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-// The map, in the order a render flows through it.
+// The rooms (the map above is their order in a render).
 pub mod bvh;
 mod error;
 pub mod integrator;

@@ -121,9 +121,7 @@ impl MeasuredMaterial {
             other => other,
         };
         let path = spec.path().map(Path::to_path_buf);
-        // A name (not a file) is shown escaped: it may hold terminal escapes.
-        let named =
-            (path.clone()).unwrap_or_else(|| PathBuf::from(source.escape_debug().to_string()));
+        let named = named(path.as_deref(), source);
         // An error that names the file already (the readers' do) is not prefixed twice.
         let fail = |e: &dyn std::fmt::Display| {
             let message = e.to_string();
@@ -155,10 +153,16 @@ impl MeasuredMaterial {
         })
     }
 
-    /// The file or name its errors name (a name shown escaped: it may hold terminal escapes).
+    /// The file or name its errors name.
     fn named(&self) -> PathBuf {
-        (self.path.clone()).unwrap_or_else(|| PathBuf::from(self.source.escape_debug().to_string()))
+        named(self.path.as_deref(), &self.source)
     }
+}
+
+/// The file a measurement was read from, or its name (shown escaped: it may hold terminal
+/// escapes), for its errors.
+fn named(path: Option<&Path>, source: &str) -> PathBuf {
+    path.map_or_else(|| PathBuf::from(source.escape_debug().to_string()), Path::to_path_buf)
 }
 
 impl Scene {
