@@ -22,6 +22,17 @@ pub struct FitJob {
     rx: Receiver<Result<Fitted, String>>,
 }
 
+/// A glTF scene's measurements named without a fit, their sampling NDFs being fitted on a
+/// background thread before the scene goes to the preview.
+pub struct SceneFitJob {
+    /// What is being fitted: the measurements, by name.
+    pub label: String,
+    /// When the fit started.
+    pub started: Instant,
+    path: PathBuf,
+    rx: Receiver<Result<PreviewScene, String>>,
+}
+
 /// A fit job's answer: the fit, and the measurement it was made from (`None` where the source
 /// has no MERL table: an anisotropic one).
 type Fitted = (FittedMaterial, Option<Measurement>);
@@ -65,6 +76,8 @@ pub struct ViewerApp {
     pub status: String,
     /// A fit running in the background.
     pub fit_job: Option<FitJob>,
+    /// The fit of a glTF scene's measurements, while it runs.
+    pub scene_fit: Option<SceneFitJob>,
     /// The live preview; `None` without a GPU (then `preview_error` says why).
     pub preview: Option<Preview>,
     /// Why there is no preview, or why it stopped.
@@ -109,6 +122,7 @@ impl ViewerApp {
             error: None,
             status: String::new(),
             fit_job: None,
+            scene_fit: None,
             preview: None,
             preview_error: None,
             texture: None,
@@ -260,24 +274,82 @@ impl ViewerApp {
         }
     }
 
-    /// Loads a glTF scene into the preview; its first Facet material takes the edits.
+    /// Loads a glTF scene into the preview; its first Facet material takes the edits. A scene
+    /// whose measurements need a fit goes to the preview once the fit job has made it.
     pub fn open_scene(&mut self, path: &Path) {
         match self.preview_scene(Some(path)) {
-            Ok(ps) => {
-                self.gltf = Some(path.to_owned());
-                self.orbit = ps.orbit;
-                self.status = format!(
-                    "scene {}: material {:?} is edited",
-                    path.display(),
-                    ps.scene.materials[ps.edited].name
-                );
-                match &self.preview {
-                    Some(p) => p.send(Command::Scene(Box::new(ps))),
-                    None => self.status += " (no preview without a GPU)",
-                }
-            }
+            Ok(ps) if !ps.scene.unfitted_measurements().is_empty() => self.fit_scene(path, ps),
+            Ok(ps) => self.show_scene(path, ps),
             Err(e) => self.error = Some(format!("cannot open {}: {e}", path.display())),
         }
+    }
+
+    /// Sends glTF scene `ps` (of `path`) to the preview.
+    fn show_scene(&mut self, path: &Path, ps: PreviewScene) {
+        self.gltf = Some(path.to_owned());
+        self.orbit = ps.orbit;
+        self.status = format!(
+            "scene {}: material {:?} is edited",
+            path.display(),
+            ps.scene.materials[ps.edited].name
+        );
+        match &self.preview {
+            Some(p) => p.send(Command::Scene(Box::new(ps))),
+            None => self.status += " (no preview without a GPU)",
+        }
+    }
+
+    /// Fits the sampling NDFs of `ps`'s measurements named without a fit on a background
+    /// thread, shown as a job; the scene goes to the preview when they arrive
+    /// ([`poll_scene_fit`](Self::poll_scene_fit)).
+    pub fn fit_scene(&mut self, path: &Path, mut ps: PreviewScene) {
+        let label = ps.scene.unfitted_measurements().join(", ");
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let fitted = ps
+                .scene
+                .fit_measured(|source, brdf| fit_material(brdf, source, &FitConfig::SINGLE_LAYER))
+                .map(|_| ps)
+                .map_err(|e| e.to_string());
+            let _ = tx.send(fitted);
+        });
+        self.scene_fit = Some(SceneFitJob {
+            label,
+            started: Instant::now(),
+            path: path.to_owned(),
+            rx,
+        });
+    }
+
+    /// Polls the scene's fit job; true while one runs.
+    pub fn poll_scene_fit(&mut self) -> bool {
+        let Some(job) = &self.scene_fit else {
+            return false;
+        };
+        let answer = match job.rx.try_recv() {
+            Err(std::sync::mpsc::TryRecvError::Empty) => return true,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => Err("the fit stopped".into()),
+            Ok(r) => r,
+        };
+        let job = self.scene_fit.take().expect("polled above");
+        match answer {
+            Ok(ps) => {
+                self.show_scene(&job.path, ps);
+                self.status += &format!(
+                    "; fitted the sampling NDF of {} in {:.1} s",
+                    job.label,
+                    job.started.elapsed().as_secs_f64()
+                );
+            }
+            Err(e) => {
+                let path = job.path.display();
+                self.error = Some(format!(
+                    "{path}: fitting the sampling NDF of {}: {e}",
+                    job.label
+                ));
+            }
+        }
+        false
     }
 
     /// Shows the model `s` asked for (`--shown`): now, where the material shown has it, and,

@@ -168,12 +168,20 @@ fn run_with(
                         rs.device.clone(),
                         rs.queue.clone(),
                     );
-                    let scene = match app.preview_scene(args.scene.as_deref()) {
-                        Err(e) if args.scene.is_some() => {
+                    let scene = match (
+                        args.scene.as_deref(),
+                        app.preview_scene(args.scene.as_deref()),
+                    ) {
+                        (Some(_), Err(e)) => {
                             app.error = Some(format!("the scene: {e}"));
                             app.preview_scene(None)
                         }
-                        r => r,
+                        // The sphere until the scene's measurements are fitted.
+                        (Some(path), Ok(ps)) if !ps.scene.unfitted_measurements().is_empty() => {
+                            app.fit_scene(path, ps);
+                            app.preview_scene(None)
+                        }
+                        (_, r) => r,
                     };
                     match scene {
                         Ok(scene) => {

@@ -132,15 +132,10 @@ impl PreviewScene {
 
     /// A glTF scene whose first Facet material (else its first material) takes the edits.
     pub fn gltf(path: &std::path::Path, material: Material) -> Result<Self, String> {
+        // A measurement named without a fit is left for the caller to fit (loading never fits):
+        // the viewer's scene fit job ([`crate::app::SceneFitJob`]).
         let mut scene =
             facet_render::scene::load_gltf(path, &Default::default()).map_err(|e| e.to_string())?;
-        // A measurement named without a fit gets its sampling NDF fitted here, before the first
-        // frame (loading never fits).
-        scene
-            .fit_measured(|source, brdf| {
-                facet_fit::fit_material(brdf, source, &facet_fit::FitConfig::SINGLE_LAYER)
-            })
-            .map_err(|e| e.to_string())?;
         let edited = scene
             .materials
             .iter()

@@ -328,3 +328,48 @@ fn a_model_picked_while_the_fit_runs_stays_picked() {
         app.status
     );
 }
+
+/// A glTF scene whose material names a measurement without a fit opens through a visible job:
+/// loading fits nothing, the job's line names the measurement, and the scene is shown (with the
+/// step's time in the status) once the fit arrives.
+#[test]
+fn a_scene_measurement_without_a_fit_is_fitted_as_a_visible_job() {
+    let dir = std::env::temp_dir().join(format!("facet-viewer-measured-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let demo = facet_viewer::demo_dir();
+    let mut gltf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(demo.join("demo.gltf")).unwrap()).unwrap();
+    gltf["materials"][1]["extras"]["facet"] =
+        serde_json::json!({"model": "measured", "source": "nbrdf:alum-bronze"});
+    for file in ["default_fit.json", "sky.exr"] {
+        std::fs::copy(demo.join(file), dir.join(file)).unwrap();
+    }
+    let path = dir.join("measured.gltf");
+    std::fs::write(&path, gltf.to_string()).unwrap();
+    let mut h = harness();
+    h.state_mut().open(&path.display().to_string());
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    let job = h.state().scene_fit.as_ref().expect("a scene fit job");
+    assert_eq!(job.label, "nbrdf:alum-bronze");
+    assert!(h.state().gltf.is_none(), "the scene waits for its fit");
+    h.run_steps(1);
+    let text = "fitting the sampling NDF of nbrdf:alum-bronze for the scene";
+    assert!(
+        h.query_by_label_contains(text).is_some(),
+        "the job's line is shown"
+    );
+    let t = std::time::Instant::now();
+    while h.state().scene_fit.is_some() && t.elapsed().as_secs() < 300 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+        h.run_steps(1);
+    }
+    assert!(h.state().error.is_none(), "{:?}", h.state().error);
+    assert_eq!(h.state().gltf.as_deref(), Some(path.as_path()));
+    let status = &h.state().status;
+    assert!(status.contains("is edited"), "{status}");
+    assert!(
+        status.contains("fitted the sampling NDF of nbrdf:alum-bronze in"),
+        "{status}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

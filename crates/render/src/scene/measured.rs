@@ -162,7 +162,10 @@ impl MeasuredMaterial {
 /// The file a measurement was read from, or its name (shown escaped: it may hold terminal
 /// escapes), for its errors.
 fn named(path: Option<&Path>, source: &str) -> PathBuf {
-    path.map_or_else(|| PathBuf::from(source.escape_debug().to_string()), Path::to_path_buf)
+    path.map_or_else(
+        || PathBuf::from(source.escape_debug().to_string()),
+        Path::to_path_buf,
+    )
 }
 
 impl Scene {

@@ -97,6 +97,16 @@ fn open_section(app: &mut ViewerApp, ui: &mut egui::Ui) {
             ));
         });
     }
+    if let Some(job) = &app.scene_fit {
+        ui.horizontal(|ui| {
+            ui.spinner();
+            ui.label(format!(
+                "fitting the sampling NDF of {} for the scene ({:.0} s)",
+                job.label,
+                job.started.elapsed().as_secs_f64()
+            ));
+        });
+    }
     if let Some(e) = app.error.clone() {
         ui.horizontal(|ui| {
             ui.colored_label(egui::Color32::from_rgb(230, 80, 60), format!("Error: {e}"));

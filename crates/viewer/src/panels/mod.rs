@@ -14,7 +14,7 @@ impl ViewerApp {
     pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.handle_drops(&ctx);
-        if self.poll_fit() {
+        if self.poll_fit() | self.poll_scene_fit() {
             ctx.request_repaint_after(std::time::Duration::from_millis(100));
         }
         material_panel(self, ui);
