@@ -87,25 +87,12 @@ fn open_section(app: &mut ViewerApp, ui: &mut egui::Ui) {
         app.open(&spec);
     }
     if let Some(job) = &app.fit_job {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label(format!(
-                "fitting {}: {} ({:.0} s)",
-                job.label,
-                job.stage.lock().unwrap(),
-                job.started.elapsed().as_secs_f64()
-            ));
-        });
+        let what = format!("{}: {}", job.label, job.stage.lock().unwrap());
+        job_line(ui, &what, job.started);
     }
     if let Some(job) = &app.scene_fit {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label(format!(
-                "fitting the sampling NDF of {} for the scene ({:.0} s)",
-                job.label,
-                job.started.elapsed().as_secs_f64()
-            ));
-        });
+        let what = format!("the sampling NDF of {} for the scene", job.label);
+        job_line(ui, &what, job.started);
     }
     if let Some(e) = app.error.clone() {
         ui.horizontal(|ui| {
@@ -273,4 +260,13 @@ fn save_section(app: &mut ViewerApp, ui: &mut egui::Ui) {
     if !app.status.is_empty() {
         ui.label(app.status.as_str());
     }
+}
+
+/// A running job's line: a spinner, "fitting WHAT (N s)".
+fn job_line(ui: &mut egui::Ui, what: &str, started: std::time::Instant) {
+    ui.horizontal(|ui| {
+        ui.spinner();
+        let secs = started.elapsed().as_secs_f64();
+        ui.label(format!("fitting {what} ({secs:.0} s)"));
+    });
 }
