@@ -450,17 +450,7 @@ fn shading_stages(
     let mut shade = Vec::new();
     for &q in &scene.queues_used {
         let Some(class) = q.class() else { continue };
-        let spec = class.stage();
-        let mut constants = spec.constants;
-        constants.push(("Q_SHADE", q.index() as f64));
-        shade.push(Stage::new(
-            device,
-            layouts,
-            spec.file,
-            spec.entry,
-            Some(q),
-            &constants,
-        )?);
+        shade.push(Stage::shading(device, layouts, &class.stage(), q)?);
     }
     Ok(shade)
 }

@@ -5,6 +5,7 @@
 
 use crate::layout::bindings::{Group, pipeline_groups};
 use crate::layout::queues::Queue;
+use crate::materials::ShadeStage;
 use facet_gpu::{GpuError, shader};
 
 /// Threads per workgroup of every stage (WGSL override `WG`).
@@ -73,7 +74,7 @@ fn pipeline(
 }
 
 impl Stage {
-    /// A stage of `shaders/render/{entry}.wgsl` (shading stages name their file).
+    /// A stage of pipeline file `file` (one of `PIPELINES`).
     pub fn new(
         device: &wgpu::Device,
         layouts: &Layouts,
@@ -82,13 +83,44 @@ impl Stage {
         queue: Option<Queue>,
         extra_constants: &[(&str, f64)],
     ) -> Result<Stage, GpuError> {
+        let groups = layouts.of_pipeline(file)?;
+        Stage::with_groups(device, file, entry, &groups, queue, extra_constants)
+    }
+
+    /// The shading stage `spec` of a material class, consuming `queue`.
+    pub fn shading(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        spec: &ShadeStage,
+        queue: Queue,
+    ) -> Result<Stage, GpuError> {
+        let groups: Vec<_> = spec.groups.iter().map(|g| layouts.of(*g)).collect();
+        let mut constants = spec.constants.clone();
+        constants.push(("Q_SHADE", queue.index() as f64));
+        Stage::with_groups(
+            device,
+            spec.file,
+            spec.entry,
+            &groups,
+            Some(queue),
+            &constants,
+        )
+    }
+
+    fn with_groups(
+        device: &wgpu::Device,
+        file: &str,
+        entry: &'static str,
+        groups: &[&wgpu::BindGroupLayout],
+        queue: Option<Queue>,
+        extra_constants: &[(&str, f64)],
+    ) -> Result<Stage, GpuError> {
         let mut constants: Vec<(&str, f64)> = Queue::constants().to_vec();
         constants.push(("WG", STAGE_WORKGROUP as f64));
         constants.extend_from_slice(extra_constants);
-        let groups = layouts.of_pipeline(file)?;
         Ok(Stage {
             name: entry,
-            pipeline: pipeline(device, file, entry, &groups, &constants)?,
+            pipeline: pipeline(device, file, entry, groups, &constants)?,
             queue,
         })
     }

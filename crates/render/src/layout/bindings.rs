@@ -137,22 +137,21 @@ impl Group {
     }
 }
 
-/// The groups of the stages that shade no glint material, in group order.
-const STAGE: &[Group] = &[Group::Frame, Group::Scene];
+/// The groups of a stage over the path state and the scene, in group order: every stage but a
+/// glint material's shading.
+pub const STAGE: &[Group] = &[Group::Frame, Group::Scene];
 
-/// Every pipeline file of the integrator with the groups of its pipeline layout, in group
-/// order: what the stages and the queue closes build their pipeline layouts from.
+/// The groups of a glint material's shading stage: its field and pyramid levels in group 2.
+pub const GLINT_STAGE: &[Group] = &[Group::Frame, Group::Scene, Group::Glint];
+
+/// Every pipeline file of the integrator but the shading stages, with the groups of its
+/// pipeline layout, in group order: what these stages and the queue closes build their
+/// pipeline layouts from. A shading stage's file and groups are its material class's
+/// (`crate::materials::ShadeStage`).
 pub const PIPELINES: &[(&str, &[Group])] = &[
     ("render/logic.wgsl", STAGE),
     ("render/generate.wgsl", STAGE),
     ("render/extend.wgsl", STAGE),
-    ("render/shade_diffuse.wgsl", STAGE),
-    ("render/shade_microfacet.wgsl", STAGE),
-    ("render/shade_rgl.wgsl", STAGE),
-    (
-        "render/shade_glint.wgsl",
-        &[Group::Frame, Group::Scene, Group::Glint],
-    ),
     ("render/connect.wgsl", STAGE),
     ("render/queue_args.wgsl", &[Group::QueueArgs]),
 ];

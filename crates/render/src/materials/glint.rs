@@ -28,9 +28,12 @@ pub fn plan<'a>(
 
 /// Its stage (one per glint material).
 pub fn stage() -> ShadeStage {
-    ShadeStage::new(
-        "render/shade_glint.wgsl",
-        "shade_glint",
-        facet_glint::gpu::flake_constants(),
-    )
+    ShadeStage {
+        groups: crate::layout::bindings::GLINT_STAGE,
+        ..ShadeStage::new(
+            "render/shade_glint.wgsl",
+            "shade_glint",
+            facet_glint::gpu::flake_constants(),
+        )
+    }
 }

@@ -12,8 +12,9 @@
 //! | glints | [`glint`] | `shade_glint.wgsl`, one per material | [`lobe::LobeBlock`] |
 //!
 //! The coat ([`coat`]) is a layer over any fitted class, named by the record's header. A new
-//! class adds its file here, its variant to [`MaterialKind`] (`layout/tags.rs`), its arms in
-//! this file's two lists ([`MaterialKind::stage`], [`class_blocks`]), and its WGSL.
+//! class adds its file here, its variant to [`MaterialKind`] (`layout/tags.rs`; the compiler
+//! then asks for its arms in this file: its name, its stage), its choice in [`plan`], its block
+//! in [`class_blocks`], and its WGSL.
 
 pub mod analytic;
 pub mod coat;
@@ -29,6 +30,7 @@ pub use lobe::FRESNEL_NODES;
 pub use record::GpuMaterial;
 
 use crate::error::RenderError;
+use crate::layout::bindings::{self, Group};
 use crate::layout::gpu_types::{MaterialKind, NONE};
 use crate::layout::queues::Queue;
 use crate::layout::tables::Tables;
@@ -39,20 +41,22 @@ use facet_brdf::model::tabulated::TabulatedNdf;
 use record::{BlockLayout, ClassBlock};
 use std::sync::Arc;
 
-/// A class's shading stage: its pipeline file, entry point and override constants (the
-/// integrator adds the queue's, `Q_SHADE`).
+/// A class's shading stage: its pipeline file, entry point, bind groups and override
+/// constants (the integrator adds the queue's, `Q_SHADE`).
 #[derive(Clone, Debug)]
 pub struct ShadeStage {
     /// The pipeline file under `shaders/`.
     pub file: &'static str,
     /// Its entry point.
     pub entry: &'static str,
+    /// The groups of its pipeline layout, in group order.
+    pub groups: &'static [Group],
     /// Its override constants.
     pub constants: Vec<(&'static str, f64)>,
 }
 
 impl ShadeStage {
-    /// A stage of `file`'s `entry` with `constants`.
+    /// A stage of `file`'s `entry` over the path state and the scene, with `constants`.
     pub fn new(
         file: &'static str,
         entry: &'static str,
@@ -61,6 +65,7 @@ impl ShadeStage {
         ShadeStage {
             file,
             entry,
+            groups: bindings::STAGE,
             constants,
         }
     }
