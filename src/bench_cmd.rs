@@ -577,7 +577,7 @@ fn viewer(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         }),
         ..Default::default()
     };
-    let scene = facet_render::scene::shapes::preview_scene(sphere);
+    let scene = facet_render::scene::sphere::SphereScene::PREVIEW.build(sphere);
     let (_, env) = demo_scene(false)?;
     let res = SceneResources::new(gpu, &scene, Some(&env), ResourceConfig::standard())?;
     let integrator = Integrator::new(&gpu.device, &res)?;
@@ -644,40 +644,14 @@ fn gold_fit(alpha: f64, model: facet_fit::model::material::ModelChoice) -> Resul
     })
 }
 
-/// Issue 12's gold scene: a GGX gold sphere (α = 0.3) on a 20 × 20 grey Lambertian floor, a
-/// constant sky of 0.5 and a 40 W/sr point light.
+/// Issue 12's gold scene ([`SphereScene::GOLD`](facet_render::scene::sphere::SphereScene::GOLD):
+/// `sphere` on a 20 × 20 grey Lambertian floor, a 40 W/sr point light) under a constant sky of
+/// 0.5.
 fn gold_scene(sphere: Material) -> Result<(Scene, Environment)> {
-    let mut scene = Scene {
-        materials: vec![
-            Material {
-                name: "floor".into(),
-                base_color: glam::Vec4::new(0.5, 0.5, 0.5, 1.0),
-                specular: 0.0,
-                ..Default::default()
-            },
-            sphere,
-        ],
-        lights: vec![facet_render::scene::Light::Point {
-            position: Vec3::new(2.0, 3.0, 2.0),
-            intensity: Vec3::splat(40.0),
-        }],
-        camera: facet_render::scene::Camera {
-            position: Vec3::new(0.0, 1.5, 5.0),
-            forward: Vec3::new(0.0, -1.5, -5.0).normalize(),
-            up: Vec3::Y,
-            yfov: 40f32.to_radians(),
-        },
-        ..Default::default()
-    };
-    scene.add_quad(
-        Vec3::new(-10.0, -1.0, 10.0),
-        Vec3::new(20.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -20.0),
-        1.0,
-        0,
-    );
-    scene.add_uv_sphere(Vec3::ZERO, 1.0, 128, 64, 1);
-    Ok((scene, Environment::Constant(Vec3::splat(0.5))))
+    Ok((
+        facet_render::scene::sphere::SphereScene::GOLD.build(sphere),
+        Environment::Constant(Vec3::splat(0.5)),
+    ))
 }
 
 /// The noise and speed of one configuration on one scene.
@@ -816,7 +790,7 @@ fn noise(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
     use facet_render::{LightSelection, NdfSampling};
     let (side, spp) = sizes.noise;
     let (demo, sky) = demo_scene(true)?;
-    let glossy = facet_render::scene::shapes::preview_scene(gold_ggx(0.05)?);
+    let glossy = facet_render::scene::sphere::SphereScene::PREVIEW.build(gold_ggx(0.05)?);
     let tabulated = gold_fit(0.3, facet_fit::model::material::ModelChoice::Tabulated)?;
     let scenes = [
         (
