@@ -4,7 +4,7 @@
 //! sample and the variance against the fit's, the image means, and the memory of each table on
 //! the GPU.
 
-use super::gold_row;
+use crate::measure::gold_row;
 use anyhow::{Result, anyhow};
 use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
 use facet_fit::model::material::ModelChoice;
