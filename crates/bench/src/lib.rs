@@ -3,9 +3,8 @@
 //! that the criterion benches (`benches/` of facet-cli) measure on.
 //!
 //! Every section takes the device ([`facet_gpu::Gpu`]) and the sizes of one mode ([`Sizes`]),
-//! prints its table as it goes and returns its JSON. A section is a measurement that stops at
-//! its first failure and says why: its errors are `anyhow` errors with context, for the binary
-//! that called it to print, not to be matched on.
+//! prints its table as it goes and returns its JSON, or stops at its first failure and says why
+//! ([`BenchError`]).
 //!
 //! ```
 //! use facet_bench::Sizes;
@@ -17,6 +16,7 @@
 //! ```
 
 pub mod assets;
+pub mod error;
 pub mod measure;
 pub mod record;
 pub mod scenes;
@@ -25,4 +25,5 @@ pub mod sizes;
 pub mod timing;
 
 pub use assets::Assets;
+pub use error::{BenchError, Result};
 pub use sizes::Sizes;

@@ -2,9 +2,9 @@
 //! a pixel's variance, E[(a − b)²] / 2, and three the median time a sample; a side-by-side row
 //! of the sections that compare materials on the gold scene.
 
+use crate::error::Result;
 use crate::scenes::{gold_scene, square};
 use crate::timing::median;
-use anyhow::Result;
 use facet_gpu::Gpu;
 use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, Material, Scene};

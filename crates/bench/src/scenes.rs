@@ -3,7 +3,7 @@
 //! gold, the lit procedural scenes and their ray sets.
 
 use crate::Assets;
-use anyhow::{Result, anyhow};
+use crate::error::{BenchError, Result};
 use facet_fit::model::analytic::parse_analytic;
 use facet_fit::model::material::ModelChoice;
 use facet_fit::model::merl_grid::MerlTable;
@@ -52,8 +52,9 @@ pub fn demo_scene(assets: &Assets, glints: bool) -> Result<(Scene, Environment)>
 /// The analytic BRDF `spec` (`ggx?alpha=0.3&conductor=gold`) sampled into an in-memory MERL
 /// table, as a measurement.
 pub fn analytic_table(spec: &str) -> Result<MerlBrdf> {
-    let model = parse_analytic(spec).map_err(|e| anyhow!("{spec}: {e}"))?;
-    MerlBrdf::from_table(spec, MerlTable::sample(&model)).map_err(|e| anyhow!("{spec}: {e}"))
+    let model = parse_analytic(spec)?;
+    MerlBrdf::from_table(spec, MerlTable::sample(&model))
+        .map_err(|e| BenchError::Other(format!("{spec}: {e}")))
 }
 
 /// A fit of an analytic GGX gold conductor, as a Facet material rendering its GGX model.

@@ -1,6 +1,6 @@
 //! Timing: medians of repeated runs after a warm-up.
 
-use anyhow::Result;
+use crate::error::Result;
 use std::time::Instant;
 
 /// Median of `runs` timed calls of `f` (ms) after one untimed call when runs > 1.

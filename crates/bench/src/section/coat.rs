@@ -4,9 +4,9 @@
 //! the coat near its critical angle), at equal spp: the time a sample and the variance, each
 //! against the same base's uncoated smooth fit.
 
+use crate::error::{BenchError, Result};
 use crate::measure::gold_row;
 use crate::scenes::analytic_table;
-use anyhow::Result;
 use facet_fit::model::coat::Coat;
 use facet_fit::model::material::{CoatRecord, FittedMaterial, ModelChoice};
 use facet_fit::{FitConfig, fit_material};
@@ -35,7 +35,7 @@ fn fits(spec: &str) -> Result<[Arc<FittedMaterial>; 2]> {
         beckmann_error: None,
         base: Box::new(bare.record.clone()),
     });
-    let coated = FittedMaterial::from_record(record).map_err(anyhow::Error::msg)?;
+    let coated = FittedMaterial::from_record(record).map_err(BenchError::Other)?;
     Ok([Arc::new(bare), Arc::new(coated)])
 }
 

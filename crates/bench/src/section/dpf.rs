@@ -2,8 +2,8 @@
 //! direct and the fast cone rule, side by side, and the fast tables' error against the direct.
 
 use crate::Sizes;
+use crate::error::{BenchError, Result};
 use crate::timing::{median, median_ms};
-use anyhow::{Context, Result};
 use facet_gpu::Gpu;
 use serde_json::{Value, json};
 
@@ -37,7 +37,7 @@ pub fn dpf_pyramid(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         let ndf = Ndf::Analytic(AnalyticNdf::isotropic(kind, alpha));
         let build = |rule: &ConeRule| {
             facet_glint::gpu::build_levels_with(gpu, &ndf, cfg, &all, rule)
-                .context("building the DPF pyramid on the GPU")
+                .map_err(BenchError::from)
         };
         let direct_ms = median_ms(runs, || build(&ConeRule::direct()).map(|_| ()))?;
         let fast_ms = median_ms(runs, || build(&ConeRule::fast()).map(|_| ()))?;

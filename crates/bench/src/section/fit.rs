@@ -3,9 +3,9 @@
 //! material, the median of the runs after a warm-up.
 
 use crate::Sizes;
+use crate::error::Result;
 use crate::scenes::analytic_table;
 use crate::timing::median_ms;
-use anyhow::{Context, Result};
 use facet_fit::extract::ExtractConfig;
 use facet_fit::fitting::{Backend, FitConfig, Models, fit_material_on};
 use facet_fit::gpu::GpuFitter;
@@ -16,10 +16,7 @@ use serde_json::{Value, json};
 /// backend (the CPU; the GPU where there is one).
 pub fn fit(gpu: Option<&Gpu>, sizes: &Sizes, material: &str) -> Result<Value> {
     let src = analytic_table(material)?;
-    let fitter = gpu
-        .map(GpuFitter::new)
-        .transpose()
-        .context("GPU fit pipelines")?;
+    let fitter = gpu.map(GpuFitter::new).transpose()?;
     let iso = FitConfig {
         extract: ExtractConfig {
             resolution: sizes.fit_resolution,

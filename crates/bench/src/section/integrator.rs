@@ -2,10 +2,10 @@
 //! with the glint filter off, Msamples/s (the median of the mode's runs), one iteration's time
 //! by stage (GPU timestamps where the adapter has them), and the glints' overhead at equal spp.
 
+use crate::error::Result;
 use crate::scenes::demo_scene;
 use crate::timing::median_ms;
 use crate::{Assets, Sizes};
-use anyhow::Result;
 use facet_gpu::Gpu;
 use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::{ImageConfig, Integrator, ResourceConfig, SampleConfig, SceneResources};

@@ -4,11 +4,11 @@
 //! against robust's, with the image means (which must agree: every selection is unbiased); and
 //! the light BVH's build time and memory for emissive triangles.
 
+use crate::error::Result;
 use crate::measure::measure_noise;
 use crate::scenes::{demo_scene, gold_ggx, gold_scene, square};
 use crate::timing::median;
 use crate::{Assets, Sizes};
-use anyhow::Result;
 use facet_render::resources::light_bvh::{GpuLightNode, LightBounds, LightBvh};
 use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, LoadOptions, Scene, load_gltf};

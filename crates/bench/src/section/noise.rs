@@ -1,10 +1,10 @@
 //! `facet bench`'s noise section: variance at equal spp and time a sample before and after
 //! visible-normal sampling and robust light selection, and each change alone.
 
+use crate::error::Result;
 use crate::measure::{Measured, measure_noise};
 use crate::scenes::{demo_scene, gold_fit, gold_ggx, gold_scene, square};
 use crate::{Assets, Sizes};
-use anyhow::Result;
 use facet_fit::model::material::ModelChoice;
 use facet_gpu::Gpu;
 use facet_render::ResourceConfig;

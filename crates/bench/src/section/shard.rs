@@ -6,8 +6,8 @@
 //! embedded proxy, its wall time against the fit's own total. The caller names the binary.
 
 use crate::Assets;
+use crate::error::{BenchError, Result};
 use crate::timing::median;
-use anyhow::{Context, Result, bail};
 use serde_json::{Value, json};
 use std::path::Path;
 use std::process::Command;
@@ -31,7 +31,7 @@ pub fn shards(
 ) -> Result<Value> {
     let (w, h) = size.unwrap_or(DEMO_SIZE);
     let tmp = std::env::temp_dir().join(format!("facet-bench-shard-{}", std::process::id()));
-    std::fs::create_dir_all(&tmp).with_context(|| format!("{}", tmp.display()))?;
+    std::fs::create_dir_all(&tmp).map_err(BenchError::io(tmp.display().to_string()))?;
     let shards = Shards {
         facet,
         assets,
@@ -77,7 +77,9 @@ impl Shards<'_> {
                 .collect::<Vec<_>>(),
         );
         // The largest shard's render time per sample: the one least disturbed by the start.
-        let last = rows.last().context("no shard size")?;
+        let last = rows
+            .last()
+            .ok_or_else(|| BenchError::Other("no shard size".into()))?;
         let per_spp =
             last["render_ms"].as_f64().unwrap_or(0.0) / last["spp"].as_f64().unwrap_or(1.0);
         // startup / (startup + S · per_spp) < OVERHEAD ⇔ S > startup (1 − OVERHEAD) / (OVERHEAD · per_spp)
@@ -106,10 +108,13 @@ impl Shards<'_> {
             .args(args)
             .current_dir(self.tmp)
             .output()
-            .context("running facet")?;
+            .map_err(BenchError::io(format!("running {}", self.facet.display())))?;
         let wall = t.elapsed().as_secs_f64() * 1e3;
         if !out.status.success() {
-            bail!("facet {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+            return Err(BenchError::Other(format!(
+                "facet {args:?}: {}",
+                String::from_utf8_lossy(&out.stderr)
+            )));
         }
         Ok((String::from_utf8_lossy(&out.stdout).into_owned(), wall))
     }
@@ -147,7 +152,7 @@ impl Shards<'_> {
                     .and_then(|(_, r)| r.split_once(' '))
             })
             .and_then(|(ms, _)| ms.parse::<f64>().ok())
-            .with_context(|| format!("no render time in {stdout}"))?;
+            .ok_or_else(|| BenchError::Other(format!("no render time in {stdout}")))?;
         Ok((wall, render))
     }
 
@@ -159,10 +164,12 @@ impl Shards<'_> {
             let args = ["fit", "nbrdf:gold-metallic-paint", "--out", &out].map(String::from);
             let (_, wall) = self.facet(&args)?;
             let json = self.tmp.join(&out).join("gold-metallic-paint.json");
-            let record: Value = serde_json::from_str(&std::fs::read_to_string(&json)?)?;
+            let text = std::fs::read_to_string(&json)
+                .map_err(BenchError::io(json.display().to_string()))?;
+            let record: Value = serde_json::from_str(&text)?;
             let total = record["timings_ms"]["total"]
                 .as_f64()
-                .context("timings_ms.total")?;
+                .ok_or_else(|| BenchError::Other("no timings_ms.total in the fit record".into()))?;
             t.push((wall, total));
         }
         let wall = median(&mut t.iter().map(|r| r.0).collect::<Vec<_>>());

@@ -5,9 +5,9 @@
 //! time then.
 
 use crate::Sizes;
+use crate::error::Result;
 use crate::scenes::trace_rays;
 use crate::timing::median;
-use anyhow::Result;
 use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
 use facet_render::bvh::procedural;

@@ -2,9 +2,9 @@
 //! sky, batches paced as the viewer paces them, each frame tone mapped and read back), its frame
 //! time and Msamples/s in the steady state.
 
+use crate::error::{BenchError, Result};
 use crate::scenes::{demo_scene, square};
 use crate::{Assets, Sizes};
-use anyhow::{Result, bail};
 use facet_gpu::Gpu;
 use facet_render::scene::Material;
 use facet_render::scene::camera_frame::CameraFrame;
@@ -46,7 +46,10 @@ pub fn viewer(gpu: &Gpu, sizes: &Sizes, assets: &Assets) -> Result<Value> {
         let rgba = wf.tone_mapped(gpu, 0.0)?;
         let ms = t.elapsed().as_secs_f64() * 1e3;
         if rgba.len() != (side * side) as usize {
-            bail!("the preview read back {} pixels", rgba.len());
+            return Err(BenchError::Other(format!(
+                "the preview read back {} pixels",
+                rgba.len()
+            )));
         }
         ms_all.push(ms);
         spp_all.push(batch);
