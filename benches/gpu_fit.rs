@@ -10,9 +10,7 @@ use facet_fit::fitting::params::fit_moments;
 use facet_fit::fitting::{Backend, FitConfig, fit_material_on};
 use facet_fit::gpu::GpuFitter;
 use facet_fit::model::analytic::parse_analytic;
-use facet_fit::model::merl_grid::MerlTable;
 use facet_fit::model::microfacet::NdfKind;
-use facet_fit::sources::merl::MerlBrdf;
 use facet_gpu::Gpu;
 use std::time::{Duration, Instant};
 
@@ -32,11 +30,7 @@ fn gpu() -> Option<Gpu> {
 fn isotropic(c: &mut Criterion) {
     let Some(gpu) = gpu() else { return };
     let fitter = GpuFitter::new(&gpu).unwrap();
-    let src = MerlBrdf::from_table(
-        "ggx-0.2",
-        MerlTable::sample(&parse_analytic("ggx?alpha=0.2&f0=0.04").unwrap()),
-    )
-    .unwrap();
+    let src = facet_bench::scenes::analytic_table("ggx?alpha=0.2&f0=0.04").unwrap();
     let mut g = c.benchmark_group("iso");
     g.sample_size(10);
     for n in [32, 64, 90, 128, 256, 1024] {

@@ -6,55 +6,22 @@
 //!   with the filter, and as glints counted everywhere, at equal spp;
 //! - printed once before those: run time and RMSE against a 256 spp reference as spp grows, for
 //!   the demo scene (`FACET_RENDER_RMSE=0` skips it).
+//!
+//! The scenes are facet-bench's, which `facet bench`'s integrator section renders too.
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
+use facet_bench::Assets;
+use facet_bench::scenes::{demo_scene, lit_procedural_scene};
+use facet_bench::sizes::triangles_from_env;
 use facet_gpu::Gpu;
-use facet_render::bvh::procedural;
 use facet_render::scene::camera_frame::CameraFrame;
-use facet_render::scene::{
-    Camera, Environment, EnvironmentMap, LoadOptions, Material, Scene, load_gltf,
-};
+use facet_render::scene::{Environment, Scene};
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
-use glam::{Vec3, Vec4};
+use glam::Vec3;
 use std::path::Path;
-use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-fn sizes() -> Vec<usize> {
-    std::env::var("FACET_RENDER_SCENES")
-        .ok()
-        .map(|s| {
-            s.split(',')
-                .map(|x| x.trim().parse::<f64>().expect("e.g. 1e4,1e5") as usize)
-                .collect()
-        })
-        .unwrap_or_else(|| vec![10_000, 100_000, 1_000_000])
-}
-
-fn procedural_scene(triangles: usize) -> Scene {
-    let mesh = procedural::test_scene(triangles, 1);
-    let mut s = Scene {
-        materials: vec![Material {
-            base_color: Vec4::new(0.7, 0.7, 0.7, 1.0),
-            ..Default::default()
-        }],
-        lights: vec![facet_render::scene::Light::Directional {
-            direction: Vec3::new(0.3, -1.0, -0.4).normalize(),
-            irradiance: Vec3::splat(3.0),
-        }],
-        camera: Camera {
-            position: Vec3::new(-8.0, 6.0, 9.0),
-            forward: (Vec3::new(2.0, 2.0, -3.0) - Vec3::new(-8.0, 6.0, 9.0)).normalize(),
-            up: Vec3::Y,
-            yfov: 60f32.to_radians(),
-        },
-        ..Default::default()
-    };
-    s.add_triangles(&mesh.positions, &mesh.indices, 0);
-    s
-}
 
 struct Prepared {
     res: SceneResources,
@@ -79,15 +46,14 @@ fn render(gpu: &Gpu, p: &Prepared, config: &RenderConfig) -> Image {
         .0
 }
 
-fn demo() -> (Scene, Environment) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo");
-    let scene = load_gltf(&dir.join("demo.gltf"), &LoadOptions::default()).unwrap();
-    let (map, _) = EnvironmentMap::load(&dir.join("sky.exr")).unwrap();
-    (scene, Environment::Map(Arc::new(map)))
+/// The demo scene and sky, glints on or off (facet-bench's, as `facet bench` renders it).
+fn demo(glints: bool) -> (Scene, Environment) {
+    let assets = Assets::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("assets"));
+    demo_scene(&assets, glints).expect("the demo scene")
 }
 
 fn rmse_against_spp(gpu: &Gpu) {
-    let (scene, env) = demo();
+    let (scene, env) = demo(true);
     let p = prepare(gpu, &scene, &env, ResourceConfig::standard());
     let base = RenderConfig {
         image: ImageConfig {
@@ -154,8 +120,8 @@ fn bench(c: &mut Criterion) {
         },
     };
     g.throughput(Throughput::Elements(128 * 128));
-    for n in sizes() {
-        let scene = procedural_scene(n);
+    for n in triangles_from_env("FACET_RENDER_SCENES", &[10_000, 100_000, 1_000_000]) {
+        let scene = lit_procedural_scene(n);
         let p = prepare(&gpu, &scene, &sky, ResourceConfig::standard());
         println!(
             "{} triangles: BVH {:.0} ms",
@@ -166,16 +132,8 @@ fn bench(c: &mut Criterion) {
     }
     g.finish();
 
-    let (scene, env) = demo();
-    let glint = scene
-        .materials
-        .iter()
-        .position(|m| m.name == "glint")
-        .unwrap();
-    let mut smooth = scene.clone();
-    if let Some(f) = smooth.materials[glint].facet.as_mut() {
-        f.glint = None;
-    }
+    let (scene, env) = demo(true);
+    let (smooth, _) = demo(false);
     let mut g = c.benchmark_group("glints");
     g.sample_size(10)
         .sampling_mode(SamplingMode::Flat)

@@ -2,15 +2,17 @@
 //! Mrays/s (criterion's elements/s) of closest-hit and any-hit queries, for pinhole camera rays
 //! and for random rays (uniform origins in the scene, uniform directions, a quarter of them
 //! short), on procedural scenes of 10^4, 10^5 and 10^6 triangles; obvhs's single-threaded CPU
-//! traversal alongside as the reference. BVH build times are printed.
+//! traversal alongside as the reference. BVH build times are printed. The scenes and rays are
+//! facet-bench's, which `facet bench`'s trace section measures too.
 //!
 //! `cargo bench --bench render_trace`; `FACET_TRACE_SCENES=1e4,1e5` picks the scene sizes.
 
 use criterion::{Criterion, SamplingMode, Throughput, criterion_group, criterion_main};
-use facet_render::bvh::procedural::{self, Rng};
-use facet_render::bvh::query::{GpuHit, GpuRay, RayTracer};
+use facet_bench::scenes::trace_rays;
+use facet_bench::sizes::triangles_from_env;
+use facet_render::bvh::procedural;
+use facet_render::bvh::query::{GpuHit, RayTracer};
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
-use glam::Vec3;
 use std::time::{Duration, Instant};
 
 /// Rays per GPU batch: enough to fill any GPU's threads many times over, small enough for
@@ -18,39 +20,6 @@ use std::time::{Duration, Instant};
 const GPU_RAYS: u32 = 1 << 17;
 /// Rays per CPU batch (one thread).
 const CPU_RAYS: usize = 1 << 14;
-
-fn scene_sizes() -> Vec<usize> {
-    std::env::var("FACET_TRACE_SCENES")
-        .ok()
-        .map(|s| {
-            s.split(',')
-                .map(|x| {
-                    x.trim()
-                        .parse::<f64>()
-                        .expect("FACET_TRACE_SCENES: e.g. 1e4,1e5") as usize
-                })
-                .collect()
-        })
-        .unwrap_or_else(|| vec![10_000, 100_000, 1_000_000])
-}
-
-fn ray_sets(count: usize) -> [(&'static str, Vec<GpuRay>); 2] {
-    let (w, h) = (512, count.div_ceil(512) as u32);
-    let camera = procedural::camera_rays(
-        Vec3::new(-8.0, 6.0, 9.0),
-        Vec3::new(2.0, 2.0, -3.0),
-        60f32.to_radians(),
-        w,
-        h,
-    );
-    let random = procedural::random_rays(
-        count,
-        Vec3::new(-9.9, 0.1, -9.9),
-        Vec3::new(9.9, 9.9, 9.9),
-        &mut Rng::new(5),
-    );
-    [("camera", camera), ("random", random)]
-}
 
 fn label(tris: usize) -> String {
     match tris {
@@ -71,7 +40,7 @@ fn trace(c: &mut Criterion) {
             None
         }
     };
-    for tris in scene_sizes() {
+    for tris in triangles_from_env("FACET_TRACE_SCENES", &[10_000, 100_000, 1_000_000]) {
         let mesh = procedural::test_scene(tris, 1);
         let start = Instant::now();
         let bvh = Bvh::build(&mesh.positions, &mesh.indices, BvhConfig::medium());
@@ -89,7 +58,8 @@ fn trace(c: &mut Criterion) {
             .warm_up_time(Duration::from_millis(300))
             .measurement_time(Duration::from_secs(2));
 
-        let sets = ray_sets(GPU_RAYS as usize);
+        // Camera rays of a 512-wide image and random rays (`facet bench`'s trace section: 1024).
+        let sets = trace_rays(GPU_RAYS as usize, 512);
         for (name, rays) in &sets {
             let rays = &rays[..CPU_RAYS];
             g.throughput(Throughput::Elements(rays.len() as u64));

@@ -11,13 +11,13 @@
 //! scene's resources).
 
 use anyhow::Result;
-use facet_fit::metric::look::SphereScene;
+use facet_fit::metric::look::SphereScene as LookScene;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_gpu::Gpu;
 use facet_render::scene::camera_frame::CameraFrame;
+use facet_render::scene::sphere::{SphereScene, View};
 use facet_render::scene::{
-    Camera, Environment, EnvironmentMap, FacetMaterial, Light, Material, MeasuredMaterial,
-    Measurement, Scene,
+    Environment, EnvironmentMap, FacetMaterial, Material, MeasuredMaterial, Measurement, Scene,
 };
 use facet_render::{
     Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
@@ -30,20 +30,30 @@ use std::sync::Arc;
 
 /// The demo's sky, embedded so that the report needs no file beside the binary.
 const SKY_EXR: &[u8] = include_bytes!("../../assets/demo/sky.exr");
-/// The scene every sphere is rendered in, as the fit judges its look
-/// ([`SphereScene::REPORT`]): the camera on +z at 3 with a 45° vertical field of view, the
-/// point light upper left in front at distance ≈ 3.9, of intensity 40 (a white Lambertian
-/// facing it gives L = I/(π r²) ≈ 1.5, shown as 1 − e^−1.5 = 0.78 — most MERL materials are
-/// darker).
+/// The scene every sphere is rendered in ([`SphereScene::REPORT`]), the one the fit judges its
+/// look in ([`LookScene::REPORT`]; checked equal below): the camera on +z at 3 with a 45°
+/// vertical field of view, the point light upper left in front at distance ≈ 3.9, of intensity
+/// 40 (a white Lambertian facing it gives L = I/(π r²) ≈ 1.5, shown as 1 − e^−1.5 = 0.78 —
+/// most MERL materials are darker).
 const SCENE: SphereScene = SphereScene::REPORT;
-const CAMERA_Z: f32 = SCENE.camera_z as f32;
-const YFOV_DEG: f32 = SCENE.yfov_deg as f32;
-const LIGHT_POSITION: Vec3 = Vec3::new(
-    SCENE.light.x as f32,
-    SCENE.light.y as f32,
-    SCENE.light.z as f32,
-);
-const LIGHT_INTENSITY: f32 = SCENE.intensity as f32;
+const LOOK: LookScene = LookScene::REPORT;
+const CAMERA_Z: f32 = LOOK.camera_z as f32;
+const YFOV_DEG: f32 = SCENE.yfov_deg;
+// The rendered spheres and the fit's look are one scene.
+const _: () = {
+    let View::Look { position, .. } = SCENE.view else {
+        panic!("the report's camera is on +z")
+    };
+    let Some(light) = SCENE.light else {
+        panic!("the report's scene has a point light")
+    };
+    assert!(position.x == 0.0 && position.y == 0.0 && position.z == CAMERA_Z);
+    assert!(YFOV_DEG == LOOK.yfov_deg as f32);
+    assert!(light.position.x == LOOK.light.x as f32);
+    assert!(light.position.y == LOOK.light.y as f32);
+    assert!(light.position.z == LOOK.light.z as f32);
+    assert!(light.intensity == LOOK.intensity as f32);
+};
 /// Bounces of the environment renders (the sphere sees only the sky: 3 is plenty).
 pub const ENV_DEPTH: u32 = 3;
 /// Samples per pixel of the point-light renders: only the pixel positions vary (anti-aliasing).
@@ -176,27 +186,9 @@ fn single_layer(fit: &Arc<FittedMaterial>) -> Arc<FittedMaterial> {
 /// The unit sphere at the origin made of `material`, the camera on +z, the point light for
 /// [`Lighting::Point`].
 fn sphere_scene(material: Material, lighting: Lighting) -> Scene {
-    let mut s = Scene {
-        materials: vec![material],
-        camera: camera(),
-        ..Default::default()
-    };
-    s.add_uv_sphere(Vec3::ZERO, 1.0, 192, 96, 0);
-    if lighting == Lighting::Point {
-        s.lights.push(Light::Point {
-            position: LIGHT_POSITION,
-            intensity: Vec3::splat(LIGHT_INTENSITY),
-        });
-    }
-    s
-}
-
-fn camera() -> Camera {
-    Camera {
-        position: Vec3::new(0.0, 0.0, CAMERA_Z),
-        forward: Vec3::NEG_Z,
-        up: Vec3::Y,
-        yfov: YFOV_DEG.to_radians(),
+    match lighting {
+        Lighting::Point => SCENE.build(material),
+        Lighting::Environment => SCENE.without_light().build(material),
     }
 }
 

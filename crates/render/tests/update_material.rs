@@ -3,6 +3,7 @@
 
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_render::scene::camera_frame::CameraFrame;
+use facet_render::scene::sphere::SphereScene;
 use facet_render::scene::{Environment, FacetMaterial, Material, Scene};
 use facet_render::{
     ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
@@ -17,8 +18,7 @@ fn demo_fit() -> FittedMaterial {
 }
 
 fn sphere_scene(fit: FittedMaterial, model: ModelChoice) -> Scene {
-    let mut scene = Scene::default();
-    scene.materials.push(Material {
+    SphereScene::SMALL.build(Material {
         name: "sphere".into(),
         facet: Some(FacetMaterial {
             source: "demo".into(),
@@ -27,10 +27,7 @@ fn sphere_scene(fit: FittedMaterial, model: ModelChoice) -> Scene {
             glint: None,
         }),
         ..Material::default()
-    });
-    scene.add_uv_sphere(Vec3::ZERO, 1.0, 32, 16, 0);
-    scene.camera.position = Vec3::new(0.0, 0.0, 3.5);
-    scene
+    })
 }
 
 fn render(gpu: &facet_gpu::Gpu, res: &SceneResources, scene: &Scene) -> facet_render::Image {

@@ -238,7 +238,7 @@ impl Drop for Preview {
 /// The preview scene: a unit sphere (material [`SPHERE`]) on a grey plane, seen by the default
 /// orbit.
 pub fn preview_scene(sphere: Material) -> Scene {
-    let mut scene = facet_render::scene::shapes::preview_scene(sphere);
+    let mut scene = facet_render::scene::sphere::SphereScene::PREVIEW.build(sphere);
     scene.camera = Orbit::default().camera();
     scene
 }

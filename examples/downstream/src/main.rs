@@ -11,7 +11,8 @@ use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_fit::sources::nbrdf::NbrdfLibrary;
 use facet_glint::dpf::{dpf, query_directions};
 use facet_render::scene::camera_frame::CameraFrame;
-use facet_render::scene::{Environment, FacetMaterial, Material, shapes};
+use facet_render::scene::sphere::SphereScene;
+use facet_render::scene::{Environment, FacetMaterial, Material};
 use facet_render::{
     Gpu, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
 };
@@ -57,7 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }),
         ..Material::default()
     };
-    let scene = shapes::preview_scene(sphere);
+    let scene = SphereScene::PREVIEW.build(sphere);
     let sky = Environment::Constant(facet_render::glam::Vec3::splat(1.0));
     let gpu = Gpu::new()?;
     println!("adapter: {}", gpu.describe());

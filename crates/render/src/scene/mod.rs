@@ -20,6 +20,7 @@ pub mod gltf_material;
 pub mod measured;
 pub mod mesh;
 pub mod shapes;
+pub mod sphere;
 pub mod uri;
 
 pub use camera_frame::CameraFrame;

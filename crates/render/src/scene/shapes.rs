@@ -1,6 +1,7 @@
-//! Scenes built in code: meshes appended to a [`Scene`] (tests, benchmarks, generated scenes).
+//! Scenes built in code: meshes appended to a [`Scene`] (tests, benchmarks, generated scenes;
+//! the sphere scenes of [`super::sphere`]).
 
-use super::{Camera, Material, Scene};
+use super::Scene;
 use glam::{Vec2, Vec3, Vec4};
 
 impl Scene {
@@ -99,36 +100,4 @@ impl Scene {
         let uv = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y].map(|u| u * uv_scale);
         self.add_mesh(&p, &[n; 4], &uv, &[t; 4], &[[0, 1, 2], [0, 2, 3]], material);
     }
-}
-
-/// The viewer's preview scene: a unit sphere at the origin (material 1, `sphere`) on a grey
-/// plane at y = −1 (material 0), seen from 4.5 away, 0.25 rad above the horizon.
-pub fn preview_scene(sphere: Material) -> Scene {
-    let mut scene = Scene::default();
-    scene.materials.push(Material {
-        name: "floor".into(),
-        base_color: Vec4::new(0.45, 0.45, 0.45, 1.0),
-        roughness: 0.8,
-        metallic: 0.0,
-        ..Material::default()
-    });
-    scene.materials.push(sphere);
-    scene.add_quad(
-        Vec3::new(-8.0, -1.0, 8.0),
-        Vec3::new(16.0, 0.0, 0.0),
-        Vec3::new(0.0, 0.0, -16.0),
-        4.0,
-        0,
-    );
-    scene.add_uv_sphere(Vec3::ZERO, 1.0, 96, 48, 1);
-    let (pitch, distance) = (0.25f32, 4.5);
-    let position = Vec3::new(0.0, pitch.sin(), pitch.cos()) * distance;
-    let forward = -position.normalize();
-    scene.camera = Camera {
-        position,
-        forward,
-        up: (Vec3::Y - forward * forward.dot(Vec3::Y)).normalize(),
-        yfov: 35f32.to_radians(),
-    };
-    scene
 }

@@ -1,29 +1,20 @@
 //! The scenes and settings of the GPU render tests (`analytic_scenes`, `integrator`): a
 //! Lambertian material, a unit sphere filling most of a square frame, render configurations.
 
-use facet_render::scene::{Camera, Material, Scene};
+use facet_render::scene::sphere::SphereScene;
+use facet_render::scene::{Material, Scene};
 use facet_render::{ImageConfig, RenderConfig, SampleConfig, Strategy};
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 
 /// The width and height of the test renders.
 pub const SIZE: u32 = 64;
 /// The vertical field of view of [`sphere_scene`]'s camera.
-pub const YFOV_DEG: f32 = 36.0;
+pub const YFOV_DEG: f32 = SphereScene::TEST.yfov_deg;
 
-/// A unit sphere at the origin seen from +z at distance 3, filling most of the frame.
+/// A unit sphere at the origin seen from +z at distance 3, filling most of the frame
+/// ([`SphereScene::TEST`]).
 pub fn sphere_scene(material: Material) -> Scene {
-    let mut s = Scene {
-        materials: vec![material],
-        camera: Camera {
-            position: Vec3::new(0.0, 0.0, 3.0),
-            forward: Vec3::NEG_Z,
-            up: Vec3::Y,
-            yfov: YFOV_DEG.to_radians(),
-        },
-        ..Default::default()
-    };
-    s.add_uv_sphere(Vec3::ZERO, 1.0, 256, 128, 0);
-    s
+    SphereScene::TEST.build(material)
 }
 
 /// A Lambertian material of this albedo (glTF: dielectric, roughness 1, no specular).

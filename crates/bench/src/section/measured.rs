@@ -4,8 +4,8 @@
 //! sample and the variance against the fit's, the image means, and the memory of each table on
 //! the GPU.
 
-use super::gold_row;
-use anyhow::{Result, anyhow};
+use crate::error::{BenchError, Result};
+use crate::measure::gold_row;
 use facet_fit::export::rgl::{BsdfResolution, rgl_tensor};
 use facet_fit::model::material::ModelChoice;
 use facet_fit::sources::rgl::RglBsdf;
@@ -24,10 +24,10 @@ fn materials() -> Result<[(&'static str, Material); 3]> {
     let src = NbrdfLibrary::embedded().get(PROXY)?;
     let source = format!("nbrdf:{PROXY}");
     let fit = Arc::new(fit_material(&src, &source, &FitConfig::SINGLE_LAYER)?);
-    let table = Measurement::of(&InputSpec::parse(&source), &src).map_err(|e| anyhow!(e))?;
+    let table = Measurement::of(&InputSpec::parse(&source), &src).map_err(BenchError::Other)?;
     let (tensor, _) = rgl_tensor(&src, &fit.tabulated.ndf, BsdfResolution::standard(), "")
-        .map_err(|e| anyhow!("{PROXY}.bsdf: {e}"))?;
-    let bsdf = RglBsdf::parse(PROXY, tensor.to_bytes()).map_err(|e| anyhow!(e))?;
+        .map_err(|e| BenchError::Other(format!("{PROXY}.bsdf: {e}")))?;
+    let bsdf = RglBsdf::parse(PROXY, tensor.to_bytes()).map_err(BenchError::Other)?;
     let measured = |data: Measurement| Material {
         name: PROXY.into(),
         measured: Some(MeasuredMaterial {

@@ -4,14 +4,15 @@
 //! timestamp queries, by GPU timestamps around its passes; rays a second come from the GPU's
 //! time then.
 
-use super::{Sizes, median};
-use anyhow::Result;
+use crate::Sizes;
+use crate::error::Result;
+use crate::scenes::trace_rays;
+use crate::timing::median;
 use facet_gpu::Gpu;
 use facet_gpu::timer::GpuTimer;
-use facet_render::bvh::procedural::{self, Rng};
+use facet_render::bvh::procedural;
 use facet_render::bvh::query::{GpuHit, RayTracer, TraceBatch, TraceQuery};
 use facet_render::bvh::{Bvh, BvhConfig, GpuBvh};
-use glam::Vec3;
 use serde_json::{Value, json};
 use std::time::Instant;
 
@@ -33,7 +34,7 @@ pub fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         let mesh = procedural::test_scene(tris, 1);
         let bvh = Bvh::build(&mesh.positions, &mesh.indices, BvhConfig::medium());
         let gpu_bvh = GpuBvh::upload(d, &bvh)?;
-        for (set, rays) in ray_sets(n) {
+        for (set, rays) in trace_rays(n as usize, 1024) {
             let rays = facet_gpu::buffer::storage(d, "rays", &rays[..n as usize]);
             for (query, out) in [(TraceQuery::Closest, &hits), (TraceQuery::Any, &occluded)] {
                 let batch = TraceBatch {
@@ -65,24 +66,6 @@ pub fn trace(gpu: &Gpu, sizes: &Sizes) -> Result<Value> {
         gpu.check_lost()?;
     }
     Ok(Value::Array(rows))
-}
-
-/// Camera rays over the scene (a 1024-wide image) and random rays inside its box.
-fn ray_sets(n: u32) -> [(&'static str, Vec<facet_render::bvh::query::GpuRay>); 2] {
-    let camera = procedural::camera_rays(
-        Vec3::new(-8.0, 6.0, 9.0),
-        Vec3::new(2.0, 2.0, -3.0),
-        60f32.to_radians(),
-        1024,
-        n.div_ceil(1024),
-    );
-    let random = procedural::random_rays(
-        n as usize,
-        Vec3::new(-9.9, 0.1, -9.9),
-        Vec3::new(9.9, 9.9, 9.9),
-        &mut Rng::new(5),
-    );
-    [("camera", camera), ("random", random)]
 }
 
 /// One query over one BVH and ray set.

@@ -4,12 +4,11 @@
 //! the coat near its critical angle), at equal spp: the time a sample and the variance, each
 //! against the same base's uncoated smooth fit.
 
-use super::gold_row;
-use anyhow::Result;
+use crate::error::{BenchError, Result};
+use crate::measure::gold_row;
+use crate::scenes::analytic_table;
 use facet_fit::model::coat::Coat;
 use facet_fit::model::material::{CoatRecord, FittedMaterial, ModelChoice};
-use facet_fit::model::merl_grid::MerlTable;
-use facet_fit::sources::merl::MerlBrdf;
 use facet_fit::{FitConfig, fit_material};
 use facet_render::scene::{FacetMaterial, GlintParams, Material};
 use serde_json::{Value, json};
@@ -26,8 +25,7 @@ const COAT: Coat = Coat::new(1.5, 0.05, 1.0);
 
 /// The fit of `spec` without and with [`COAT`].
 fn fits(spec: &str) -> Result<[Arc<FittedMaterial>; 2]> {
-    let model = facet_fit::model::analytic::parse_analytic(spec)?;
-    let src = MerlBrdf::from_table(spec, MerlTable::sample(&model)).map_err(anyhow::Error::msg)?;
+    let src = analytic_table(spec)?;
     let bare = fit_material(&src, spec, &FitConfig::SINGLE_LAYER)?;
     let mut record = bare.record.clone();
     record.coat = Some(CoatRecord {
@@ -37,7 +35,7 @@ fn fits(spec: &str) -> Result<[Arc<FittedMaterial>; 2]> {
         beckmann_error: None,
         base: Box::new(bare.record.clone()),
     });
-    let coated = FittedMaterial::from_record(record).map_err(anyhow::Error::msg)?;
+    let coated = FittedMaterial::from_record(record).map_err(BenchError::Other)?;
     Ok([Arc::new(bare), Arc::new(coated)])
 }
 

@@ -4,8 +4,11 @@
 //! against robust's, with the image means (which must agree: every selection is unbiased); and
 //! the light BVH's build time and memory for emissive triangles.
 
-use super::{Sizes, demo_scene, gold_ggx, gold_scene, measure_noise, median, square};
-use anyhow::Result;
+use crate::error::Result;
+use crate::measure::measure_noise;
+use crate::scenes::{demo_scene, gold_ggx, gold_scene, square};
+use crate::timing::median;
+use crate::{Assets, Sizes};
 use facet_render::resources::light_bvh::{GpuLightNode, LightBounds, LightBvh};
 use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::{Environment, LoadOptions, Scene, load_gltf};
@@ -15,27 +18,27 @@ use facet_render::{
 };
 use glam::Vec3;
 use serde_json::{Value, json};
-use std::path::Path;
 use std::time::Instant;
 
 /// A many-light room of `assets/many_lights/`.
-fn room(file: &str) -> Result<(Scene, Option<Environment>)> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("assets/many_lights")
-        .join(file);
+fn room(assets: &Assets, file: &str) -> Result<(Scene, Option<Environment>)> {
+    let path = assets.room(file);
     Ok((load_gltf(&path, &LoadOptions::default())?, None))
 }
 
 /// The section: the renders, then the builds.
-pub fn lights(gpu: &facet_gpu::Gpu, sizes: &Sizes) -> Result<Value> {
+pub fn lights(gpu: &facet_gpu::Gpu, sizes: &Sizes, assets: &Assets) -> Result<Value> {
     let (side, spp, builds) = sizes.lights;
-    let (demo, sky) = demo_scene(true)?;
-    let (gold, gold_sky) = gold_scene(gold_ggx(0.3)?)?;
+    let (demo, sky) = demo_scene(assets, true)?;
+    let (gold, gold_sky) = gold_scene(gold_ggx(0.3)?);
     let scenes = [
-        ("room, 100 point and spot lamps", room("room_points.gltf")?),
+        (
+            "room, 100 point and spot lamps",
+            room(assets, "room_points.gltf")?,
+        ),
         (
             "room, 100 emissive panels (10^4 triangles)",
-            room("room_panels.gltf")?,
+            room(assets, "room_panels.gltf")?,
         ),
         ("gold sphere, sky and point light", (gold, Some(gold_sky))),
         ("demo", (demo, Some(sky))),
