@@ -257,20 +257,22 @@ impl IsoTables {
         if let Some(iso) = &set.iso {
             return iso.log_error_sum(self);
         }
-        set.samples()
-            .par_iter()
-            .with_min_len(4096)
-            .map(|s| {
-                let (wi, wo) = set.directions(s);
-                let ideal = self.x_ideal_at(wi, wo, s.i as usize);
-                let f = self.fresnel[s.j as usize];
-                log_diff(
-                    std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * wi.z),
-                    s,
-                    set.scale,
-                )
-            })
-            .sum()
+        let log_diff_of = |s: &GridSample| {
+            let (wi, wo) = set.directions(s);
+            let ideal = self.x_ideal_at(wi, wo, s.i as usize);
+            let f = self.fresnel[s.j as usize];
+            log_diff(
+                std::array::from_fn(|c| f[c] * ideal + self.diffuse[c] * wi.z),
+                s,
+                set.scale,
+            )
+        };
+        let parts: Vec<f64> = set
+            .samples()
+            .par_chunks(CHUNK)
+            .map(|chunk| chunk.iter().map(log_diff_of).sum())
+            .collect();
+        parts.into_iter().sum()
     }
 
     /// F per θd bin for this model's D and G (see [`fresnel_average`]).
@@ -293,16 +295,28 @@ fn x_direct(model: &dyn Brdf, set: &GridSamples, s: &GridSample) -> Option<Rgb> 
     model.eval(wi, wo).map(|f| f.map(|v| v * wi.z))
 }
 
+/// Samples per task of the passes over a grid's samples. Fixed, with each task's sum taken in
+/// order and the tasks' sums in order, so that a sum does not depend on the thread schedule and
+/// a fit is the same, bit for bit, run to run.
+const CHUNK: usize = 4096;
+
 /// The error metric of the design notes: mean over valid samples and channels of
 /// |ln(1 + x_model) − ln(1 + x_data)|, x = f_r cos θi. Samples where the model has no value
 /// are left out.
 pub fn error_metric(model: &dyn Brdf, set: &GridSamples) -> f64 {
-    let (sum, count) = set
+    let parts: Vec<(f64, usize)> = set
         .samples()
-        .par_iter()
-        .filter_map(|s| x_direct(model, set, s).map(|x| log_diff(x, s, set.scale)))
-        .fold(|| (0.0, 0usize), |(a, n), e| (a + e, n + 1))
-        .reduce(|| (0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            chunk
+                .iter()
+                .filter_map(|s| x_direct(model, set, s).map(|x| log_diff(x, s, set.scale)))
+                .fold((0.0, 0), |(a, n), e| (a + e, n + 1))
+        })
+        .collect();
+    let (sum, count) = parts
+        .into_iter()
+        .fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     sum / (3 * count.max(1)) as f64
 }
 
@@ -531,32 +545,32 @@ fn average_with(model: &MicrofacetBrdf, tables: Option<&IsoTables>, set: &GridSa
 /// Σ x_data / Σ x_ideal per θd bin, empty bins filled by interpolation.
 fn average_per_theta_d(set: &GridSamples, ideal: impl Fn(&GridSample) -> f64 + Sync) -> Vec<Rgb> {
     type Acc = Vec<([f64; 3], f64)>;
-    let acc: Acc = set
+    let parts: Vec<Acc> = set
         .samples()
-        .par_iter()
-        .with_min_len(4096)
-        .fold(
-            || vec![([0.0; 3], 0.0); THETA_D_RES],
-            |mut acc: Acc, s| {
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let mut acc: Acc = vec![([0.0; 3], 0.0); THETA_D_RES];
+            for s in chunk {
                 let xi = ideal(s);
                 if xi.is_finite() && xi > 0.0 {
                     let a = &mut acc[s.j as usize];
                     (0..3).for_each(|c| a.0[c] += s.x[c] as f64);
                     a.1 += xi;
                 }
-                acc
-            },
-        )
-        .reduce(
-            || vec![([0.0; 3], 0.0); THETA_D_RES],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(b) {
-                    (0..3).for_each(|c| x.0[c] += y.0[c]);
-                    x.1 += y.1;
-                }
-                a
-            },
-        );
+            }
+            acc
+        })
+        .collect();
+    let acc = parts
+        .into_iter()
+        .reduce(|mut a, b| {
+            for (x, y) in a.iter_mut().zip(b) {
+                (0..3).for_each(|c| x.0[c] += y.0[c]);
+                x.1 += y.1;
+            }
+            a
+        })
+        .unwrap_or_else(|| vec![([0.0; 3], 0.0); THETA_D_RES]);
     fresnel_from_sums(&acc)
 }
 

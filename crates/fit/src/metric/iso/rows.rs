@@ -50,20 +50,24 @@ impl<const N: usize, const M: usize, const P: usize> IsoSamples<N, M, P> {
         })
     }
 
-    /// A pass over this set's rows, a θh bin's rows per task.
+    /// A pass over this set's rows, a θh bin's rows per task. The bins' accumulators merge in
+    /// bin order, so the result does not depend on how the tasks were scheduled: a fit is the
+    /// same, bit for bit, run to run.
     pub(super) fn run<R: RowPass>(&self, pass: &R) -> R::Acc {
         let bounds = self.bin_bounds();
-        (0..THETA_H_RES)
+        let per_bin: Vec<R::Acc> = (0..THETA_H_RES)
             .into_par_iter()
-            .fold(R::init, |mut acc, i| {
+            .map(|i| {
+                let mut acc = R::init();
                 let rows = &self.rows[bounds[i]..bounds[i + 1]];
                 run_rows(pass, &mut acc, rows, bounds[i]);
                 acc
             })
-            .reduce(R::init, |mut a, b| {
-                R::merge(&mut a, b);
-                a
-            })
+            .collect();
+        per_bin.into_iter().fold(R::init(), |mut a, b| {
+            R::merge(&mut a, b);
+            a
+        })
     }
 }
 
