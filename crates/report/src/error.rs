@@ -29,8 +29,8 @@ pub enum ReportError {
     Rendering {
         /// The input and the variant rendered.
         what: String,
-        /// Why the render failed.
-        source: facet_render::RenderError,
+        /// Why the render failed (boxed: the error stays small on every `Result`'s path).
+        source: Box<facet_render::RenderError>,
     },
     /// Writing a file of the page.
     #[error("writing {}", path.display())]

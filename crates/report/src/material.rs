@@ -171,7 +171,7 @@ fn render_variants(
             .render(m.clone(), lighting, SEED)
             .map_err(|source| ReportError::Rendering {
                 what: format!("{}: rendering {}", subject.input, variant.key()),
-                source,
+                source: Box::new(source),
             })?;
         let path = out.join(render_file(stem, lighting, *variant));
         image.write_png(&path, 0.0).map_err(|e| ReportError::Png {
@@ -199,7 +199,7 @@ fn noise_floor(
         .render(again.1.clone(), lighting, FLOOR_SEED)
         .map_err(|source| ReportError::Rendering {
             what: format!("{}: rendering {} again", subject.input, again.0.key()),
-            source,
+            source: Box::new(source),
         })?;
     let d = delta_e_image(reference, &image, &mask(renderer.side()));
     false_colour::write_png(&d, &out.join(floor_file(stem, lighting)))?;
