@@ -2,31 +2,24 @@
 //! their fits — per material, spheres of the measurement and of each model under a point light
 //! and an environment, their ΔE2000 images and mean ΔE2000 and ΔE_ITP, NDF and Fresnel plots,
 //! errors and times; a database summary (sortable table, mean ΔE per model, mean ΔE images over
-//! the set); run time against error over N = 32, 64, 90, 128 ([`sweep`]).
+//! the set); run time against error over N = 32, 64, 90, 128. The work is facet-report's; this
+//! file is the arguments, their checks, the output folder and the progress bars.
 
-mod delta_e;
-mod false_colour;
-mod html;
-mod material;
-mod plots;
-mod scenes;
-mod subject;
-mod sweep;
-
-use self::material::{MaterialReport, report_material};
-use self::scenes::{Lighting, SphereRenderer};
 use crate::fit_cmd::{CoatArg, MetricArg};
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use facet_fit::FitConfig;
-use facet_fit::fitting::CoatSearch;
 use facet_fit::io::input::same_file;
 use facet_fit::sources::nbrdf::NbrdfLibrary;
+use facet_render::scene::EnvironmentMap;
+use facet_report::{IMG, Progress, ReportConfig, ReportError, Sky};
 use indicatif::{ProgressBar, ProgressStyle};
-use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::Arc;
 use std::time::Instant;
+
+/// The demo's sky, embedded so that the report needs no file beside the binary.
+const SKY_EXR: &[u8] = include_bytes!("../assets/demo/sky.exr");
 
 #[derive(Args)]
 pub struct ReportArgs {
@@ -109,9 +102,6 @@ fn inputs(args: &ReportArgs) -> Result<Vec<String>> {
     Ok(v)
 }
 
-/// Subfolder of the report's images.
-pub const IMG: &str = "img";
-
 /// Refuses, before anything is written, an input file the page would replace: `index.html` of
 /// `--out`, or a file in its `img/` (whose names come from the materials'), named as an input
 /// or as `--env`.
@@ -137,19 +127,7 @@ fn refuse_replacing_inputs(args: &ReportArgs, inputs: &[String]) -> Result<()> {
     Ok(())
 }
 
-/// A file stem for `name`, unique among `taken` (-2, -3, ... on a repeat).
-fn unique_stem(name: &str, taken: &mut HashSet<String>) -> String {
-    let base = facet_fit::io::input::safe_file_stem(name);
-    let mut stem = base.clone();
-    for k in 2.. {
-        if taken.insert(stem.clone()) {
-            break;
-        }
-        stem = format!("{base}-{k}");
-    }
-    stem
-}
-
+/// A bar of `n` steps, with the step's words and the time left.
 fn progress_bar(n: usize) -> ProgressBar {
     let bar = ProgressBar::new(n as u64);
     bar.set_style(
@@ -159,167 +137,87 @@ fn progress_bar(n: usize) -> ProgressBar {
     bar
 }
 
+impl ReportArgs {
+    /// The library's settings.
+    fn config(&self) -> ReportConfig {
+        ReportConfig {
+            side: self.resolution,
+            env_spp: self.spp,
+            fit_resolution: self.fit_resolution,
+            coat: self.coat.search(self.no_coat),
+            metric: self.metric.metric(),
+            sweep: self.sweep,
+        }
+    }
+}
+
+/// The environment of `--env`, or the embedded sky; the loader's warnings printed.
+fn sky(env: Option<&Path>) -> Result<Sky> {
+    let (map, warnings) = match env {
+        Some(path) => EnvironmentMap::load(path)?,
+        None => EnvironmentMap::from_exr_bytes(Path::new("embedded sky.exr"), SKY_EXR)?,
+    };
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+    let name = env.map_or("the demo's sky".into(), |p| p.display().to_string());
+    Ok(Sky {
+        map: Arc::new(map),
+        name,
+    })
+}
+
+/// A progress bar per stage of the report (the materials, the N sweep); an input that fails
+/// printed above it.
+fn show_progress(bar: &mut ProgressBar) -> impl FnMut(Progress) + '_ {
+    move |p| match p {
+        Progress::Start { len } => *bar = progress_bar(len),
+        Progress::Step(what) => bar.set_message(what.to_owned()),
+        Progress::Failed(e) => bar.suspend(|| eprintln!("error: {:#}", anyhow::Error::from(e))),
+        Progress::Done => bar.inc(1),
+        Progress::Finish => bar.finish_and_clear(),
+    }
+}
+
 pub fn run(args: &ReportArgs) -> Result<ExitCode> {
     let started = Instant::now();
     let inputs = inputs(args)?;
     refuse_replacing_inputs(args, &inputs)?;
     prepare_out(&args.out, args.force)?;
     let gpu = crate::render_cmd::open_gpu()?;
-    let mut renderer = SphereRenderer::new(&gpu, args.resolution, args.spp, args.env.as_deref())?;
-    let mut cfg = FitConfig {
-        coat: args.coat.search(args.no_coat),
-        metric: args.metric.metric(),
-        ..FitConfig::isotropic()
-    };
-    cfg.extract.resolution = args.fit_resolution;
-    let mut library = None;
-    let bar = progress_bar(inputs.len());
-    let (mut reports, mut stems, mut failed) = (Vec::new(), HashSet::new(), 0);
-    for input in &inputs {
-        bar.set_message(input.clone());
-        let done = subject::open(input, &cfg, &mut library).and_then(|s| {
-            let stem = unique_stem(&s.fit.record.name, &mut stems);
-            report_material(&mut renderer, &s, &stem, &args.out)
-        });
-        match done {
-            Ok(r) => reports.push(r),
-            // The readers' and the steps' errors name the input; the others still go on.
-            Err(e) => {
-                failed += 1;
-                bar.suspend(|| eprintln!("error: {e:#}"));
-            }
+    let sky = sky(args.env.as_deref())?;
+    let mut bar = ProgressBar::hidden();
+    let done = facet_report::report(
+        &gpu,
+        &inputs,
+        &args.out,
+        &sky,
+        &args.config(),
+        started,
+        &mut show_progress(&mut bar),
+    );
+    let outcome = match done {
+        Err(e @ ReportError::NothingReported { .. }) => {
+            // Nothing to show: the folders made above go again (only if empty: nothing else
+            // is removed).
+            let _ = std::fs::remove_dir(args.out.join(IMG));
+            let _ = std::fs::remove_dir(&args.out);
+            return Err(e.into());
         }
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    if reports.is_empty() {
-        // Nothing to show: the folders made above go again (only if empty: nothing else is
-        // removed).
-        let _ = std::fs::remove_dir(args.out.join(IMG));
-        let _ = std::fs::remove_dir(&args.out);
-        bail!("no input could be reported ({failed} failed)");
-    }
-    // The sweep fits again only inputs that were reported.
-    let reported: Vec<String> = reports.iter().map(|r| r.input.clone()).collect();
-    // The sweep times the single layer's fit against N: no coat is searched.
-    let single = FitConfig {
-        coat: CoatSearch::Off,
-        ..cfg
+        done => done?,
     };
-    let sweep = run_sweep(&reported, args.sweep, &single, &mut library)?;
-    write_page(args, &gpu, &reports, &sweep, started)?;
-    print_means(&reports, started);
-    Ok(if failed > 0 {
+    println!("wrote {}", outcome.index.display());
+    for line in facet_report::means_lines(&outcome.materials) {
+        println!("{line}");
+    }
+    println!(
+        "{} material(s) in {:.1} s",
+        outcome.materials.len(),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(if outcome.failed > 0 {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS
     })
-}
-
-/// The N sweep of the first `k` inputs, with its own progress bar.
-fn run_sweep(
-    inputs: &[String],
-    k: usize,
-    cfg: &FitConfig,
-    library: &mut Option<NbrdfLibrary>,
-) -> Result<Vec<sweep::SweepPoint>> {
-    let chosen = &inputs[..k.min(inputs.len())];
-    let bar = progress_bar(chosen.len());
-    let mut points = Vec::new();
-    for input in chosen {
-        bar.set_message(format!("N sweep: {input}"));
-        points.extend(sweep::sweep_input(input, cfg, library)?);
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-    Ok(points)
-}
-
-/// The database's mean ΔE images, the scale, the sweep plot and index.html.
-fn write_page(
-    args: &ReportArgs,
-    gpu: &facet_gpu::Gpu,
-    reports: &[MaterialReport],
-    sweep: &[sweep::SweepPoint],
-    started: Instant,
-) -> Result<()> {
-    let out = &args.out;
-    for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        for k in 0..scenes::N_MODELS {
-            let images: Vec<_> = reports.iter().filter_map(|r| r.de[l][k].as_ref()).collect();
-            if let Some(mean) = delta_e::DeltaE::mean_of(&images) {
-                false_colour::write_png(&mean, &out.join(html::mean_de_file(*lighting, k)))?;
-            }
-        }
-    }
-    plots::write_scale(&out.join(plots::SCALE_FILE))?;
-    if !sweep.is_empty() {
-        plots::write_sweep_plot(sweep, &out.join(plots::SWEEP_FILE))?;
-    }
-    let info = html::PageInfo {
-        adapter: gpu.describe(),
-        side: args.resolution,
-        env_spp: args.spp,
-        resolution: args.fit_resolution,
-        coat: match args.coat.search(args.no_coat) {
-            CoatSearch::Auto => {
-                "a clear coat searched where the single layer's point-light sphere is above \
-                 ΔE2000 0.9, kept where it looks better"
-            }
-            CoatSearch::Always => {
-                "a clear coat searched for every material, kept where it looks better"
-            }
-            CoatSearch::Off => "no coat searched",
-        },
-        env: args
-            .env
-            .as_ref()
-            .map_or("the demo's sky".into(), |p| p.display().to_string()),
-        seconds: started.elapsed().as_secs_f64(),
-        version: env!("CARGO_PKG_VERSION"),
-    };
-    let page = html::page(&info, reports, sweep);
-    let index = out.join("index.html");
-    std::fs::write(&index, page).with_context(|| format!("writing {}", index.display()))?;
-    println!("wrote {}", index.display());
-    Ok(())
-}
-
-/// The mean ΔE2000 and ΔE_ITP per model over the set, the noise floor's mean and median, and
-/// the wall time.
-fn print_means(reports: &[MaterialReport], started: Instant) {
-    let means = html::set_means(reports);
-    for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        for (d, name) in ["ΔE", "ΔE_ITP"].iter().enumerate() {
-            let v: Vec<String> = scenes::Variant::MODELS
-                .iter()
-                .zip(means[l])
-                .map(|(m, v)| {
-                    let v = v.map(|v| v.both()[d]);
-                    format!(
-                        "{} {}",
-                        m.key(),
-                        v.map_or("–".into(), |v| format!("{v:.3}"))
-                    )
-                })
-                .collect();
-            println!("mean {name} ({}): {}", lighting.key(), v.join(", "));
-        }
-    }
-    for (l, lighting) in Lighting::ALL.iter().enumerate() {
-        let floors = html::floor_stats(reports)[l];
-        println!(
-            "noise floor ({}): ΔE mean {:.3} median {:.3}, ΔE_ITP mean {:.3} median {:.3}",
-            lighting.key(),
-            floors[0].0,
-            floors[0].1,
-            floors[1].0,
-            floors[1].1
-        );
-    }
-    println!(
-        "{} material(s) in {:.1} s",
-        reports.len(),
-        started.elapsed().as_secs_f64()
-    );
 }

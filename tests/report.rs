@@ -6,17 +6,13 @@
 
 mod common;
 
-// The report's ΔE module itself (it needs only facet-render's Image and palette).
-#[path = "../src/report_cmd/delta_e.rs"]
-#[allow(dead_code)]
-mod delta_e;
-
 use common::{facet_in, scratch};
-use delta_e::{
+// The report's ΔE module, facet-report's public API.
+use facet_render::Image;
+use facet_report::delta_e::{
     REC709_TO_REC2020, REFERENCE_WHITE, ciede2000, delta_e_image, delta_e_itp, displayed, ictcp,
     lab, pq,
 };
-use facet_render::Image;
 use palette::{Lab, LinSrgb};
 use std::path::Path;
 use std::process::Command;

@@ -1,25 +1,32 @@
 //! The page: one self-contained `index.html` (inline CSS and a few lines of inline JS to sort
 //! the table), its images as PNG and SVG files in `img/` beside it.
 
-use super::delta_e::{DePair, NAMES, REFERENCE_WHITE};
-use super::false_colour::DE_MAX;
-use super::material::{MaterialReport, de_file, floor_file, reference, render_file, variants};
-use super::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
-use super::scenes::{ENV_DEPTH, Lighting, N_MODELS, POINT_SPP, Variant};
-use super::sweep::SweepPoint;
+use crate::delta_e::{DePair, NAMES, REFERENCE_WHITE};
+use crate::false_colour::DE_MAX;
+use crate::material::{MaterialReport, de_file, floor_file, reference, render_file, variants};
+use crate::plots::{SCALE_FILE, SWEEP_FILE, fresnel_file, ndf_file};
+use crate::scenes::{ENV_DEPTH, Lighting, N_MODELS, POINT_SPP, Variant};
+use crate::sweep::SweepPoint;
 use facet_fit::model::metric::Metric;
 use std::fmt::Write;
 
 /// What the page says about the run.
 pub struct PageInfo {
+    /// The adapter the spheres were rendered on, in words.
     pub adapter: String,
+    /// Side of each sphere image, pixels.
     pub side: u32,
+    /// Samples per pixel of the environment renders.
     pub env_spp: u32,
+    /// Polar nodes N of the fits.
     pub resolution: usize,
     /// When a coat was searched (`--coat`).
     pub coat: &'static str,
+    /// The environment map's name.
     pub env: String,
+    /// The run's wall time, seconds.
     pub seconds: f64,
+    /// Facet's version.
     pub version: &'static str,
 }
 

@@ -1,7 +1,7 @@
 //! One input of the report, opened and fitted: a measurement (everything `facet fit` takes) is
 //! tabulated and fitted here; a fit JSON is read, and has no measurement to render.
 
-use anyhow::{Context, Result, anyhow};
+use crate::error::{ReportError, Result};
 use facet_fit::Brdf;
 use facet_fit::FitConfig;
 use facet_fit::model::material::FittedMaterial;
@@ -46,15 +46,19 @@ pub fn open(input: &str, cfg: &FitConfig, library: &mut Option<NbrdfLibrary>) ->
     let fitted = |src: &dyn Brdf| -> Result<(FittedMaterial, f64)> {
         let t = Instant::now();
         let fit =
-            facet_fit::fit_material(src, input, cfg).with_context(|| format!("fitting {input}"))?;
+            facet_fit::fit_material(src, input, cfg).map_err(|source| ReportError::Fitting {
+                input: input.to_owned(),
+                n: None,
+                source,
+            })?;
         Ok((fit, t.elapsed().as_secs_f64() * 1e3))
     };
     let ((fit, fit_ms), measurement) = if matches!(spec, InputSpec::Rgl(_)) || !src.is_isotropic() {
         (fitted(&*src)?, Measurement::of(&spec, &*src).ok())
     } else {
         let table = src.merl_table().into_owned();
-        let tabulated =
-            MerlBrdf::from_table(src.name(), table.clone()).map_err(|e| anyhow!("{input}: {e}"))?;
+        let tabulated = MerlBrdf::from_table(src.name(), table.clone())
+            .map_err(|e| ReportError::Other(format!("{input}: {e}")))?;
         (fitted(&tabulated)?, Some(Measurement::Merl(table.filled())))
     };
     Ok(Subject {

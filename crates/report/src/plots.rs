@@ -2,10 +2,10 @@
 //! a material's NDFs (log scale) and Fresnel curves, the N sweep's time against error, and the
 //! ΔE colour scale.
 
-use super::IMG;
-use super::false_colour::{DE_MAX, colour};
-use super::sweep::SweepPoint;
-use anyhow::{Result, anyhow};
+use crate::IMG;
+use crate::error::{ReportError, Result};
+use crate::false_colour::{DE_MAX, colour};
+use crate::sweep::SweepPoint;
 use facet_fit::model::material::FittedMaterial;
 use glam::DVec3;
 use plotters::prelude::*;
@@ -28,8 +28,8 @@ pub const SCALE_FILE: &str = "img/delta-e-scale.svg";
 /// The page-relative path of the sweep plot.
 pub const SWEEP_FILE: &str = "img/sweep.svg";
 
-fn plot_error<E: std::fmt::Debug>(e: E) -> anyhow::Error {
-    anyhow!("drawing a plot: {e:?}")
+fn plot_error<E: std::fmt::Debug>(e: E) -> ReportError {
+    ReportError::Plot(format!("{e:?}"))
 }
 
 /// D(θh) at φ = 0 of the extracted NDF, of the GGX and Beckmann fits and, for a fit that kept a
@@ -251,5 +251,5 @@ pub fn write_scale(path: &Path) -> Result<()> {
         );
     }
     s += "</svg>\n";
-    std::fs::write(path, s).map_err(|e| anyhow!("writing {}: {e}", path.display()))
+    std::fs::write(path, s).map_err(ReportError::write(path))
 }

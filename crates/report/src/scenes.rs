@@ -10,26 +10,24 @@
 //! pipelines depend only on those classes; each render gets its own wavefront bound to its own
 //! scene's resources).
 
-use anyhow::Result;
+use crate::error::{ReportError, Result};
+use crate::sky::Sky;
 use facet_fit::metric::look::SphereScene as LookScene;
 use facet_fit::model::material::{FittedMaterial, ModelChoice};
 use facet_gpu::Gpu;
 use facet_render::scene::camera_frame::CameraFrame;
 use facet_render::scene::sphere::{SphereScene, View};
 use facet_render::scene::{
-    Environment, EnvironmentMap, FacetMaterial, Material, MeasuredMaterial, Measurement, Scene,
+    Environment, FacetMaterial, Material, MeasuredMaterial, Measurement, Scene,
 };
 use facet_render::{
-    Image, ImageConfig, Integrator, RenderConfig, ResourceConfig, SampleConfig, SceneResources,
-    Sequence, Strategy,
+    Image, ImageConfig, Integrator, RenderConfig, RenderError, ResourceConfig, SampleConfig,
+    SceneResources, Sequence, Strategy,
 };
 use glam::Vec3;
 use std::collections::HashMap;
-use std::path::Path;
 use std::sync::Arc;
 
-/// The demo's sky, embedded so that the report needs no file beside the binary.
-const SKY_EXR: &[u8] = include_bytes!("../../assets/demo/sky.exr");
 /// The scene every sphere is rendered in ([`SphereScene::REPORT`]), the one the fit judges its
 /// look in ([`LookScene::REPORT`]; checked equal below): the camera on +z at 3 with a 45°
 /// vertical field of view, the point light upper left in front at distance ≈ 3.9, of intensity
@@ -149,12 +147,20 @@ pub fn material(
             }),
             ..Default::default()
         },
-        (Variant::Measured, None) => anyhow::bail!("{source}: no measurement to render"),
+        (Variant::Measured, None) => {
+            return Err(ReportError::Other(format!(
+                "{source}: no measurement to render"
+            )));
+        }
         (Variant::Model(model), _) => facet_material(source, single_layer(fit), model),
         (Variant::Coated, _) if fit.coated.is_some() => {
             facet_material(source, fit.clone(), ModelChoice::Tabulated)
         }
-        (Variant::Coated, _) => anyhow::bail!("{source}: the fit kept no coat"),
+        (Variant::Coated, _) => {
+            return Err(ReportError::Other(format!(
+                "{source}: the fit kept no coat"
+            )));
+        }
     })
 }
 
@@ -216,23 +222,15 @@ pub struct SphereRenderer<'g> {
 }
 
 impl<'g> SphereRenderer<'g> {
-    /// A renderer of `side`² images with `env_spp` samples in the environment `env` (an EXR
-    /// file; `None`: the embedded sky).
-    pub fn new(gpu: &'g Gpu, side: u32, env_spp: u32, env: Option<&Path>) -> Result<Self> {
-        let (map, warnings) = match env {
-            Some(path) => EnvironmentMap::load(path)?,
-            None => EnvironmentMap::from_exr_bytes(Path::new("embedded sky.exr"), SKY_EXR)?,
-        };
-        for w in warnings {
-            eprintln!("warning: {w}");
-        }
-        Ok(SphereRenderer {
+    /// A renderer of `side`² images with `env_spp` samples in the environment `sky`.
+    pub fn new(gpu: &'g Gpu, side: u32, env_spp: u32, sky: &Sky) -> Self {
+        SphereRenderer {
             gpu,
-            environment: Environment::Map(Arc::new(map)),
+            environment: Environment::Map(sky.map.clone()),
             side,
             env_spp,
             integrators: HashMap::new(),
-        })
+        }
     }
 
     /// The image side, pixels.
@@ -241,7 +239,12 @@ impl<'g> SphereRenderer<'g> {
     }
 
     /// `material` on the sphere under `lighting`, its samples drawn from `seed`'s sequence.
-    pub fn render(&mut self, material: Material, lighting: Lighting, seed: u32) -> Result<Image> {
+    pub fn render(
+        &mut self,
+        material: Material,
+        lighting: Lighting,
+        seed: u32,
+    ) -> Result<Image, RenderError> {
         let scene = sphere_scene(material, lighting);
         let env = (lighting == Lighting::Environment).then_some(&self.environment);
         let res = SceneResources::new(self.gpu, &scene, env, ResourceConfig::standard())?;

@@ -3,7 +3,7 @@
 //! tabulated on the MERL grid once first, so that the times are the fit's, not a neural
 //! proxy's evaluation (about a second, the same at every N).
 
-use anyhow::{Context, Result, anyhow};
+use crate::error::{ReportError, Result};
 use facet_fit::FitConfig;
 use facet_fit::model::metric::Metric;
 use facet_fit::sources::merl::MerlBrdf;
@@ -47,14 +47,19 @@ pub fn sweep_input(
         return Ok(Vec::new());
     }
     let table = MerlBrdf::from_table(src.name(), src.merl_table().into_owned())
-        .map_err(|e| anyhow!("{input}: {e}"))?;
+        .map_err(|e| ReportError::Other(format!("{input}: {e}")))?;
     let mut points = Vec::new();
     for n in RESOLUTIONS {
         let mut cfg = *cfg;
         cfg.extract.resolution = n;
         let t = Instant::now();
-        let fit = facet_fit::fit_material(&table, input, &cfg)
-            .with_context(|| format!("fitting {input} at N = {n}"))?;
+        let fit = facet_fit::fit_material(&table, input, &cfg).map_err(|source| {
+            ReportError::Fitting {
+                input: input.to_owned(),
+                n: Some(n),
+                source,
+            }
+        })?;
         let r = &fit.record;
         points.push(SweepPoint {
             material: input.to_owned(),

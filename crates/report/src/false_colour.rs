@@ -2,8 +2,8 @@
 //! [`DE_MAX`], pixels off the sphere dark grey. One fixed scale for every image of a report, so
 //! that images compare.
 
-use super::delta_e::DeltaE;
-use anyhow::{Context, Result};
+use crate::delta_e::DeltaE;
+use crate::error::{ReportError, Result};
 use plotters::style::colors::colormaps::ViridisRGB;
 use std::path::Path;
 
@@ -34,5 +34,8 @@ pub fn write_png(de: &DeltaE, path: &Path) -> Result<()> {
         image::ExtendedColorType::Rgb8,
         image::ImageFormat::Png,
     )
-    .with_context(|| format!("writing {}", path.display()))
+    .map_err(|e| ReportError::Png {
+        path: path.to_owned(),
+        source: Box::new(e),
+    })
 }

@@ -3,13 +3,13 @@
 //! measurement, or the tabulated model when there is none), the noise floor (the reference
 //! rendered again at another seed, against itself), and the plots of its NDF and F.
 
-use super::delta_e::{DePair, DeltaE, delta_e_image};
-use super::scenes::{
+use crate::delta_e::{DePair, DeltaE, delta_e_image};
+use crate::error::{ReportError, Result};
+use crate::scenes::{
     FLOOR_SEED, Lighting, N_MODELS, SEED, SphereRenderer, Variant, material, on_sphere,
 };
-use super::subject::Subject;
-use super::{IMG, false_colour, plots};
-use anyhow::{Context, Result};
+use crate::subject::Subject;
+use crate::{IMG, false_colour, plots};
 use facet_fit::model::material::ModelChoice;
 use facet_render::Image;
 use facet_render::scene::Material;
@@ -169,11 +169,15 @@ fn render_variants(
     for (variant, m) in materials {
         let image = renderer
             .render(m.clone(), lighting, SEED)
-            .with_context(|| format!("{}: rendering {}", subject.input, variant.key()))?;
+            .map_err(|source| ReportError::Rendering {
+                what: format!("{}: rendering {}", subject.input, variant.key()),
+                source: Box::new(source),
+            })?;
         let path = out.join(render_file(stem, lighting, *variant));
-        image
-            .write_png(&path, 0.0)
-            .with_context(|| format!("writing {}", path.display()))?;
+        image.write_png(&path, 0.0).map_err(|e| ReportError::Png {
+            path: path.clone(),
+            source: Box::new(e),
+        })?;
         images.push((*variant, image));
     }
     Ok(images)
@@ -193,7 +197,10 @@ fn noise_floor(
 ) -> Result<DePair<f64>> {
     let image = renderer
         .render(again.1.clone(), lighting, FLOOR_SEED)
-        .with_context(|| format!("{}: rendering {} again", subject.input, again.0.key()))?;
+        .map_err(|source| ReportError::Rendering {
+            what: format!("{}: rendering {} again", subject.input, again.0.key()),
+            source: Box::new(source),
+        })?;
     let d = delta_e_image(reference, &image, &mask(renderer.side()));
     false_colour::write_png(&d, &out.join(floor_file(stem, lighting)))?;
     Ok(d.mean())
